@@ -1,0 +1,102 @@
+#pragma once
+// Helpers shared by the tests: running the tethash program, temporary folders, finding a Python
+// interpreter that imports given modules, the shared real meshes.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace tethash::test {
+
+struct RunResult {
+    int status = -1;        ///< exit status
+    std::string out;        ///< standard output
+    std::string err;        ///< standard error
+};
+
+/// A fresh empty folder under the build tree, named after the running test.
+inline std::filesystem::path temp_dir()
+{
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "misc";
+    for (char& c : name)
+        if (c == '/') c = '_';
+    std::filesystem::path p = std::filesystem::path(TETHASH_TEST_TMP) / name;
+    std::filesystem::remove_all(p);
+    std::filesystem::create_directories(p);
+    return p;
+}
+
+inline std::string read_text(const std::filesystem::path& p)
+{
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+inline void write_text(const std::filesystem::path& p, const std::string& text)
+{
+    std::ofstream out(p, std::ios::binary);
+    out << text;
+}
+
+/// Runs a shell command line; captures stdout and stderr through files.
+inline RunResult run_shell(const std::string& cmdline)
+{
+    static int counter = 0;
+    const auto dir = std::filesystem::path(TETHASH_TEST_TMP) / "_run";
+    std::filesystem::create_directories(dir);
+    const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(counter++);
+    const auto out = dir / ("out_" + tag), err = dir / ("err_" + tag);
+    const std::string full = cmdline + " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
+    const int raw = std::system(full.c_str());
+    RunResult r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read_text(out);
+    r.err = read_text(err);
+    std::filesystem::remove(out);
+    std::filesystem::remove(err);
+    return r;
+}
+
+/// Runs the tethash program with the given arguments (already shell-quoted where needed).
+inline RunResult run_tethash(const std::string& args) { return run_shell(std::string("'") + TETHASH_EXE + "' " + args); }
+
+/// A Python interpreter that imports every module in `modules` (space separated), or nullopt.
+/// Tries /usr/bin/python3 (Debian's packages install there) before the python3 first on PATH.
+inline std::optional<std::string> python_with(const std::string& modules)
+{
+    std::string imports;
+    std::istringstream ss(modules);
+    for (std::string m; ss >> m;) imports += "import " + m + ";";
+    for (const char* candidate : {"/usr/bin/python3", "python3"}) {
+        const std::string cmd = std::string(candidate) + " -c '" + imports + "' >/dev/null 2>&1";
+        if (std::system(cmd.c_str()) == 0) return std::string(candidate);
+    }
+    return std::nullopt;
+}
+
+/// Path of a mesh in ../shared/meshes, or nullopt if the folder or the file is absent.
+inline std::optional<std::filesystem::path> shared_mesh(const std::string& name)
+{
+    std::filesystem::path p = std::filesystem::path(TETHASH_SHARED_MESHES) / name;
+    if (std::filesystem::exists(p)) return p;
+    return std::nullopt;
+}
+
+inline std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+} // namespace tethash::test
+
+#define TETHASH_SKIP_WITHOUT_PYTHON(var, modules)                                \
+    auto var##_opt = ::tethash::test::python_with(modules);                      \
+    if (!var##_opt) GTEST_SKIP() << "no python3 that imports: " << modules;      \
+    const std::string var = *var##_opt
