@@ -1,0 +1,129 @@
+#pragma once
+/// \file detect.hpp
+/// The three-stage spatial-hash collision detection of Teschner et al. 2003 for deformable
+/// tetrahedral meshes: (1) hash every vertex into an infinite uniform grid through a hash table,
+/// (2) hash the cells touched by every tet's bounding box into the same table, (3) test each vertex
+/// found there against the tet (closed inside test, exact).
+///
+/// Usage from an FEM code (no copies of its arrays):
+/// \code
+///   tethash::Detector det;                       // parameters: defaults (auto cell and table size)
+///   det.set_topology(tets);                      // once: m × 4 int32 row-major, validated here
+///   for (each step) {
+///       const auto& contacts = det.detect(positions);   // n × 3 double row-major
+///       for (const tethash::Contact& c : contacts) ...
+///   }
+/// \endcode
+
+#include "tethash/mesh.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tethash {
+
+/// A vertex lying inside (or on the boundary of) a tet it does not belong to.
+/// Plain data, 80 bytes; arrays of it are sorted by (vertex, tet).
+struct Contact {
+    Index vertex = -1;       ///< global vertex id
+    Index tet = -1;          ///< global tet id
+    Index vertex_object = 0; ///< object of the vertex
+    Index tet_object = 0;    ///< object of the tet
+    double bary[4] = {0, 0, 0, 0};   ///< barycentric coordinates of the vertex in the tet (sum 1, all ≥ 0 up to rounding)
+    /// Penetration depth (length units, ≥ 0) and unit direction pointing out of the penetrated object;
+    /// NaN unless penetration was requested (see penetration.hpp).
+    double depth = std::numeric_limits<double>::quiet_NaN();
+    double direction[3] = {0, 0, 0};
+};
+
+/// Hash function of the infinite grid's cells onto the table.
+enum class HashFunction {
+    teschner,  ///< (x·73856093 xor y·19349663 xor z·83492791) mod n  (the 2003 paper)
+    column,    ///< mix(x, y) + z: cells of one z-run land in consecutive buckets (one lookup per column)
+};
+/// "teschner" / "column"; throws Error for anything else.
+HashFunction parse_hash_function(const std::string& name);
+const char* to_string(HashFunction h);
+
+/// Per-object options. Objects not listed get the defaults.
+struct ObjectOptions {
+    bool self_collision = true; ///< report contacts between a vertex and a tet of the same object
+    bool is_static = false;     ///< positions never change: hashed once; static-static pairs are never reported
+};
+
+struct DetectParams {
+    /// Grid cell edge length l. ≤ 0 is invalid when `cell_size_mode == absolute`.
+    enum class CellSizeMode { auto_mean_edge, absolute, factor_of_mean_edge };
+    CellSizeMode cell_size_mode = CellSizeMode::auto_mean_edge;
+    double cell_size = 1.0;        ///< absolute length, or the factor for factor_of_mean_edge
+    std::int64_t table_size = 0;   ///< number of buckets; 0 = automatic from the vertex count
+    HashFunction hash = HashFunction::column;
+    int threads = 0;               ///< 0 = OpenMP default; 1 = serial
+};
+
+/// Statistics of one detect() call. Times in milliseconds.
+struct DetectStats {
+    double ms_total = 0, ms_vertices = 0, ms_tets = 0, ms_inside = 0, ms_sort = 0;
+    double cell_size = 0;                  ///< l actually used
+    std::int64_t table_size = 0;           ///< n actually used
+    int threads = 1;
+    std::int64_t vertices = 0, tets = 0;
+    std::int64_t cells_visited = 0;        ///< grid cells enumerated from tet boxes
+    std::int64_t entries_scanned = 0;      ///< bucket entries looked at
+    std::int64_t hash_collisions = 0;      ///< scanned entries whose cell differs from the visited cell
+    std::int64_t box_rejections = 0;       ///< candidates rejected by the tet's bounding box
+    std::int64_t own_vertex_skips = 0;     ///< candidates that were one of the tet's own vertices
+    std::int64_t inside_tests = 0;         ///< barycentric / orientation tests made
+    std::int64_t exact_fallbacks = 0;      ///< tests the floating-point filter could not decide
+    std::int64_t degenerate_tets = 0;      ///< zero-volume tets skipped
+    std::int64_t contacts = 0;
+    double table_load = 0;                 ///< vertices / table size
+    std::int64_t memory_bytes = 0;         ///< detector working memory
+};
+
+class DetectorImpl;
+
+/// Owns every buffer and reuses it across calls; after the first call on a scene, detect() does not allocate.
+/// Not thread-safe itself (one detect() at a time per Detector); parallel inside.
+class Detector {
+public:
+    Detector();
+    explicit Detector(const DetectParams& params);
+    ~Detector();
+    Detector(Detector&&) noexcept;
+    Detector& operator=(Detector&&) noexcept;
+    Detector(const Detector&) = delete;
+    Detector& operator=(const Detector&) = delete;
+
+    /// Sets parameters; validated (throws Error naming the parameter and value).
+    void set_params(const DetectParams& params);
+    const DetectParams& params() const;
+
+    /// Sets the topology once. `tets` is m × 4; `vertex_object`/`tet_object` give object ids (empty: all 0);
+    /// `objects[k]` gives the options of object k (missing: defaults). The number of vertices is fixed here.
+    /// Throws Error on indices out of range or repeated within a tet, or object ids out of range.
+    void set_topology(const TetsRef& tets, Index num_vertices,
+                      std::span<const Index> vertex_object = {}, std::span<const Index> tet_object = {},
+                      std::span<const ObjectOptions> objects = {});
+    /// Convenience: topology and object ids of a TetMesh.
+    void set_topology(const TetMesh& mesh, std::span<const ObjectOptions> objects = {});
+
+    /// Runs the three stages on `positions` (n × 3, n as in set_topology). Throws Error on a non-finite
+    /// position or a wrong row count. Returns the contacts sorted by (vertex, tet), valid until the next call.
+    const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats = nullptr);
+
+    /// The contacts of the last detect() call (mutable so that penetration can fill depth and direction).
+    std::vector<Contact>& contacts();
+
+private:
+    std::unique_ptr<DetectorImpl> m_impl;
+};
+
+/// Mean edge length of the unique edges of `tets` at `positions` (the default cell size).
+double mean_edge_length(const PositionsRef& positions, const TetsRef& tets);
+
+} // namespace tethash

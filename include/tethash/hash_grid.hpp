@@ -1,0 +1,100 @@
+#pragma once
+/// \file hash_grid.hpp
+/// The infinite uniform grid and the hash table of vertices used by the Detector (stage 1).
+///
+/// A point p lies in cell floor(p · (1/l)) per axis (negative coordinates included); cell coordinates
+/// are guarded to |c| < 2^30 (an Error otherwise, never wrap-around). A cell (x, y, z) goes to bucket
+/// H(x, y, z) mod n. The table is rebuilt each step as a counting sort of the vertices by bucket into
+/// one contiguous array (structure of arrays: float x, y, z relative to an origin, vertex id and the
+/// integer cell), so that a bucket is a contiguous index range [start[b], start[b+1]).
+///
+/// Two hash functions:
+/// - teschner: (x·73856093 xor y·19349663 xor z·83492791) mod n on 32-bit wrapping integers (the 2003 paper);
+/// - column: (mix(x, y) + z) mod n: the cells of one (x, y) column land in consecutive buckets, so a
+///   tet looks up a whole z-run of cells as one (or, wrapping around, two) contiguous bucket ranges.
+
+#include "tethash/detect.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace tethash {
+
+/// Largest allowed |cell coordinate| (exclusive).
+inline constexpr double max_cell_coordinate = 1073741824.0;   // 2^30
+/// Largest allowed table size.
+inline constexpr std::int64_t max_table_size = std::int64_t{1} << 27;
+
+inline std::uint64_t teschner_hash(std::int32_t x, std::int32_t y, std::int32_t z)
+{
+    return static_cast<std::uint32_t>(static_cast<std::uint32_t>(x) * 73856093u ^
+                                      static_cast<std::uint32_t>(y) * 19349663u ^
+                                      static_cast<std::uint32_t>(z) * 83492791u);
+}
+
+/// 64-bit mix of a column (x, y).
+inline std::uint64_t column_mix(std::int32_t x, std::int32_t y)
+{
+    std::uint64_t h = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) |
+                      static_cast<std::uint32_t>(y);
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdULL;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ULL;
+    h ^= h >> 33;
+    return h;
+}
+
+/// Reduces hashes modulo the table size n (mask for powers of two).
+struct TableModulus {
+    std::uint64_t n = 1;
+    std::uint64_t mask = 0;   ///< n − 1 when n is a power of two, else 0
+    bool pow2 = true;
+    explicit TableModulus(std::uint64_t size = 1) : n(size), mask(size - 1), pow2((size & (size - 1)) == 0) {}
+    std::uint64_t reduce(std::uint64_t h) const { return pow2 ? (h & mask) : (h % n); }
+    /// Bucket of cell z of the column with mix value h (column hash).
+    std::uint64_t column_bucket(std::uint64_t h, std::int32_t z) const
+    {
+        if (pow2) return (h + static_cast<std::uint64_t>(static_cast<std::int64_t>(z))) & mask;
+        const std::int64_t zn = static_cast<std::int64_t>(z) % static_cast<std::int64_t>(n);
+        const std::uint64_t zm = static_cast<std::uint64_t>(zn < 0 ? zn + static_cast<std::int64_t>(n) : zn);
+        return (h % n + zm) % n;
+    }
+};
+
+/// The default table size for `vertices` hashed vertices: for the column hash the smallest power of two
+/// ≥ 2·vertices (bucket ranges are masks; beyond 2V the collisions saved no longer pay for the table
+/// memory), for Teschner's hash the smallest prime ≥ 2·vertices (the xor-product hash needs an odd modulus).
+/// At least 1.
+std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices);
+/// Smallest prime ≥ n (n ≥ 2).
+std::int64_t next_prime(std::int64_t n);
+
+/// Stage 1: the vertex table. Keeps its buffers across builds.
+class VertexTable {
+public:
+    /// Rebuilds the table from the vertices `ids` (or all rows of `positions` when `ids` is null, count
+    /// = positions.rows()). `origin` is subtracted before the float conversion. Returns false when a
+    /// coordinate is non-finite or a cell coordinate is out of range (the caller diagnoses and throws).
+    bool build(const double* positions, const Index* ids, Index count, double cell_size, const double origin[3],
+               std::int64_t table_size, HashFunction hash, int threads);
+
+    std::int64_t table_size() const { return static_cast<std::int64_t>(m_mod.n); }
+    const TableModulus& modulus() const { return m_mod; }
+    Index size() const { return m_count; }
+    std::int64_t memory_bytes() const;
+
+    // Structure of arrays in bucket order, padded by 8 entries at the end (padding never matches).
+    std::vector<float> x, y, z;
+    std::vector<std::int32_t> id, cx, cy, cz;
+    std::vector<std::int32_t> start;   ///< n + 1 offsets
+
+private:
+    TableModulus m_mod;
+    Index m_count = 0;
+    std::vector<std::uint32_t> m_bucket;   ///< per input vertex
+    std::vector<std::int32_t> m_cell;      ///< per input vertex, 3 ints
+    std::vector<float> m_local;            ///< per input vertex, 3 floats
+};
+
+} // namespace tethash

@@ -1,0 +1,50 @@
+#pragma once
+/// \file io/mesh_io.hpp
+/// Reading and writing tet meshes by file extension, and the helpers every format shares.
+///
+/// Readers throw tethash::Error with a message "FILE:LINE: expected X, found Y" (or "FILE: byte
+/// OFFSET: ..." for binary data). Writers write to a temporary name in the target folder and rename
+/// when complete, so a failed write never leaves half a file where a good one was.
+
+#include "tethash/mesh.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace tethash::io {
+
+/// A data array attached to points or cells for output (ParaView shows it by name).
+struct Field {
+    std::string name;
+    int components = 1;           ///< 1 (scalar) or 3 (vector)
+    std::vector<double> values;   ///< size = count × components, row-major
+};
+struct Fields {
+    std::vector<Field> point;     ///< one value per vertex
+    std::vector<Field> cell;      ///< one value per tet
+};
+
+/// Notes a reader makes without failing (for example "skipped 12 cells of type 5").
+struct ReadNotes {
+    std::int64_t skipped_cells = 0;       ///< non-tet cells skipped
+    std::vector<std::string> messages;    ///< human-readable notes
+};
+
+/// Formats by extension: .vtk .vtu .msh .node/.ele (either name) .mesh .veg (tet meshes);
+/// surfaces (.obj .stl .ply .off .gltf .glb ...) are not tet meshes: use surface.hpp.
+TetMesh read_mesh(const std::string& path, ReadNotes* notes = nullptr);
+/// Writers by extension: .vtu .vtk .msh (4.1) .mesh .node/.ele; surfaces (.obj .ply .stl .gltf/.glb) write the boundary.
+void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fields = {});
+/// True if `path` has an extension read_mesh knows.
+bool is_tet_mesh_path(const std::string& path);
+
+/// Lower-case extension with the dot (".vtu"), "" if none.
+std::string extension_of(const std::string& path);
+
+/// Writes a file through a temporary name next to it; `write` gets the temporary path.
+/// On success renames over `path`; on any exception removes the temporary and rethrows.
+void write_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
+
+} // namespace tethash::io

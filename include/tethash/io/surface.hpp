@@ -1,0 +1,25 @@
+#pragma once
+/// \file io/surface.hpp
+/// Triangle surfaces through assimp (OBJ, STL, PLY, OFF, glTF, ...): import for obstacles and for
+/// tetrahedralization, export of a tet mesh's boundary. Without assimp these throw Error saying so.
+#include "tethash/io/mesh_io.hpp"
+
+namespace tethash::io {
+
+struct SurfaceMesh {
+    Positions vertices;   ///< k × 3
+    Triangles triangles;  ///< t × 3
+};
+
+/// True when tethash was built with assimp.
+bool have_assimp();
+/// All meshes of the file merged into one triangle soup with shared vertices joined (assimp's JoinIdenticalVertices).
+SurfaceMesh read_surface(const std::string& path);
+/// Format from the extension (.obj .ply .stl .gltf .glb).
+void write_surface(const std::string& path, const SurfaceMesh& surface);
+/// The outward boundary of `mesh` as a surface (vertices compacted).
+SurfaceMesh boundary_surface(const TetMesh& mesh);
+/// True if `path` has a surface extension.
+bool is_surface_path(const std::string& path);
+
+} // namespace tethash::io

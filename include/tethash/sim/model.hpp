@@ -1,0 +1,86 @@
+#pragma once
+/// \file sim/model.hpp
+/// The mass-spring model: one spring per unique tet edge, one volume term per tet, lumped masses,
+/// plus gravity and ground. Positions and velocities are n × 3 row-major (Positions).
+/// Forces are accumulated (+=) into n × 3 arrays; energies in force × length.
+
+#include "tethash/mesh.hpp"
+#include "tethash/sim/scene.hpp"
+
+#include <Eigen/Sparse>
+
+#include <cmath>
+
+#include <vector>
+
+namespace tethash::sim {
+
+struct Springs {
+    Edges edges;                   ///< e × 2 vertex ids
+    std::vector<double> rest;      ///< e rest lengths
+    std::vector<double> k;         ///< e stiffnesses (force / length)
+    std::vector<double> c;         ///< e dashpot coefficients (force · s / length)
+};
+
+struct VolumeTerms {
+    Tets tets;                     ///< tets of the dynamic objects
+    std::vector<double> rest;      ///< rest signed volumes (> 0 after orientation)
+    std::vector<double> k;         ///< stiffness: energy ½ k V0 ((V − V0)/V0)²
+};
+
+/// Energy split (force × length). `total()` = kinetic + elastic + volume + gravity + ground + contact.
+struct Energy {
+    double kinetic = 0, spring = 0, volume = 0, gravity = 0, ground = 0, contact = 0;
+    double total() const { return kinetic + spring + volume + gravity + ground + contact; }
+    double internal() const { return kinetic + spring + volume + ground + contact; }  ///< all ≥ 0
+};
+
+/// Everything computed once from the rest state.
+struct Model {
+    Springs springs;
+    VolumeTerms volumes;
+    std::vector<double> mass;      ///< n lumped masses (static objects: their own mass, unused)
+    std::vector<char> fixed;       ///< n: 1 = pinned or static (never moves)
+    Eigen::Vector3d gravity{0, 0, 0};
+    Ground ground;
+
+    /// Springs, volumes and masses of the dynamic objects of `mesh` (rest state = mesh.rest()),
+    /// materials per object. Throws Error on a zero-volume tet or a zero-length edge, naming the element.
+    static Model build(const TetMesh& mesh, const std::vector<Material>& materials,
+                       const std::vector<char>& object_static);
+
+    /// Which forces add_forces() adds, and how.
+    struct ForceOptions {
+        enum Part : unsigned { springs = 1, damping = 2, volume = 4, gravity = 8, ground = 16, all = 31 };
+        unsigned parts = all;
+        double h = 0;                 ///< > 0: friction capped so that it cannot reverse a sliding velocity in one step of h
+        double volume_scale = 1;      ///< multiplies the volume term
+        double ground_scale = 1;      ///< multiplies the ground stiffness and damping
+    };
+    /// f += spring, damping, volume, gravity and ground forces at (x, v); fixed vertices included (callers ignore them).
+    void add_forces(const Positions& x, const Positions& v, Positions& f) const { add_forces(x, v, f, ForceOptions{}); }
+    void add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const;
+    /// Only the spring forces (elastic part, no damping).
+    void add_spring_forces(const Positions& x, Positions& f) const;
+    /// Energies (contact left 0: see Simulation).
+    Energy energy(const Positions& x, const Positions& v) const;
+    /// Largest eigenvalue bound of M⁻¹K over springs and volume terms (Gershgorin, rest state): ω_max².
+    double omega_max_sq(const Positions& x) const;
+    /// Explicit (symplectic Euler) stability limit (s) per vertex from the Gershgorin bounds of ω² and of the
+    /// damping rate γ: h < (−γ + sqrt(γ² + 4ω²)) / ω² (= 2/ω without damping); minimum over free vertices.
+    /// `extra_k` adds a stiffness per vertex (e.g. contact or ground penalty). +inf when nothing is stiff.
+    double explicit_dt_limit(const Positions& x, double extra_k = 0) const;
+    /// Adds the (positive semi-definite) stiffness −∂f/∂x of springs (+ volume Gauss–Newton part) and the
+    /// damping −∂f/∂v of the dashpots as triplets on the 3n × 3n matrix: scale_k · K + scale_c · C.
+    void add_matrix_triplets(const Positions& x, double scale_k, double scale_c,
+                             std::vector<Eigen::Triplet<double>>& out) const;
+    /// Matrix-free form of the same matrix: out += (scale_k · K + scale_c · C) p for flat 3n vectors; rows and
+    /// columns of fixed vertices are skipped (as in add_matrix_triplets).
+    void apply_matrix(const Positions& x, double scale_k, double scale_c, const Eigen::VectorXd& p,
+                      Eigen::VectorXd& out) const;
+    /// diag += the diagonal of scale_k · K + scale_c · C (fixed vertices skipped).
+    void add_matrix_diagonal(const Positions& x, double scale_k, double scale_c, Eigen::VectorXd& diag) const;
+    Index num_vertices() const { return static_cast<Index>(mass.size()); }
+};
+
+} // namespace tethash::sim

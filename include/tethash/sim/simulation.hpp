@@ -1,0 +1,92 @@
+#pragma once
+/// \file sim/simulation.hpp
+/// A running simulation of a Scene: detection → penetration depth → contact response → integration.
+///
+/// \code
+///   tethash::sim::Simulation sim(tethash::sim::load_scene("meshes/scenes/default.toml"));
+///   for (int s = 0; s < sim.scene().steps; ++s) {
+///       sim.step();                                   // throws RunFailure on blow-up (state unchanged)
+///       use(sim.positions(), sim.energy().total(), sim.max_penetration());
+///   }
+/// \endcode
+
+#include "tethash/detect.hpp"
+#include "tethash/io/mesh_io.hpp"
+#include "tethash/penetration.hpp"
+#include "tethash/sim/model.hpp"
+#include "tethash/sim/scene.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tethash::sim {
+
+/// Timing and contact figures of one step (all its substeps). Times in milliseconds.
+struct StepStats {
+    double ms_detect = 0;      ///< Detector::detect
+    double ms_response = 0;    ///< penetration depth + contact forces
+    double ms_integrate = 0;   ///< forces, matrix assembly, solve, update
+    std::int64_t contacts = 0; ///< contacts at the last substep
+    double max_depth = 0;      ///< largest penetration depth at the last substep (0 without contacts)
+    double mean_depth = 0;     ///< mean over contacts at the last substep
+    int solver_iterations = 0; ///< CG iterations (implicit) summed over substeps
+};
+
+class SimulationImpl;
+
+class Simulation {
+public:
+    /// Builds objects (reads files / generates shapes), the model and the detector. Throws Error on bad
+    /// input (missing file, zero-volume tet, pinned ids out of range...).
+    explicit Simulation(const Scene& scene);
+    ~Simulation();
+    Simulation(Simulation&&) noexcept;
+    Simulation& operator=(Simulation&&) noexcept;
+
+    /// Advances one time step (scene().dt, in scene().substeps substeps). On NaN/Inf or energy growing by
+    /// orders of magnitude throws RunFailure naming the step and the likely cause; the state stays at the
+    /// last good step.
+    void step();
+
+    const Scene& scene() const;
+    std::int64_t step_index() const;   ///< steps completed
+    double time() const;               ///< simulated time (s)
+
+    /// The whole scene as one mesh (objects in order, object ids set), positions = current positions.
+    const TetMesh& mesh() const;
+    const Positions& positions() const;      ///< n × 3
+    const Positions& velocities() const;     ///< n × 3
+    const Model& model() const;
+    /// Vertex range [first, first + count) and tet range of object k in mesh().
+    std::pair<Index, Index> object_vertices(int k) const;
+    std::pair<Index, Index> object_tets(int k) const;
+
+    Energy energy() const;                   ///< at the current state (contact term from the last contacts)
+    Eigen::Vector3d momentum() const;        ///< Σ m v over non-fixed vertices
+
+    const std::vector<Contact>& contacts() const;   ///< of the last detection, depth/direction filled
+    double max_penetration() const;          ///< max depth over contacts() (0 if none)
+    double mean_penetration() const;
+    /// Exact distance of each contact's vertex to the penetrated object's boundary (for error studies).
+    std::vector<double> exact_depths() const;
+    /// Runs detection + penetration at the current positions (updates contacts()).
+    void refresh_contacts();
+
+    const StepStats& last_stats() const;
+    /// Explicit stability limit 2/ω_max of the model (s); a warning is issued when dt/substeps exceeds it
+    /// with the symplectic integrator.
+    double explicit_dt_limit() const;
+    /// Warnings gathered at construction (for example "dt above the explicit stability limit").
+    const std::vector<std::string>& warnings() const;
+
+    /// Point data (velocity, contact flag, penetration depth) and cell data (object) for a frame,
+    /// filtered by scene().output.fields.
+    io::Fields output_fields() const;
+
+private:
+    std::unique_ptr<SimulationImpl> m_impl;
+};
+
+} // namespace tethash::sim

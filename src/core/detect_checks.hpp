@@ -1,0 +1,25 @@
+#pragma once
+// Input checks shared by the Detector (src/core/detect.cpp) and the oracle (src/oracle): private header.
+#include "tethash/detect.hpp"
+
+#include <span>
+#include <vector>
+
+namespace tethash::detail {
+
+/// Throws Error naming the first offending tet/vertex: index out of range or repeated in a tet,
+/// object id arrays of the wrong length or negative ids.
+void check_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
+                    std::span<const Index> tet_object);
+/// Throws Error on a wrong row count or a non-finite coordinate (naming the vertex).
+void check_positions(const PositionsRef& positions, Index num_vertices);
+
+/// Per-object flags expanded to the number of objects in use (1 + largest id; ids ≥ objects.size() get defaults).
+struct ObjectFlags {
+    std::vector<unsigned char> self_collision;  ///< per object
+    std::vector<unsigned char> is_static;       ///< per object
+};
+ObjectFlags object_flags(std::span<const Index> vertex_object, std::span<const Index> tet_object,
+                         std::span<const ObjectOptions> objects);
+
+} // namespace tethash::detail

@@ -1,0 +1,110 @@
+// Stage 1: counting sort of the vertices by bucket into one contiguous structure of arrays.
+#include "tethash/hash_grid.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#ifdef TETHASH_HAVE_OPENMP
+#include <omp.h>
+#endif
+
+namespace tethash {
+
+std::int64_t next_prime(std::int64_t n)
+{
+    if (n <= 2) return 2;
+    for (std::int64_t c = n | 1;; c += 2) {
+        bool prime = true;
+        for (std::int64_t d = 3; d * d <= c; d += 2)
+            if (c % d == 0) {
+                prime = false;
+                break;
+            }
+        if (prime) return c;
+    }
+}
+
+std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices)
+{
+    const std::int64_t want = std::max<std::int64_t>(2 * vertices, 1);
+    if (hash == HashFunction::teschner) return std::min(next_prime(want), max_table_size);
+    std::int64_t n = 1;
+    while (n < want && n < max_table_size) n <<= 1;
+    return n;
+}
+
+std::int64_t VertexTable::memory_bytes() const
+{
+    return static_cast<std::int64_t>(x.capacity() * 3 * sizeof(float) + id.capacity() * 4 * sizeof(std::int32_t) +
+                                     start.capacity() * sizeof(std::int32_t) + m_bucket.capacity() * 4 +
+                                     m_cell.capacity() * 4 + m_local.capacity() * 4);
+}
+
+bool VertexTable::build(const double* positions, const Index* ids, Index count, double cell_size,
+                        const double origin[3], std::int64_t table_size, HashFunction hash, int threads)
+{
+    m_mod = TableModulus(static_cast<std::uint64_t>(table_size));
+    m_count = count;
+    const std::size_t padded = static_cast<std::size_t>(count) + 8;
+    if (x.size() != padded) {
+        for (auto* v : {&x, &y, &z}) v->assign(padded, std::numeric_limits<float>::quiet_NaN());
+        for (auto* v : {&id, &cx, &cy, &cz}) v->assign(padded, std::numeric_limits<std::int32_t>::min());
+    }
+    m_bucket.resize(count);
+    m_cell.resize(3 * static_cast<std::size_t>(count));
+    m_local.resize(3 * static_cast<std::size_t>(count));
+    start.assign(static_cast<std::size_t>(table_size) + 1, 0);
+
+    const double inv = 1.0 / cell_size;
+    const double ox = origin[0], oy = origin[1], oz = origin[2];
+    const TableModulus mod = m_mod;
+    int bad = 0;
+    (void)threads;
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(| : bad) if (count > 20000)
+    for (Index i = 0; i < count; ++i) {
+        const Index v = ids ? ids[i] : i;
+        const double* p = positions + 3 * static_cast<std::size_t>(v);
+        const double sx = p[0] * inv, sy = p[1] * inv, sz = p[2] * inv;
+        // NaN fails every comparison: caught here too.
+        if (!(std::fabs(sx) < max_cell_coordinate && std::fabs(sy) < max_cell_coordinate &&
+              std::fabs(sz) < max_cell_coordinate)) {
+            bad = 1;
+            continue;
+        }
+        const auto ix = static_cast<std::int32_t>(std::floor(sx));
+        const auto iy = static_cast<std::int32_t>(std::floor(sy));
+        const auto iz = static_cast<std::int32_t>(std::floor(sz));
+        m_cell[3 * i] = ix;
+        m_cell[3 * i + 1] = iy;
+        m_cell[3 * i + 2] = iz;
+        m_local[3 * i] = static_cast<float>(p[0] - ox);
+        m_local[3 * i + 1] = static_cast<float>(p[1] - oy);
+        m_local[3 * i + 2] = static_cast<float>(p[2] - oz);
+        m_bucket[i] = static_cast<std::uint32_t>(hash == HashFunction::column
+                                                     ? mod.column_bucket(column_mix(ix, iy), iz)
+                                                     : mod.reduce(teschner_hash(ix, iy, iz)));
+    }
+    if (bad) return false;
+
+    // Counting sort, stable in input order (deterministic whatever the thread count).
+    std::int32_t* s = start.data();
+    for (Index i = 0; i < count; ++i) ++s[m_bucket[i] + 1];
+    for (std::int64_t b = 0; b < table_size; ++b) s[b + 1] += s[b];
+    for (Index i = 0; i < count; ++i) {
+        const std::int32_t k = s[m_bucket[i]]++;
+        x[k] = m_local[3 * i];
+        y[k] = m_local[3 * i + 1];
+        z[k] = m_local[3 * i + 2];
+        id[k] = ids ? ids[i] : i;
+        cx[k] = m_cell[3 * i];
+        cy[k] = m_cell[3 * i + 1];
+        cz[k] = m_cell[3 * i + 2];
+    }
+    // start[b] now holds the end of bucket b: shift right by one.
+    std::memmove(s + 1, s, static_cast<std::size_t>(table_size) * sizeof(std::int32_t));
+    s[0] = 0;
+    return true;
+}
+
+} // namespace tethash

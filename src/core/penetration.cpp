@@ -1,0 +1,508 @@
+#include "tethash/penetration.hpp"
+
+#include "tethash/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+namespace tethash {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+struct Face {
+    Index v[3];   ///< oriented by the caller at use: normal flipped away from `opp`
+    Index opp;    ///< the fourth vertex of the tet the face belongs to (inside)
+};
+
+Vec3 pos(const PositionsRef& x, Index i) { return x.row(i).transpose(); }
+
+/// Outward unit normal of a boundary face at the current positions (away from the tet's fourth vertex).
+Vec3 outward_normal(const PositionsRef& x, const Face& f)
+{
+    const Vec3 a = pos(x, f.v[0]);
+    Vec3 n = (pos(x, f.v[1]) - a).cross(pos(x, f.v[2]) - a);
+    if (n.dot(pos(x, f.opp) - a) > 0) n = -n;
+    const double len = n.norm();
+    return len > 0 ? Vec3(n / len) : Vec3::Zero();
+}
+
+/// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
+{
+    const Vec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+    if (d1 <= 0 && d2 <= 0) return a;
+    const Vec3 bp = p - b;
+    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+    if (d3 >= 0 && d4 <= d3) return b;
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+    const Vec3 cp = p - c;
+    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+    if (d6 >= 0 && d5 <= d6) return c;
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    const double denom = 1.0 / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+/// Segment p + t (q − p), t ∈ [0, 1], against triangle abc (Möller–Trumbore, both sides). Returns t or −1.
+double segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c)
+{
+    const Vec3 d = q - p, e1 = b - a, e2 = c - a;
+    const Vec3 s1 = d.cross(e2);
+    const double det = e1.dot(s1);
+    const double scale = e1.norm() * e2.norm() * d.norm();
+    if (!(std::abs(det) > 1e-14 * scale)) return -1;
+    const double inv = 1.0 / det;
+    const Vec3 s = p - a;
+    const double u = s.dot(s1) * inv;
+    if (u < 0 || u > 1) return -1;
+    const Vec3 s2 = s.cross(e1);
+    const double v = d.dot(s2) * inv;
+    if (v < 0 || u + v > 1) return -1;
+    const double t = e2.dot(s2) * inv;
+    return (t >= 0 && t <= 1) ? t : -1;
+}
+
+/// Axis-aligned bounding-box tree over some boundary faces at fixed positions.
+class Bvh {
+public:
+    struct Node {
+        Vec3 lo, hi;
+        Index left = -1, right = -1;   // children (inner) or −1
+        Index first = 0, count = 0;     // face range in m_order (leaf)
+    };
+
+    void build(const PositionsRef& x, const std::vector<Face>& faces)
+    {
+        m_faces = &faces;
+        m_nodes.clear();
+        m_order.resize(faces.size());
+        std::iota(m_order.begin(), m_order.end(), 0);
+        m_lo.resize(faces.size());
+        m_hi.resize(faces.size());
+        m_center.resize(faces.size());
+        for (size_t f = 0; f < faces.size(); ++f) {
+            const Vec3 a = pos(x, faces[f].v[0]), b = pos(x, faces[f].v[1]), c = pos(x, faces[f].v[2]);
+            m_lo[f] = a.cwiseMin(b).cwiseMin(c);
+            m_hi[f] = a.cwiseMax(b).cwiseMax(c);
+            m_center[f] = (a + b + c) / 3.0;
+        }
+        if (!faces.empty()) build_node(0, static_cast<Index>(faces.size()));
+    }
+
+    bool empty() const { return m_nodes.empty(); }
+
+    /// Visits faces whose box meets the segment's box.
+    template <class F>
+    void for_segment(const Vec3& p, const Vec3& q, F&& visit) const
+    {
+        if (m_nodes.empty()) return;
+        const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+        Index stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top) {
+            const Node& n = m_nodes[static_cast<size_t>(stack[--top])];
+            if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
+            if (n.left < 0) {
+                for (Index k = n.first; k < n.first + n.count; ++k) visit(m_order[static_cast<size_t>(k)]);
+            } else if (top < 126) {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            }
+        }
+    }
+
+    /// Closest point over faces accepted by `accept(face)`: returns face id (−1 if none) and fills point, dist².
+    template <class A>
+    Index closest(const PositionsRef& x, const Vec3& p, A&& accept, Vec3& best_point, double& best_d2) const
+    {
+        best_d2 = std::numeric_limits<double>::infinity();
+        Index best = -1;
+        if (m_nodes.empty()) return best;
+        Index stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top) {
+            const Node& n = m_nodes[static_cast<size_t>(stack[--top])];
+            const Vec3 d = (n.lo - p).cwiseMax(p - n.hi).cwiseMax(Vec3::Zero());
+            if (d.squaredNorm() >= best_d2) continue;
+            if (n.left < 0) {
+                for (Index k = n.first; k < n.first + n.count; ++k) {
+                    const Index f = m_order[static_cast<size_t>(k)];
+                    const Face& fc = (*m_faces)[static_cast<size_t>(f)];
+                    if (!accept(fc)) continue;
+                    const Vec3 c = closest_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+                    const double d2 = (c - p).squaredNorm();
+                    if (d2 < best_d2) {
+                        best_d2 = d2;
+                        best_point = c;
+                        best = f;
+                    }
+                }
+            } else if (top < 126) {
+                // Nearer child last so that it is popped first.
+                const Node& l = m_nodes[static_cast<size_t>(n.left)];
+                const Node& r = m_nodes[static_cast<size_t>(n.right)];
+                const double dl = (l.lo - p).cwiseMax(p - l.hi).cwiseMax(Vec3::Zero()).squaredNorm();
+                const double dr = (r.lo - p).cwiseMax(p - r.hi).cwiseMax(Vec3::Zero()).squaredNorm();
+                if (dl < dr) {
+                    stack[top++] = n.right;
+                    stack[top++] = n.left;
+                } else {
+                    stack[top++] = n.left;
+                    stack[top++] = n.right;
+                }
+            }
+        }
+        return best;
+    }
+
+private:
+    Index build_node(Index first, Index count)
+    {
+        const Index id = static_cast<Index>(m_nodes.size());
+        m_nodes.emplace_back();
+        Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+        Vec3 clo = lo, chi = hi;
+        for (Index k = first; k < first + count; ++k) {
+            const size_t f = static_cast<size_t>(m_order[static_cast<size_t>(k)]);
+            lo = lo.cwiseMin(m_lo[f]);
+            hi = hi.cwiseMax(m_hi[f]);
+            clo = clo.cwiseMin(m_center[f]);
+            chi = chi.cwiseMax(m_center[f]);
+        }
+        m_nodes[static_cast<size_t>(id)].lo = lo;
+        m_nodes[static_cast<size_t>(id)].hi = hi;
+        // Depth is bounded by the median split: log2(faces) levels (the traversal stack holds 128).
+        if (count <= 4) {
+            m_nodes[static_cast<size_t>(id)].first = first;
+            m_nodes[static_cast<size_t>(id)].count = count;
+            return id;
+        }
+        int axis = 0;
+        (chi - clo).maxCoeff(&axis);
+        const Index mid = first + count / 2;
+        std::nth_element(m_order.begin() + first, m_order.begin() + mid, m_order.begin() + first + count,
+                         [&](Index a, Index b) { return m_center[static_cast<size_t>(a)][axis] < m_center[static_cast<size_t>(b)][axis]; });
+        const Index l = build_node(first, mid - first);
+        const Index r = build_node(mid, first + count - mid);
+        m_nodes[static_cast<size_t>(id)].left = l;
+        m_nodes[static_cast<size_t>(id)].right = r;
+        return id;
+    }
+
+    const std::vector<Face>* m_faces = nullptr;
+    std::vector<Node> m_nodes;
+    std::vector<Index> m_order;
+    std::vector<Vec3> m_lo, m_hi, m_center;
+};
+
+} // namespace
+
+class PenetrationImpl {
+public:
+    Index n = 0;
+    Index objects = 0;
+    std::vector<Index> vertex_object;
+    Adjacency adjacency;
+    std::vector<std::vector<Face>> faces;   // boundary faces per object
+    bool ready = false;
+
+    void set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj, std::span<const Index> tobj);
+    /// Builds the trees of the objects flagged in `need` at positions x.
+    void build_trees(const PositionsRef& x, const std::vector<char>& need, std::vector<Bvh>& trees) const;
+    /// Closest point on object b's boundary to vertex i, ignoring faces touching i or its neighbours.
+    bool closest(const PositionsRef& x, const Bvh& tree, Index i, Vec3& point, double& dist) const;
+    bool near_vertex(const Face& f, Index i) const
+    {
+        for (Index a : f.v) {
+            if (a == i) return true;
+            const auto b = adjacency.neighbours.begin() + adjacency.offsets[static_cast<size_t>(i)];
+            const auto e = adjacency.neighbours.begin() + adjacency.offsets[static_cast<size_t>(i) + 1];
+            if (std::binary_search(b, e, a)) return true;
+        }
+        return false;
+    }
+};
+
+void PenetrationImpl::set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj, std::span<const Index> tobj)
+{
+    const Index m = static_cast<Index>(tets.rows());
+    if (num_vertices < 0) throw Error("penetration: negative vertex count");
+    if (!vobj.empty() && static_cast<Index>(vobj.size()) != num_vertices)
+        throw Error("penetration: vertex_object has " + std::to_string(vobj.size()) + " entries for " +
+                    std::to_string(num_vertices) + " vertices");
+    if (!tobj.empty() && static_cast<Index>(tobj.size()) != m)
+        throw Error("penetration: tet_object has " + std::to_string(tobj.size()) + " entries for " + std::to_string(m) + " tets");
+    for (Index t = 0; t < m; ++t)
+        for (int k = 0; k < 4; ++k)
+            if (tets(t, k) < 0 || tets(t, k) >= num_vertices)
+                throw Error("penetration: tet " + std::to_string(t) + " has vertex index " + std::to_string(tets(t, k)) +
+                            " out of range [0, " + std::to_string(num_vertices) + ")");
+    n = num_vertices;
+    vertex_object.assign(vobj.begin(), vobj.end());
+    if (vertex_object.empty()) vertex_object.assign(static_cast<size_t>(n), 0);
+    objects = 0;
+    for (Index o : vertex_object) objects = std::max(objects, o + 1);
+    for (Index o : tobj) objects = std::max(objects, o + 1);
+    if (m > 0) objects = std::max<Index>(objects, 1);
+    adjacency = vertex_adjacency(tets, n);
+
+    // Boundary faces: faces of exactly one tet, with that tet's fourth vertex for orientation.
+    struct Key {
+        std::array<Index, 3> s;
+        Index tet;
+        int face;
+    };
+    static constexpr int kFace[4][4] = {{1, 2, 3, 0}, {0, 3, 2, 1}, {0, 1, 3, 2}, {0, 2, 1, 3}};
+    std::vector<Key> keys;
+    keys.reserve(static_cast<size_t>(4 * m));
+    for (Index t = 0; t < m; ++t)
+        for (int f = 0; f < 4; ++f) {
+            std::array<Index, 3> s{tets(t, kFace[f][0]), tets(t, kFace[f][1]), tets(t, kFace[f][2])};
+            std::sort(s.begin(), s.end());
+            keys.push_back({s, t, f});
+        }
+    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.s < b.s || (a.s == b.s && a.tet < b.tet); });
+    faces.assign(static_cast<size_t>(objects), {});
+    for (size_t a = 0; a < keys.size();) {
+        size_t b = a + 1;
+        while (b < keys.size() && keys[b].s == keys[a].s) ++b;
+        if (b - a == 1) {
+            const Key& k = keys[a];
+            Face fc;
+            for (int j = 0; j < 3; ++j) fc.v[j] = tets(k.tet, kFace[k.face][j]);
+            fc.opp = tets(k.tet, kFace[k.face][3]);
+            const Index o = tobj.empty() ? 0 : tobj[static_cast<size_t>(k.tet)];
+            faces[static_cast<size_t>(o)].push_back(fc);
+        }
+        a = b;
+    }
+    ready = true;
+}
+
+void PenetrationImpl::build_trees(const PositionsRef& x, const std::vector<char>& need, std::vector<Bvh>& trees) const
+{
+    trees.resize(static_cast<size_t>(objects));
+    for (Index o = 0; o < objects; ++o)
+        if (need[static_cast<size_t>(o)]) trees[static_cast<size_t>(o)].build(x, faces[static_cast<size_t>(o)]);
+}
+
+bool PenetrationImpl::closest(const PositionsRef& x, const Bvh& tree, Index i, Vec3& point, double& dist) const
+{
+    double d2 = 0;
+    const Vec3 p = pos(x, i);
+    const Index obj = vertex_object[static_cast<size_t>(i)];
+    // Faces of i's own neighbourhood are skipped: for self-collisions they would be at distance ~0.
+    const Index best = tree.closest(x, p, [&](const Face& f) {
+        return vertex_object[static_cast<size_t>(f.v[0])] != obj || !near_vertex(f, i);
+    }, point, d2);
+    if (best < 0) return false;
+    dist = std::sqrt(d2);
+    return true;
+}
+
+Penetration::Penetration() : m_impl(std::make_unique<PenetrationImpl>()) {}
+Penetration::~Penetration() = default;
+Penetration::Penetration(Penetration&&) noexcept = default;
+Penetration& Penetration::operator=(Penetration&&) noexcept = default;
+
+void Penetration::set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
+                               std::span<const Index> tet_object)
+{
+    m_impl->set(tets, num_vertices, vertex_object, tet_object);
+}
+
+void Penetration::set_topology(const TetMesh& mesh)
+{
+    m_impl->set(mesh.tets, mesh.num_vertices(), mesh.vertex_object, mesh.tet_object);
+}
+
+void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, PenetrationStats* stats)
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    PenetrationImpl& s = *m_impl;
+    if (!s.ready) throw Error("penetration: set_topology was not called");
+    if (x.rows() != s.n)
+        throw Error("penetration: positions have " + std::to_string(x.rows()) + " rows, topology has " + std::to_string(s.n) + " vertices");
+    PenetrationStats st;
+
+    // (vertex, penetrated object) pairs.
+    struct Pair {
+        Index vertex, object;
+        double depth = 0;
+        Vec3 dir = Vec3::Zero();
+        int state = 0;   // 0 none, 1 valued (border), 2 valued (propagated), 3 fallback
+    };
+    std::vector<Pair> pairs;
+    std::unordered_map<std::int64_t, Index> slot;
+    auto key = [&](Index v, Index o) { return static_cast<std::int64_t>(v) * s.objects + o; };
+    std::vector<Index> contact_slot(contacts.size());
+    std::vector<char> need(static_cast<size_t>(s.objects), 0);
+    for (size_t c = 0; c < contacts.size(); ++c) {
+        const Contact& ct = contacts[c];
+        if (ct.vertex < 0 || ct.vertex >= s.n || ct.tet_object < 0 || ct.tet_object >= s.objects)
+            throw Error("penetration: contact " + std::to_string(c) + " has vertex " + std::to_string(ct.vertex) +
+                        " / tet object " + std::to_string(ct.tet_object) + " out of range");
+        auto [it, fresh] = slot.try_emplace(key(ct.vertex, ct.tet_object), static_cast<Index>(pairs.size()));
+        if (fresh) pairs.push_back(Pair{ct.vertex, ct.tet_object});
+        contact_slot[c] = it->second;
+        need[static_cast<size_t>(ct.tet_object)] = 1;
+    }
+    st.pairs = static_cast<std::int64_t>(pairs.size());
+    std::vector<Bvh> trees;
+    s.build_trees(x, need, trees);
+    auto find = [&](Index v, Index o) -> Index {
+        auto it = slot.find(key(v, o));
+        return it == slot.end() ? -1 : it->second;
+    };
+
+    // 1. Border: edges from a colliding vertex to a non-colliding neighbour, intersected with the surface.
+    for (Pair& p : pairs) {
+        const Vec3 xi = pos(x, p.vertex);
+        const auto& faces = s.faces[static_cast<size_t>(p.object)];
+        double wsum = 0, dsum = 0;
+        Vec3 nsum = Vec3::Zero();
+        for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)]; a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
+            const Index j = s.adjacency.neighbours[static_cast<size_t>(a)];
+            if (find(j, p.object) >= 0) continue;
+            const Vec3 xj = pos(x, j);
+            double best_t = 2;
+            Index best_f = -1;
+            trees[static_cast<size_t>(p.object)].for_segment(xi, xj, [&](Index f) {
+                const Face& fc = faces[static_cast<size_t>(f)];
+                for (Index v : fc.v)
+                    if (v == p.vertex || v == j) return;
+                const double t = segment_triangle(xi, xj, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+                if (t >= 0 && t < best_t) {
+                    best_t = t;
+                    best_f = f;
+                }
+            });
+            if (best_f < 0) continue;
+            ++st.intersections;
+            const Vec3 hit = xi + best_t * (xj - xi);
+            const Vec3 nrm = outward_normal(x, faces[static_cast<size_t>(best_f)]);
+            const double dist2 = (hit - xi).squaredNorm();
+            const double w = 1.0 / std::max(dist2, 1e-300);
+            wsum += w;
+            dsum += w * (hit - xi).dot(nrm);
+            nsum += w * nrm;
+        }
+        if (wsum > 0 && nsum.norm() > 0) {
+            p.depth = dsum / wsum;
+            p.dir = nsum.normalized();
+            p.state = 1;
+            ++st.border;
+        }
+    }
+
+    // 2. Propagation inwards, wave by wave: only values from earlier waves are used.
+    std::vector<Index> wave;
+    for (int round = 0;; ++round) {
+        wave.clear();
+        std::vector<std::pair<double, Vec3>> values;
+        for (Index q = 0; q < static_cast<Index>(pairs.size()); ++q) {
+            Pair& p = pairs[static_cast<size_t>(q)];
+            if (p.state) continue;
+            const Vec3 xi = pos(x, p.vertex);
+            double msum = 0, dsum = 0;
+            Vec3 rsum = Vec3::Zero();
+            for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)]; a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
+                const Index j = s.adjacency.neighbours[static_cast<size_t>(a)];
+                const Index qj = find(j, p.object);
+                if (qj < 0) continue;
+                const Pair& pj = pairs[static_cast<size_t>(qj)];
+                if (!pj.state) continue;
+                const Vec3 xj = pos(x, j);
+                const double mu = 1.0 / std::max((xj - xi).squaredNorm(), 1e-300);
+                msum += mu;
+                dsum += mu * ((xj - xi).dot(pj.dir) + pj.depth);
+                rsum += mu * pj.dir;
+            }
+            if (msum > 0 && rsum.norm() > 0) {
+                wave.push_back(q);
+                values.emplace_back(dsum / msum, rsum.normalized());
+            }
+        }
+        if (wave.empty()) break;
+        for (size_t w = 0; w < wave.size(); ++w) {
+            Pair& p = pairs[static_cast<size_t>(wave[w])];
+            p.depth = values[w].first;
+            p.dir = values[w].second;
+            p.state = 2;
+            ++st.propagated;
+        }
+    }
+
+    // 3. Fallback: closest point on the penetrated object's boundary.
+    for (Pair& p : pairs) {
+        if (p.state) continue;
+        Vec3 point;
+        double dist = 0;
+        if (s.closest(x, trees[static_cast<size_t>(p.object)], p.vertex, point, dist)) {
+            p.depth = dist;
+            const Vec3 d = point - pos(x, p.vertex);
+            p.dir = dist > 0 ? Vec3(d / dist) : Vec3::UnitZ();
+        } else {
+            p.depth = 0;
+            p.dir = Vec3::UnitZ();
+        }
+        p.state = 3;
+        ++st.fallback;
+    }
+
+    for (size_t c = 0; c < contacts.size(); ++c) {
+        const Pair& p = pairs[static_cast<size_t>(contact_slot[c])];
+        contacts[c].depth = std::max(0.0, p.depth);
+        for (int k = 0; k < 3; ++k) contacts[c].direction[k] = p.dir[k];
+    }
+    st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (stats) *stats = st;
+}
+
+std::vector<double> Penetration::exact_depths(const PositionsRef& x, std::span<const Contact> contacts) const
+{
+    const PenetrationImpl& s = *m_impl;
+    if (!s.ready) throw Error("penetration: set_topology was not called");
+    std::vector<char> need(static_cast<size_t>(s.objects), 0);
+    for (const Contact& c : contacts) {
+        if (c.vertex < 0 || c.vertex >= s.n || c.tet_object < 0 || c.tet_object >= s.objects)
+            throw Error("penetration: contact with vertex " + std::to_string(c.vertex) + " / tet object " +
+                        std::to_string(c.tet_object) + " out of range");
+        need[static_cast<size_t>(c.tet_object)] = 1;
+    }
+    std::vector<Bvh> trees;
+    s.build_trees(x, need, trees);
+    std::vector<double> out(contacts.size(), 0.0);
+    for (size_t c = 0; c < contacts.size(); ++c) {
+        Vec3 point;
+        double dist = 0;
+        if (s.closest(x, trees[static_cast<size_t>(contacts[c].tet_object)], contacts[c].vertex, point, dist))
+            out[c] = dist;
+    }
+    return out;
+}
+
+void compute_penetration(const TetMesh& mesh, std::span<Contact> contacts, PenetrationStats* stats)
+{
+    Penetration p;
+    p.set_topology(mesh);
+    p.compute(mesh.positions, contacts, stats);
+}
+
+} // namespace tethash

@@ -1,0 +1,216 @@
+// Stage-2 bucket scan: 8 entries at a time with AVX2 (float box test, cell test, own-vertex test as masks,
+// survivors extracted by bit scan), or one at a time. The AVX2 version is compiled with a target attribute
+// and chosen at run time, so one build runs everywhere and uses AVX2 where present.
+#include "scan.hpp"
+
+#include "tethash/predicates.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define TETHASH_X86 1
+#endif
+
+namespace tethash::detail {
+namespace {
+
+std::int32_t scan_scalar(const VertexTable& t, std::int32_t begin, std::int32_t end, const ScanQuery& q, Index* out,
+                         ScanCounters& c)
+{
+    std::int32_t n = 0;
+    c.scanned += end - begin;
+    for (std::int32_t i = begin; i < end; ++i) {
+        if (t.cx[i] != q.cx || t.cy[i] != q.cy || t.cz[i] < q.z0 || t.cz[i] > q.z1) {
+            ++c.collisions;
+            continue;
+        }
+        if (!(t.x[i] >= q.lo[0] && t.x[i] <= q.hi[0] && t.y[i] >= q.lo[1] && t.y[i] <= q.hi[1] && t.z[i] >= q.lo[2] &&
+              t.z[i] <= q.hi[2])) {
+            ++c.box_rejections;
+            continue;
+        }
+        const Index v = t.id[i];
+        if (v == q.own[0] || v == q.own[1] || v == q.own[2] || v == q.own[3]) {
+            ++c.own;
+            continue;
+        }
+        out[n++] = v;
+    }
+    return n;
+}
+
+#ifdef TETHASH_X86
+__attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const VertexTable& t, const ScanRange* ranges,
+                                                                      std::int32_t count, const ScanQuery& q,
+                                                                      Index* out, ScanCounters& c)
+{
+    const __m256 lx = _mm256_set1_ps(q.lo[0]), ly = _mm256_set1_ps(q.lo[1]), lz = _mm256_set1_ps(q.lo[2]);
+    const __m256 hx = _mm256_set1_ps(q.hi[0]), hy = _mm256_set1_ps(q.hi[1]), hz = _mm256_set1_ps(q.hi[2]);
+    const __m256i o0 = _mm256_set1_epi32(q.own[0]), o1 = _mm256_set1_epi32(q.own[1]);
+    const __m256i o2 = _mm256_set1_epi32(q.own[2]), o3 = _mm256_set1_epi32(q.own[3]);
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const float* X = t.x.data();
+    const float* Y = t.y.data();
+    const float* Z = t.z.data();
+    const std::int32_t* ID = t.id.data();
+    const std::int32_t* CX = t.cx.data();
+    const std::int32_t* CY = t.cy.data();
+    const std::int32_t* CZ = t.cz.data();
+    std::int32_t n = 0;
+    std::int64_t coll = 0, boxr = 0, own = 0;
+    for (std::int32_t r = 0; r < count; ++r) {
+    const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
+    const __m256i qx = _mm256_set1_epi32(ranges[r].cx), qy = _mm256_set1_epi32(ranges[r].cy);
+    const __m256i z0 = _mm256_set1_epi32(ranges[r].z0 - 1), z1 = _mm256_set1_epi32(ranges[r].z1 + 1);
+    c.scanned += end - begin;
+    for (std::int32_t i = begin; i < end; i += 8) {
+        const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
+        const __m256i cx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CX + i));
+        const __m256i cy = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CY + i));
+        const __m256i cz = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CZ + i));
+        const __m256i cell = _mm256_and_si256(_mm256_and_si256(_mm256_cmpeq_epi32(cx, qx), _mm256_cmpeq_epi32(cy, qy)),
+                                              _mm256_and_si256(_mm256_cmpgt_epi32(cz, z0), _mm256_cmpgt_epi32(z1, cz)));
+        const int mv = _mm256_movemask_ps(_mm256_castsi256_ps(valid));
+        const int mc = _mm256_movemask_ps(_mm256_castsi256_ps(cell)) & mv;
+        coll += __builtin_popcount(mv & ~mc);
+        if (!mc) continue;
+        const __m256 x = _mm256_loadu_ps(X + i), y = _mm256_loadu_ps(Y + i), z = _mm256_loadu_ps(Z + i);
+        const __m256 inx = _mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ));
+        const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
+        const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
+        const int mb = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(inx, iny), inz)) & mc;
+        boxr += __builtin_popcount(mc & ~mb);
+        if (!mb) continue;
+        const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
+        const __m256i isown = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
+                                              _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
+        const int mo = _mm256_movemask_ps(_mm256_castsi256_ps(isown)) & mb;
+        own += __builtin_popcount(mo);
+        int keep = mb & ~mo;
+        while (keep) {
+            const int k = __builtin_ctz(static_cast<unsigned>(keep));
+            out[n++] = ID[i + k];
+            keep &= keep - 1;
+        }
+    }
+    }
+    c.collisions += coll;
+    c.box_rejections += boxr;
+    c.own += own;
+    return n;
+}
+#endif
+
+void filter_scalar(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                   std::int8_t* code)
+{
+    constexpr double E = predicates::orient3d_error_bound;
+    for (std::int32_t j = 0; j < count; ++j) {
+        const double* p = P + 3 * static_cast<std::size_t>(cand[j]);
+        int undecided = 0;
+        bool outside = false;
+        for (int i = 0; i < 4; ++i) {
+            const double dx = p[0] - f.rx[i], dy = p[1] - f.ry[i], dz = p[2] - f.rz[i];
+            const double v = f.nx[i] * dx + f.ny[i] * dy + f.nz[i] * dz;
+            const double bound = E * (std::fabs(dx) * f.mx[i] + std::fabs(dy) * f.my[i] + std::fabs(dz) * f.mz[i]);
+            val[4 * j + i] = v;
+            outside |= v < -bound;
+            if (v <= bound) undecided |= 1 << i;
+        }
+        code[j] = static_cast<std::int8_t>(outside ? -1 : undecided);
+    }
+}
+
+#ifdef TETHASH_X86
+__attribute__((target("avx2"))) void filter_avx2(const FacePlanes& f, const double* P, const Index* cand,
+                                                 std::int32_t count, double* val, std::int8_t* code)
+{
+    const __m256d rx = _mm256_load_pd(f.rx), ry = _mm256_load_pd(f.ry), rz = _mm256_load_pd(f.rz);
+    const __m256d nx = _mm256_load_pd(f.nx), ny = _mm256_load_pd(f.ny), nz = _mm256_load_pd(f.nz);
+    const __m256d mx = _mm256_load_pd(f.mx), my = _mm256_load_pd(f.my), mz = _mm256_load_pd(f.mz);
+    const __m256d E = _mm256_set1_pd(predicates::orient3d_error_bound);
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    for (std::int32_t j = 0; j < count; ++j) {
+        const double* p = P + 3 * static_cast<std::size_t>(cand[j]);
+        const __m256d dx = _mm256_sub_pd(_mm256_broadcast_sd(p), rx);
+        const __m256d dy = _mm256_sub_pd(_mm256_broadcast_sd(p + 1), ry);
+        const __m256d dz = _mm256_sub_pd(_mm256_broadcast_sd(p + 2), rz);
+        const __m256d v = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
+        const __m256d perm = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_andnot_pd(sign, dx), mx),
+                                                         _mm256_mul_pd(_mm256_andnot_pd(sign, dy), my)),
+                                           _mm256_mul_pd(_mm256_andnot_pd(sign, dz), mz));
+        const __m256d bound = _mm256_mul_pd(E, perm);
+        _mm256_storeu_pd(val + 4 * j, v);
+        const int out = _mm256_movemask_pd(_mm256_cmp_pd(v, _mm256_xor_pd(bound, sign), _CMP_LT_OQ));
+        const int und = _mm256_movemask_pd(_mm256_cmp_pd(v, bound, _CMP_LE_OQ));
+        code[j] = static_cast<std::int8_t>(out ? -1 : und);
+    }
+}
+#endif
+
+using FilterFn = void (*)(const FacePlanes&, const double*, const Index*, std::int32_t, double*, std::int8_t*);
+
+std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count,
+                                const ScanQuery& q, Index* out, ScanCounters& c)
+{
+    std::int32_t n = 0;
+    ScanQuery qq = q;
+    for (std::int32_t r = 0; r < count; ++r) {
+        qq.cx = ranges[r].cx;
+        qq.cy = ranges[r].cy;
+        qq.z0 = ranges[r].z0;
+        qq.z1 = ranges[r].z1;
+        n += scan_scalar(t, ranges[r].begin, ranges[r].end, qq, out + n, c);
+    }
+    return n;
+}
+
+using ScanFn = std::int32_t (*)(const VertexTable&, const ScanRange*, std::int32_t, const ScanQuery&, Index*,
+                                ScanCounters&);
+
+ScanFn choose()
+{
+    const char* env = std::getenv("TETHASH_SIMD");
+    if (env && std::strcmp(env, "scalar") == 0) return scan_ranges_scalar;
+#ifdef TETHASH_X86
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2")) return scan_ranges_avx2;
+#endif
+    return scan_ranges_scalar;
+}
+
+const ScanFn chosen = choose();
+const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
+#ifdef TETHASH_X86
+                                                     : filter_avx2;
+#else
+                                                     : filter_scalar;
+#endif
+
+} // namespace
+
+std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
+                         Index* out, ScanCounters& counters)
+{
+    return chosen(table, ranges, count, q, out, counters);
+}
+
+std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
+                               Index* out, ScanCounters& counters)
+{
+    const ScanRange r{begin, end, q.cx, q.cy, q.z0, q.z1};
+    return chosen(table, &r, 1, q, out, counters);
+}
+
+void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                       std::int8_t* code)
+{
+    chosen_filter(f, P, cand, count, val, code);
+}
+
+const char* scan_kernel_name() { return chosen == scan_ranges_scalar ? "scalar" : "avx2"; }
+
+} // namespace tethash::detail

@@ -1,0 +1,57 @@
+#pragma once
+// The bucket-range scan of stage 2 (private header): scalar and AVX2 versions, chosen at run time.
+#include "tethash/hash_grid.hpp"
+
+#include <cstdint>
+
+namespace tethash::detail {
+
+/// What one tet looks for in a bucket range: entries in column/cell (cx, cy, z0..z1), inside the float box
+/// (lo, hi, relative to the table origin), and not one of the tet's own vertices.
+struct ScanQuery {
+    float lo[3], hi[3];
+    std::int32_t cx = 0, cy = 0, z0 = 0, z1 = 0;
+    Index own[4];
+};
+
+struct ScanCounters {
+    std::int64_t scanned = 0, collisions = 0, box_rejections = 0, own = 0;
+};
+
+/// One bucket range to scan, with the column (cx, cy) and cell z-range its entries must have.
+struct ScanRange {
+    std::int32_t begin, end, cx, cy, z0, z1;
+};
+
+/// Scans every range of `ranges` for the box and own vertices of `q` (q.cx/cy/z0/z1 ignored); appends the ids
+/// to `out` (room for the sum of the range lengths); returns how many.
+std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
+                         Index* out, ScanCounters& counters);
+
+/// Appends to `out` the ids of the entries [begin, end) of `table` that match `q`; returns how many.
+/// `out` must have room for end − begin ids.
+std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
+                               Index* out, ScanCounters& counters);
+
+/// "avx2" or "scalar": the version scan_bucket_range uses (environment TETHASH_SIMD=scalar forces scalar).
+const char* scan_kernel_name();
+
+} // namespace tethash::detail
+
+namespace tethash::detail {
+
+/// The four face planes of a tet, sign-folded so that inside ⇔ every value n_i·(p − r_i) ≥ 0, plus the
+/// weights of the orient3d error bound. Lanes = faces.
+struct alignas(32) FacePlanes {
+    double rx[4], ry[4], rz[4];
+    double nx[4], ny[4], nz[4];
+    double mx[4], my[4], mz[4];
+};
+
+/// Filtered plane tests of `count` candidates (vertex ids `cand`, positions `P` n × 3): for candidate j writes the
+/// four values to val[4j..4j+3] and returns in code[j] −1 if p is certainly outside, else the bit mask of faces
+/// whose sign the filter could not decide (0: certainly inside).
+void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                       std::int8_t* code);
+
+} // namespace tethash::detail

@@ -1,0 +1,203 @@
+// Triangle surfaces through assimp (import: every mesh of the scene with its node transform;
+// export: one mesh, written through a private folder so side files get their final names).
+#include "tethash/io/surface.hpp"
+
+#include "tethash/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <filesystem>
+#include <unistd.h>
+
+#ifdef TETHASH_HAVE_ASSIMP
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#endif
+
+namespace tethash::io {
+
+bool is_surface_path(const std::string& path)
+{
+    const std::string e = extension_of(path);
+    return e == ".obj" || e == ".stl" || e == ".ply" || e == ".off" || e == ".gltf" || e == ".glb" || e == ".fbx" ||
+           e == ".dae" || e == ".3ds";
+}
+
+SurfaceMesh boundary_surface(const TetMesh& mesh)
+{
+    mesh.check_consistency("mesh for its boundary surface");
+    const Triangles faces = boundary_faces(mesh.tets);
+    std::vector<Index> new_id(static_cast<std::size_t>(mesh.num_vertices()), -1);
+    for (Eigen::Index i = 0; i < faces.rows(); ++i)
+        for (int k = 0; k < 3; ++k) new_id[static_cast<std::size_t>(faces(i, k))] = 0;
+    Index n = 0;
+    for (auto& id : new_id)
+        if (id == 0) id = n++; // increasing original index: deterministic
+    SurfaceMesh s;
+    s.vertices.resize(n, 3);
+    for (Index v = 0; v < mesh.num_vertices(); ++v)
+        if (new_id[static_cast<std::size_t>(v)] >= 0) s.vertices.row(new_id[static_cast<std::size_t>(v)]) = mesh.positions.row(v);
+    s.triangles.resize(faces.rows(), 3);
+    for (Eigen::Index i = 0; i < faces.rows(); ++i)
+        for (int k = 0; k < 3; ++k) s.triangles(i, k) = new_id[static_cast<std::size_t>(faces(i, k))];
+    return s;
+}
+
+#ifdef TETHASH_HAVE_ASSIMP
+
+bool have_assimp() { return true; }
+
+namespace {
+
+void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, std::vector<double>& xyz,
+             std::vector<Index>& tri)
+{
+    const aiMatrix4x4 m = parent * node->mTransformation;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+        const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+        const auto base = static_cast<Index>(xyz.size() / 3);
+        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+            const aiVector3D p = m * mesh->mVertices[v];
+            xyz.insert(xyz.end(), {double(p.x), double(p.y), double(p.z)});
+        }
+        for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+            const aiFace& face = mesh->mFaces[f];
+            if (face.mNumIndices != 3) continue; // points and lines
+            for (int k = 0; k < 3; ++k) tri.push_back(base + static_cast<Index>(face.mIndices[k]));
+        }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) collect(scene, node->mChildren[c], m, xyz, tri);
+}
+
+} // namespace
+
+SurfaceMesh read_surface(const std::string& path)
+{
+    if (!std::filesystem::exists(path)) throw Error(path + ": no such file");
+    if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a surface file");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+    if (!scene || !scene->mRootNode) throw Error(path + ": cannot read surface: " + importer.GetErrorString());
+    std::vector<double> xyz;
+    std::vector<Index> tri;
+    collect(scene, scene->mRootNode, aiMatrix4x4(), xyz, tri);
+    if (tri.empty()) throw Error(path + ": no triangles in the file");
+    // Join vertices at identical positions (assimp keeps STL corners apart: they differ in their normals),
+    // keeping the first occurrence's order.
+    const std::size_t nv = xyz.size() / 3;
+    std::vector<std::size_t> order(nv);
+    for (std::size_t i = 0; i < nv; ++i) order[i] = i;
+    auto key = [&](std::size_t i) { return std::array<double, 3>{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; };
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+    std::vector<std::size_t> rep(nv);
+    for (std::size_t i = 0; i < nv;) {
+        std::size_t j = i;
+        while (j < nv && key(order[j]) == key(order[i])) rep[order[j++]] = order[i];
+        i = j;
+    }
+    std::vector<Index> new_id(nv, -1);
+    Index n = 0;
+    for (std::size_t i = 0; i < nv; ++i)
+        if (rep[i] == i) new_id[i] = n++;
+    SurfaceMesh s;
+    s.vertices.resize(n, 3);
+    for (std::size_t i = 0; i < nv; ++i)
+        if (rep[i] == i) s.vertices.row(new_id[i]) << xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2];
+    s.triangles.resize(static_cast<Eigen::Index>(tri.size() / 3), 3);
+    for (std::size_t t = 0; t < tri.size(); ++t)
+        s.triangles(static_cast<Eigen::Index>(t / 3), static_cast<Eigen::Index>(t % 3)) =
+            new_id[rep[static_cast<std::size_t>(tri[t])]];
+    if (!s.vertices.allFinite()) throw Error(path + ": non-finite vertex coordinate");
+    return s;
+}
+
+void write_surface(const std::string& path, const SurfaceMesh& surface)
+{
+    namespace fs = std::filesystem;
+    const std::string e = extension_of(path);
+    std::string format;
+    if (e == ".obj") format = "objnomtl";
+    else if (e == ".ply") format = "plyb";
+    else if (e == ".stl") format = "stlb";
+    else if (e == ".gltf") format = "gltf2";
+    else if (e == ".glb") format = "glb2";
+    else throw Error(path + ": unknown surface format '" + e + "' (expected .obj .ply .stl .gltf .glb)");
+    if (surface.triangles.rows() == 0) throw Error(path + ": surface to write has no triangles");
+    const auto nv = static_cast<unsigned>(surface.vertices.rows());
+    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if (surface.triangles(t, k) < 0 || static_cast<unsigned>(surface.triangles(t, k)) >= nv)
+                throw Error(path + ": surface triangle " + std::to_string(t) + " has vertex index " +
+                            std::to_string(surface.triangles(t, k)) + " out of range");
+
+    // The scene owns (and its destructor frees) everything allocated below.
+    aiScene scene;
+    scene.mRootNode = new aiNode();
+    scene.mRootNode->mName = "tethash";
+    scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+    scene.mNumMaterials = 1;
+    auto* mesh = new aiMesh();
+    scene.mMeshes = new aiMesh*[1]{mesh};
+    scene.mNumMeshes = 1;
+    scene.mRootNode->mMeshes = new unsigned[1]{0};
+    scene.mRootNode->mNumMeshes = 1;
+    mesh->mMaterialIndex = 0;
+    mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    mesh->mNumVertices = nv;
+    mesh->mVertices = new aiVector3D[nv];
+    for (unsigned v = 0; v < nv; ++v)
+        mesh->mVertices[v] = aiVector3D(static_cast<ai_real>(surface.vertices(v, 0)), static_cast<ai_real>(surface.vertices(v, 1)),
+                                        static_cast<ai_real>(surface.vertices(v, 2)));
+    const auto nf = static_cast<unsigned>(surface.triangles.rows());
+    mesh->mNumFaces = nf;
+    mesh->mFaces = new aiFace[nf];
+    for (unsigned f = 0; f < nf; ++f) {
+        mesh->mFaces[f].mNumIndices = 3;
+        mesh->mFaces[f].mIndices = new unsigned[3];
+        for (int k = 0; k < 3; ++k) mesh->mFaces[f].mIndices[k] = static_cast<unsigned>(surface.triangles(f, k));
+    }
+
+    write_atomically(path, [&](const std::string& tmp) {
+        // Export under the final file name inside a private folder next to the target: formats with
+        // side files (.gltf + .bin) then refer to them by their final names.
+        static std::atomic<int> counter{0};
+        const fs::path target(path);
+        const fs::path dir = fs::path(tmp).parent_path();
+        const fs::path work = dir / (".tethash_export" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+        fs::create_directories(work);
+        struct Cleanup {
+            fs::path p;
+            ~Cleanup()
+            {
+                std::error_code ec;
+                fs::remove_all(p, ec);
+            }
+        } cleanup{work};
+        const fs::path main_file = work / target.filename();
+        Assimp::Exporter exporter;
+        if (exporter.Export(&scene, format, main_file.string()) != aiReturn_SUCCESS)
+            throw Error(path + ": cannot write surface: " + exporter.GetErrorString());
+        if (!fs::exists(main_file)) throw Error(path + ": assimp wrote no file");
+        for (const auto& entry : fs::directory_iterator(work)) {
+            if (entry.path() == main_file) continue;
+            fs::rename(entry.path(), dir / entry.path().filename()); // side file (e.g. the .bin of a .gltf)
+        }
+        fs::rename(main_file, tmp);
+    });
+}
+
+#else
+
+bool have_assimp() { return false; }
+SurfaceMesh read_surface(const std::string& path) { throw Error(path + ": cannot read surfaces: tethash was built without assimp"); }
+void write_surface(const std::string& path, const SurfaceMesh&)
+{
+    throw Error(path + ": cannot write surfaces: tethash was built without assimp");
+}
+
+#endif
+
+} // namespace tethash::io

@@ -1,0 +1,277 @@
+#include "text_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace tethash::io::detail {
+
+std::string read_file_bytes(const std::string& path)
+{
+    if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path + ": cannot open for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw Error(path + ": read error");
+    return ss.str();
+}
+
+void write_file_bytes(const std::string& path, const std::string& content)
+{
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(path + ": cannot open for writing");
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+    out.close();
+    if (!out) throw Error(path + ": write error (disk full?)");
+}
+
+TextReader::TextReader(std::string path, char comment, char extra_separator)
+    : m_path(std::move(path)), m_comment(comment), m_extra(extra_separator)
+{
+    m_data = read_file_bytes(m_path);
+}
+
+TextReader::TextReader(std::string path, std::string content, char comment, char extra_separator)
+    : m_path(std::move(path)), m_data(std::move(content)), m_comment(comment), m_extra(extra_separator)
+{
+}
+
+void TextReader::skip_space()
+{
+    const std::size_t n = m_data.size();
+    while (m_pos < n) {
+        const char c = m_data[m_pos];
+        if (c == '\n') {
+            ++m_line;
+            ++m_pos;
+        } else if (is_space(c)) {
+            ++m_pos;
+        } else if (m_comment && c == m_comment) {
+            while (m_pos < n && m_data[m_pos] != '\n') ++m_pos;
+        } else {
+            break;
+        }
+    }
+}
+
+bool TextReader::at_end()
+{
+    skip_space();
+    return m_pos >= m_data.size();
+}
+
+std::string_view TextReader::peek()
+{
+    skip_space();
+    std::size_t e = m_pos;
+    while (e < m_data.size() && !is_space(m_data[e]) && !(m_comment && m_data[e] == m_comment)) ++e;
+    return std::string_view(m_data).substr(m_pos, e - m_pos);
+}
+
+std::int64_t TextReader::peek_line()
+{
+    skip_space();
+    return m_line;
+}
+
+std::string_view TextReader::next(std::string_view what)
+{
+    const std::string_view tok = peek();
+    m_token_line = m_line;
+    if (tok.empty()) {
+        // Name the last line of the file rather than the empty one after its final line break.
+        if (m_token_line > 1 && !m_data.empty() && m_data.back() == '\n') --m_token_line;
+        fail(what, "end of file");
+    }
+    m_pos += tok.size();
+    return tok;
+}
+
+void TextReader::expect(std::string_view word, bool ignore_case)
+{
+    const std::string_view tok = next(word);
+    const bool same = ignore_case ? (tok.size() == word.size() &&
+                                     std::equal(tok.begin(), tok.end(), word.begin(), [](char a, char b) {
+                                         return std::tolower(static_cast<unsigned char>(a)) ==
+                                                std::tolower(static_cast<unsigned char>(b));
+                                     }))
+                                  : tok == word;
+    if (!same) fail(word, describe(tok));
+}
+
+std::int64_t TextReader::next_int(std::string_view what)
+{
+    const std::string_view tok = next(what);
+    std::int64_t v = 0;
+    if (!parse_int(tok, v)) fail(std::string(what) + " (an integer)", describe(tok));
+    return v;
+}
+
+std::int64_t TextReader::next_int_in(std::string_view what, std::int64_t lo, std::int64_t hi)
+{
+    const std::int64_t v = next_int(what);
+    if (v < lo || v > hi)
+        fail(std::string(what) + " in " + std::to_string(lo) + ".." + std::to_string(hi), std::to_string(v));
+    return v;
+}
+
+double TextReader::next_double(std::string_view what)
+{
+    const std::string_view tok = next(what);
+    double v = 0;
+    if (!parse_double(tok, v)) fail(std::string(what) + " (a number)", describe(tok));
+    if (!std::isfinite(v)) fail(std::string(what) + " (a finite number)", describe(tok));
+    return v;
+}
+
+double TextReader::next_double_any(std::string_view what)
+{
+    const std::string_view tok = next(what);
+    double v = 0;
+    if (!parse_double(tok, v)) fail(std::string(what) + " (a number)", describe(tok));
+    return v;
+}
+
+void TextReader::skip_rest_of_line()
+{
+    while (m_pos < m_data.size() && m_data[m_pos] != '\n') ++m_pos;
+    if (m_pos < m_data.size()) {
+        ++m_pos;
+        ++m_line;
+    }
+}
+
+std::string_view TextReader::next_line(bool* eof)
+{
+    if (eof) *eof = m_pos >= m_data.size();
+    m_token_line = m_line;
+    const std::size_t start = m_pos;
+    while (m_pos < m_data.size() && m_data[m_pos] != '\n') ++m_pos;
+    std::size_t end = m_pos;
+    if (m_pos < m_data.size()) {
+        ++m_pos;
+        ++m_line;
+    }
+    if (end > start && m_data[end - 1] == '\r') --end;
+    return std::string_view(m_data).substr(start, end - start);
+}
+
+bool TextReader::skip_past_line(std::string_view marker)
+{
+    std::size_t from = m_pos;
+    while (true) {
+        const std::size_t hit = m_data.find(marker, from);
+        if (hit == std::string::npos) return false;
+        const bool line_start = hit == 0 || m_data[hit - 1] == '\n';
+        std::size_t e = hit + marker.size();
+        while (e < m_data.size() && (m_data[e] == ' ' || m_data[e] == '\t' || m_data[e] == '\r')) ++e;
+        const bool line_end = e >= m_data.size() || m_data[e] == '\n';
+        if (line_start && line_end) {
+            m_line += std::count(m_data.begin() + static_cast<std::ptrdiff_t>(m_pos),
+                                 m_data.begin() + static_cast<std::ptrdiff_t>(hit), '\n');
+            m_token_line = m_line;
+            m_pos = e;
+            skip_rest_of_line();
+            return true;
+        }
+        from = hit + 1;
+    }
+}
+
+std::string TextReader::describe(std::string_view token)
+{
+    if (token.empty()) return "end of file";
+    std::string s = "'";
+    const std::size_t limit = 40;
+    for (std::size_t i = 0; i < token.size() && i < limit; ++i) {
+        const unsigned char c = static_cast<unsigned char>(token[i]);
+        if (std::isprint(c)) {
+            s += static_cast<char>(c);
+        } else {
+            static const char* hex = "0123456789abcdef";
+            s += "\\x";
+            s += hex[c >> 4];
+            s += hex[c & 15];
+        }
+    }
+    if (token.size() > limit) s += "...";
+    s += "'";
+    return s;
+}
+
+void TextReader::fail(std::string_view expected, std::string_view found) const
+{
+    throw Error(m_path + ":" + std::to_string(m_token_line) + ": expected " + std::string(expected) + ", found " +
+                std::string(found));
+}
+
+void TextReader::fail_message(const std::string& message) const { fail_at_line(m_token_line, message); }
+
+void TextReader::fail_at_line(std::int64_t line, const std::string& message) const
+{
+    throw Error(m_path + ":" + std::to_string(line) + ": " + message);
+}
+
+void TextReader::fail_at_byte(std::size_t offset, const std::string& message) const
+{
+    throw Error(m_path + ": byte " + std::to_string(offset) + ": " + message);
+}
+
+std::uint64_t TextReader::read_binary_uint(std::size_t size, std::string_view what)
+{
+    if (size == 4) return read_binary<std::uint32_t>(what);
+    return read_binary<std::uint64_t>(what);
+}
+
+void TextReader::skip_bytes(std::size_t count, std::string_view what)
+{
+    if (m_data.size() - m_pos < count)
+        fail_at_byte(m_pos, "expected " + std::string(what) + " (" + std::to_string(count) +
+                                " bytes), found end of file after " + std::to_string(m_data.size() - m_pos) +
+                                " bytes");
+    m_pos += count;
+}
+
+bool parse_int(std::string_view token, std::int64_t& value)
+{
+    if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+    if (token.empty()) return false;
+    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    return ec == std::errc() && ptr == token.data() + token.size();
+}
+
+bool parse_double(std::string_view token, double& value)
+{
+    if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+    if (token.empty()) return false;
+    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec == std::errc::result_out_of_range) {
+        // Denormal or huge: let strtod decide (it gives 0 or ±HUGE_VAL, which the finite check catches).
+        value = std::strtod(std::string(token).c_str(), nullptr);
+        return ptr == token.data() + token.size();
+    }
+    return ec == std::errc() && ptr == token.data() + token.size();
+}
+
+void append_double(std::string& out, double value)
+{
+    char buf[64];
+    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);
+    (void)ec;
+    out.append(buf, ptr);
+}
+
+void append_int(std::string& out, std::int64_t value)
+{
+    char buf[32];
+    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);
+    (void)ec;
+    out.append(buf, ptr);
+}
+
+} // namespace tethash::io::detail

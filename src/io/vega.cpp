@@ -1,0 +1,123 @@
+// Vega FEM .veg (ASCII) reader.
+//
+// Sections: *VERTICES with a header "n 3 0 0" and lines "id x y z" (ids 1..n), *ELEMENTS followed by
+// the element type TET (on the same line or the next) with a header "m 4 0" and lines
+// "id v0 v1 v2 v3" (1-based). Other sections (*MATERIAL, *REGION, *SET, *SOLVER ...) are skipped up to
+// the next '*' keyword; *INCLUDE is rejected (the included file would be needed). '#' starts a
+// comment and commas separate values like spaces.
+#include "tethash/io/tetgen.hpp"
+
+#include "tethash/error.hpp"
+#include "text_reader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <limits>
+#include <map>
+
+namespace tethash::io {
+
+namespace {
+
+using detail::TextReader;
+
+constexpr std::int64_t k_max_int32 = std::numeric_limits<std::int32_t>::max();
+
+std::string upper(std::string_view s)
+{
+    std::string out(s);
+    std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::toupper(c); });
+    return out;
+}
+
+} // namespace
+
+TetMesh read_veg(const std::string& path, ReadNotes* notes)
+{
+    TextReader r(path, '#', ',');
+    TetMesh mesh;
+    bool have_vertices = false, have_elements = false;
+    std::vector<std::int64_t> tet_lines;
+    std::map<std::string, int> skipped;
+    while (!r.at_end()) {
+        const std::string_view tok = r.next("a section keyword");
+        if (tok.front() != '*') r.fail("a section keyword such as *VERTICES or *ELEMENTS", TextReader::describe(tok));
+        const std::string key = upper(tok);
+        if (key == "*VERTICES") {
+            if (have_vertices) r.fail_message("a second *VERTICES section");
+            const std::int64_t n = r.next_int_in("the number of vertices", 0, k_max_int32);
+            const std::int64_t dim = r.next_int("the dimension");
+            if (dim != 3) r.fail("dimension 3 in the *VERTICES header", std::to_string(dim));
+            r.skip_rest_of_line();
+            if (n > static_cast<std::int64_t>(r.size()))
+                r.fail("a number of vertices that fits in a file of " + std::to_string(r.size()) + " bytes",
+                       std::to_string(n));
+            mesh.positions.resize(static_cast<Index>(n), 3);
+            static const char* axis[] = {"x", "y", "z"};
+            for (std::int64_t i = 0; i < n; ++i) {
+                const std::int64_t id = r.next_int("a vertex number");
+                if (id != i + 1)
+                    r.fail("vertex number " + std::to_string(i + 1) + " (vertices are numbered 1.." + std::to_string(n) +
+                               " in order)",
+                           std::to_string(id));
+                for (int a = 0; a < 3; ++a)
+                    mesh.positions(static_cast<Index>(i), a) =
+                        r.next_double(std::string(axis[a]) + " coordinate of vertex " + std::to_string(id));
+            }
+            have_vertices = true;
+        } else if (key == "*ELEMENTS") {
+            if (have_elements) r.fail_message("a second *ELEMENTS section");
+            const std::string_view type = r.next("the element type TET");
+            if (upper(type) != "TET")
+                r.fail("the element type TET (tethash reads tet meshes only)", TextReader::describe(type));
+            const std::int64_t m = r.next_int_in("the number of elements", 0, k_max_int32);
+            const std::int64_t per = r.next_int("the number of vertices per element");
+            if (per != 4) r.fail("4 vertices per TET element", std::to_string(per));
+            r.skip_rest_of_line();
+            if (m > static_cast<std::int64_t>(r.size()))
+                r.fail("a number of elements that fits in a file of " + std::to_string(r.size()) + " bytes",
+                       std::to_string(m));
+            mesh.tets.resize(static_cast<Index>(m), 4);
+            tet_lines.resize(static_cast<std::size_t>(m));
+            for (std::int64_t t = 0; t < m; ++t) {
+                const std::int64_t id = r.next_int("an element number");
+                if (id != t + 1)
+                    r.fail("element number " + std::to_string(t + 1) + " (elements are numbered 1.." +
+                               std::to_string(m) + " in order)",
+                           std::to_string(id));
+                tet_lines[static_cast<std::size_t>(t)] = r.line();
+                for (int k = 0; k < 4; ++k) {
+                    const std::int64_t v =
+                        r.next_int("vertex " + std::to_string(k + 1) + " of element " + std::to_string(id));
+                    if (v < 1 || v > k_max_int32)
+                        r.fail_message("element " + std::to_string(id) + ": vertex index " + std::to_string(v) +
+                                       " is out of range (vertices are numbered from 1)");
+                    mesh.tets(static_cast<Index>(t), k) = static_cast<Index>(v - 1);
+                }
+            }
+            have_elements = true;
+        } else if (key == "*INCLUDE") {
+            r.fail_message("*INCLUDE is not supported (merge the included file into " + path + ")");
+        } else {
+            // *MATERIAL, *REGION, *SET, *SOLVER, ...: skip to the next keyword.
+            while (!r.at_end() && r.peek().front() != '*') r.next("");
+            skipped[key] += 1;
+        }
+    }
+    if (!have_vertices) throw Error(path + ": no *VERTICES section");
+    if (!have_elements) throw Error(path + ": no *ELEMENTS section");
+    const Index n = mesh.num_vertices();
+    for (Index t = 0; t < mesh.num_tets(); ++t)
+        for (int k = 0; k < 4; ++k)
+            if (mesh.tets(t, k) >= n)
+                r.fail_at_line(tet_lines[static_cast<std::size_t>(t)],
+                               "element " + std::to_string(t + 1) + ": vertex index " +
+                                   std::to_string(mesh.tets(t, k) + 1) + " is past the end (*VERTICES has 1.." +
+                                   std::to_string(n) + ")");
+    if (notes)
+        for (const auto& [name, count] : skipped)
+            notes->messages.push_back("skipped " + std::to_string(count) + " " + name + " section(s)");
+    return mesh;
+}
+
+} // namespace tethash::io

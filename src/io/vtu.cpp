@@ -1,0 +1,869 @@
+// VTK XML UnstructuredGrid (.vtu) reader and writer, ParaView collections (.pvd).
+#include "tethash/error.hpp"
+#include "tethash/io/vtk.hpp"
+#include "vtk_detail.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+
+namespace tethash::io {
+namespace {
+
+using namespace vtk_detail;
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+
+std::string read_file(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path + ": cannot open file for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::string xml_escape(std::string_view s)
+{
+    std::string r;
+    for (char c : s) {
+        switch (c) {
+        case '&': r += "&amp;"; break;
+        case '<': r += "&lt;"; break;
+        case '>': r += "&gt;"; break;
+        case '"': r += "&quot;"; break;
+        case '\'': r += "&apos;"; break;
+        default: r += c;
+        }
+    }
+    return r;
+}
+
+// ---- a small XML reader: elements, attributes, text ranges; stops at <AppendedData> ----------
+
+struct XmlElement {
+    std::string name;
+    std::vector<std::pair<std::string, std::string>> attrs;
+    std::vector<XmlElement> children;
+    std::vector<std::pair<std::size_t, std::size_t>> text;   ///< [begin, end) byte ranges of direct text
+    std::int64_t line = 0;
+
+    const std::string* attr(std::string_view key) const
+    {
+        for (const auto& [k, v] : attrs)
+            if (k == key) return &v;
+        return nullptr;
+    }
+    const XmlElement* child(std::string_view n) const
+    {
+        for (const auto& c : children)
+            if (c.name == n) return &c;
+        return nullptr;
+    }
+};
+
+struct XmlDocument {
+    XmlElement root;
+    std::size_t appended_pos = std::string::npos;   ///< first byte after the '_' of <AppendedData>
+    std::string appended_encoding;
+    std::int64_t appended_line = 0;
+};
+
+class XmlParser {
+public:
+    XmlParser(const std::string& path, const std::string& data) : m_path(path), m_data(data) {}
+    XmlDocument parse();
+
+private:
+    [[noreturn]] void fail(const std::string& msg) const { throw Error(m_path + ":" + std::to_string(m_line) + ": " + msg); }
+    std::string found() const
+    {
+        if (m_pos >= m_data.size()) return "end of file";
+        return quote_token(std::string_view(m_data).substr(m_pos, 16));
+    }
+    void advance_to(std::size_t p)
+    {
+        for (; m_pos < p; ++m_pos)
+            if (m_data[m_pos] == '\n') ++m_line;
+    }
+    void skip_ws()
+    {
+        while (m_pos < m_data.size() && is_space(m_data[m_pos])) {
+            if (m_data[m_pos] == '\n') ++m_line;
+            ++m_pos;
+        }
+    }
+    bool starts(std::string_view s) const { return std::string_view(m_data).substr(m_pos, s.size()) == s; }
+    void skip_past(std::string_view end, const char* what)
+    {
+        const std::size_t p = m_data.find(end, m_pos);
+        if (p == std::string::npos) fail("expected '" + std::string(end) + "' to close " + what + ", found end of file");
+        advance_to(p + end.size());
+    }
+    std::string name()
+    {
+        const std::size_t s = m_pos;
+        while (m_pos < m_data.size()) {
+            const unsigned char c = static_cast<unsigned char>(m_data[m_pos]);
+            if (std::isalnum(c) || c == '_' || c == ':' || c == '.' || c == '-' || c >= 128) ++m_pos;
+            else break;
+        }
+        return m_data.substr(s, m_pos - s);
+    }
+    std::string decode_entities(std::string_view v) const;
+
+    const std::string& m_path;
+    const std::string& m_data;
+    std::size_t m_pos = 0;
+    std::int64_t m_line = 1;
+};
+
+std::string XmlParser::decode_entities(std::string_view v) const
+{
+    std::string r;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        if (v[i] != '&') {
+            r += v[i];
+            continue;
+        }
+        const std::size_t semi = v.find(';', i);
+        if (semi == std::string_view::npos) {
+            r += v[i];
+            continue;
+        }
+        const std::string_view ent = v.substr(i + 1, semi - i - 1);
+        if (ent == "amp") r += '&';
+        else if (ent == "lt") r += '<';
+        else if (ent == "gt") r += '>';
+        else if (ent == "quot") r += '"';
+        else if (ent == "apos") r += '\'';
+        else if (!ent.empty() && ent[0] == '#') {
+            const bool hex = ent.size() > 1 && (ent[1] == 'x' || ent[1] == 'X');
+            const unsigned long code = std::strtoul(std::string(ent.substr(hex ? 2 : 1)).c_str(), nullptr, hex ? 16 : 10);
+            r += code < 128 ? static_cast<char>(code) : '?';
+        } else {
+            r += std::string(v.substr(i, semi - i + 1));
+        }
+        i = semi;
+    }
+    return r;
+}
+
+XmlDocument XmlParser::parse()
+{
+    XmlDocument doc;
+    std::vector<XmlElement*> stack;
+    bool have_root = false;
+    for (;;) {
+        const std::size_t lt = m_data.find('<', m_pos);
+        if (lt == std::string::npos) {
+            if (!stack.empty()) {
+                advance_to(m_data.size());
+                if (!m_data.empty() && m_data.back() == '\n' && m_line > 1) --m_line;   // the last line, not the empty one after it
+                fail("expected </" + stack.back()->name + ">, found end of file");
+            }
+            break;
+        }
+        if (!stack.empty() && lt > m_pos) stack.back()->text.emplace_back(m_pos, lt);
+        advance_to(lt);
+        if (starts("<?")) {
+            skip_past("?>", "a processing instruction");
+        } else if (starts("<!--")) {
+            skip_past("-->", "a comment");
+        } else if (starts("<![CDATA[")) {
+            const std::size_t b = m_pos + 9;
+            skip_past("]]>", "a CDATA section");
+            if (!stack.empty()) stack.back()->text.emplace_back(b, m_pos - 3);
+        } else if (starts("<!")) {
+            skip_past(">", "a declaration");
+        } else if (starts("</")) {
+            m_pos += 2;
+            const std::string n = name();
+            skip_ws();
+            if (m_pos >= m_data.size() || m_data[m_pos] != '>') fail("expected '>' after </" + n + ", found " + found());
+            ++m_pos;
+            if (stack.empty() || stack.back()->name != n)
+                fail("expected " + (stack.empty() ? std::string("no end tag") : "</" + stack.back()->name + ">") +
+                     ", found </" + n + ">");
+            stack.pop_back();
+            if (stack.empty()) break;
+        } else {
+            ++m_pos;
+            XmlElement el;
+            el.line = m_line;
+            el.name = name();
+            if (el.name.empty()) fail("expected an element name after '<', found " + found());
+            bool empty = false;
+            for (;;) {
+                skip_ws();
+                if (m_pos >= m_data.size()) fail("expected '>' to close <" + el.name + ", found end of file");
+                if (starts("/>")) {
+                    m_pos += 2;
+                    empty = true;
+                    break;
+                }
+                if (m_data[m_pos] == '>') {
+                    ++m_pos;
+                    break;
+                }
+                const std::string key = name();
+                if (key.empty()) fail("expected an attribute name or '>' in <" + el.name + ">, found " + found());
+                skip_ws();
+                if (m_pos >= m_data.size() || m_data[m_pos] != '=')
+                    fail("expected '=' after attribute " + key + " of <" + el.name + ">, found " + found());
+                ++m_pos;
+                skip_ws();
+                if (m_pos >= m_data.size() || (m_data[m_pos] != '"' && m_data[m_pos] != '\''))
+                    fail("expected a quoted value for attribute " + key + " of <" + el.name + ">, found " + found());
+                const char q = m_data[m_pos++];
+                const std::size_t end = m_data.find(q, m_pos);
+                if (end == std::string::npos)
+                    fail("expected the closing quote of attribute " + key + " of <" + el.name + ">, found end of file");
+                el.attrs.emplace_back(key, decode_entities(std::string_view(m_data).substr(m_pos, end - m_pos)));
+                advance_to(end + 1);
+            }
+            if (el.name == "AppendedData") {
+                if (stack.empty()) fail("expected <VTKFile> before <AppendedData>");
+                const std::string* enc = el.attr("encoding");
+                doc.appended_encoding = enc ? *enc : "";
+                doc.appended_line = el.line;
+                if (!empty) {
+                    skip_ws();
+                    if (m_pos >= m_data.size() || m_data[m_pos] != '_')
+                        fail("expected '_' at the start of the appended data, found " + found());
+                    doc.appended_pos = m_pos + 1;
+                }
+                stack.back()->children.push_back(std::move(el));
+                break;   // the rest is (possibly binary) appended data
+            }
+            XmlElement* added;
+            if (stack.empty()) {
+                if (have_root) fail("expected a single root element, found a second one <" + el.name + ">");
+                doc.root = std::move(el);
+                have_root = true;
+                added = &doc.root;
+            } else {
+                stack.back()->children.push_back(std::move(el));
+                added = &stack.back()->children.back();
+            }
+            if (!empty) stack.push_back(added);
+        }
+    }
+    if (!have_root) fail("expected an XML element, found " + found());
+    return doc;
+}
+
+// ---- .vtu reader ---------------------------------------------------------------------------
+
+class VtuReader {
+public:
+    VtuReader(std::string path, ReadNotes* notes) : m_path(std::move(path)), m_notes(notes) {}
+    TetMesh read();
+
+private:
+    std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
+    std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
+    [[noreturn]] void fail(const std::string& where, const std::string& msg) const { throw Error(where + ": " + msg); }
+    std::string attr(const XmlElement& el, const char* key, bool required = true) const
+    {
+        const std::string* v = el.attr(key);
+        if (!v && required)
+            fail(at_line(el.line), "expected attribute " + std::string(key) + "=\"...\" in <" + el.name + ">, found none");
+        return v ? *v : std::string();
+    }
+    std::int64_t int_attr(const XmlElement& el, const char* key, std::int64_t min_value) const;
+    std::string array_label(const XmlElement& da) const
+    {
+        const std::string* n = da.attr("Name");
+        return "DataArray" + (n ? " '" + *n + "'" : std::string());
+    }
+    /// Place of value k of an array, for error messages (line of the value for ASCII arrays).
+    std::string at_value(const XmlElement& da, std::size_t k) const;
+
+    /// Decodes a DataArray of `expected` values (components included) into T (double or int64).
+    template <class T>
+    std::vector<T> read_array(const XmlElement& da, std::size_t expected, const std::string& what);
+    template <class T>
+    std::vector<T> read_ascii(const XmlElement& da, Scalar type, std::size_t expected, const std::string& what);
+    /// The payload bytes of a binary block (header + data, possibly zlib-compressed).
+    template <class Source>
+    std::vector<unsigned char> read_block(Source& src, const XmlElement& da, std::size_t expected_bytes,
+                                          const std::string& what);
+
+    std::string m_path;
+    ReadNotes* m_notes;
+    std::string m_data;
+    XmlDocument m_doc;
+    bool m_big_endian = false;
+    bool m_header64 = false;
+    bool m_zlib = false;
+};
+
+std::int64_t VtuReader::int_attr(const XmlElement& el, const char* key, std::int64_t min_value) const
+{
+    const std::string v = attr(el, key);
+    std::string_view s = v;
+    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+    const auto i = parse_int(s);
+    if (!i || *i < min_value)
+        fail(at_line(el.line), "expected " + std::string(key) + " in <" + el.name + "> to be an integer ≥ " +
+                                   std::to_string(min_value) + ", found \"" + v + "\"");
+    return *i;
+}
+
+std::string VtuReader::at_value(const XmlElement& da, std::size_t k) const
+{
+    const std::string* format = da.attr("format");
+    if (!format || *format != "ascii") return at_line(da.line) + ": " + array_label(da) + ", value " + std::to_string(k);
+    // Count lines up to the k-th token of the text (error path only).
+    std::int64_t line = da.line;
+    std::size_t scanned = da.text.empty() ? 0 : da.text.front().first;
+    // Lines from the tag to the text start.
+    std::size_t tag_pos = scanned;
+    while (tag_pos > 0 && m_data[tag_pos - 1] != '<') --tag_pos;
+    for (std::size_t p = tag_pos; p < scanned; ++p)
+        if (m_data[p] == '\n') ++line;
+    std::size_t count = 0;
+    for (const auto& [b, e] : da.text) {
+        for (std::size_t p = std::max(b, scanned); p < e;) {
+            if (m_data[p] == '\n') ++line;
+            if (is_space(m_data[p])) {
+                ++p;
+                continue;
+            }
+            if (count == k) return at_line(line);
+            while (p < e && !is_space(m_data[p])) ++p;
+            ++count;
+        }
+        scanned = e;
+    }
+    return at_line(line);
+}
+
+template <class T>
+std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::size_t expected, const std::string& what)
+{
+    std::vector<T> out;
+    out.reserve(std::min(expected, m_data.size() / 2 + 1));   // a count from a broken file may be huge
+    std::int64_t line = da.line;
+    std::size_t prev = da.text.empty() ? 0 : da.text.front().first;
+    {
+        std::size_t tag_pos = prev;
+        while (tag_pos > 0 && m_data[tag_pos - 1] != '<') --tag_pos;
+        for (std::size_t p = tag_pos; p < prev; ++p)
+            if (m_data[p] == '\n') ++line;
+    }
+    std::size_t count = 0;
+    std::int64_t last_line = line;
+    for (const auto& [b, e] : da.text) {
+        for (std::size_t p = prev; p < b; ++p)
+            if (m_data[p] == '\n') ++line;
+        std::size_t p = b;
+        while (p < e) {
+            if (is_space(m_data[p])) {
+                if (m_data[p] == '\n') ++line;
+                ++p;
+                continue;
+            }
+            const std::size_t s = p;
+            while (p < e && !is_space(m_data[p])) ++p;
+            const std::string_view tok(m_data.data() + s, p - s);
+            last_line = line;
+            if (count >= expected) {
+                // Count the rest for the message.
+                std::size_t total = count;
+                for (std::size_t q = s; q < m_data.size() && q < da.text.back().second;) {
+                    while (q < m_data.size() && is_space(m_data[q])) ++q;
+                    if (q >= da.text.back().second) break;
+                    ++total;
+                    while (q < m_data.size() && !is_space(m_data[q]) && m_data[q] != '<') ++q;
+                }
+                fail(at_line(line), "expected " + std::to_string(expected) + " values in " + what + ", found " +
+                                        std::to_string(total));
+            }
+            if constexpr (std::is_same_v<T, double>) {
+                const auto v = parse_double(tok);
+                if (!v) fail(at_line(line), "expected a number (value " + std::to_string(count) + " of " + what + "), found " + quote_token(tok));
+                out.push_back(*v);
+            } else {
+                auto v = parse_int(tok);
+                if (!v && !scalar_is_integer(type)) {
+                    const auto d = parse_double(tok);
+                    if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18) v = static_cast<std::int64_t>(*d);
+                }
+                if (!v) fail(at_line(line), "expected an integer (value " + std::to_string(count) + " of " + what + "), found " + quote_token(tok));
+                out.push_back(*v);
+            }
+            ++count;
+        }
+        prev = e;
+    }
+    if (count != expected)
+        fail(at_line(last_line), "expected " + std::to_string(expected) + " values in " + what + ", found " + std::to_string(count));
+    return out;
+}
+
+/// Bytes straight from the file (raw appended data).
+struct RawSource {
+    const std::string& data;
+    std::size_t pos;
+    bool take(std::size_t n, std::vector<unsigned char>& out)
+    {
+        if (n > data.size() - std::min(pos, data.size())) return false;
+        out.insert(out.end(), data.begin() + static_cast<std::ptrdiff_t>(pos), data.begin() + static_cast<std::ptrdiff_t>(pos + n));
+        pos += n;
+        return true;
+    }
+};
+
+/// Bytes decoded from base64 text (inline binary or base64 appended data).
+struct Base64Source {
+    Base64Reader reader;
+    std::size_t pos = 0;   ///< decoded bytes so far
+    bool take(std::size_t n, std::vector<unsigned char>& out)
+    {
+        const std::size_t got = reader.read(n, out);
+        pos += got;
+        return got == n;
+    }
+};
+
+template <class Source>
+std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& da, std::size_t expected_bytes,
+                                                 const std::string& what)
+{
+    constexpr bool raw = std::is_same_v<Source, RawSource>;
+    const std::size_t hs = m_header64 ? 8 : 4;
+    const Scalar ht = m_header64 ? Scalar::UInt64 : Scalar::UInt32;
+    const auto where = [&] { return raw ? at_byte(src.pos) : at_line(da.line); };
+    const auto short_data = [&](std::size_t need, const char* part) {
+        if constexpr (raw) {
+            fail(at_byte(src.pos), "expected " + std::to_string(need) + " bytes of " + part + " of " + what + " (line " +
+                                       std::to_string(da.line) + "), found only " +
+                                       std::to_string(m_data.size() - std::min(src.pos, m_data.size())) +
+                                       " before the end of the file");
+        } else {
+            if (src.reader.bad())
+                fail(at_line(da.line), what + ": invalid character " + quote_token(std::string(1, src.reader.bad_char())) +
+                                           " in base64 data");
+            fail(at_line(da.line), "expected " + std::to_string(need) + " bytes of " + part + " of " + what +
+                                       ", found the end of the base64 text after " + std::to_string(src.pos) +
+                                       " decoded bytes");
+        }
+    };
+    const auto header_words = [&](std::size_t n) {
+        std::vector<unsigned char> b;
+        if (!src.take(n * hs, b)) short_data(n * hs, "the block header");
+        std::vector<std::int64_t> w(n);
+        convert_to_int64(b.data(), ht, n, m_big_endian, w.data());
+        return w;
+    };
+    std::vector<unsigned char> out;
+    if (!m_zlib) {
+        const std::size_t header_pos = src.pos;
+        const std::int64_t nbytes = header_words(1)[0];
+        if (nbytes < 0 || static_cast<std::size_t>(nbytes) != expected_bytes)
+            fail(raw ? at_byte(header_pos) : at_line(da.line),
+                 "expected the block header of " + what + " to give " + std::to_string(expected_bytes) +
+                     " bytes, found " + std::to_string(nbytes));
+        out.reserve(std::min(expected_bytes, m_data.size()));
+        if (!src.take(expected_bytes, out)) short_data(expected_bytes, "data");
+        return out;
+    }
+    const std::size_t header_pos = src.pos;
+    const auto h = header_words(3);
+    const std::int64_t nblocks = h[0], block_size = h[1], last_size = h[2];
+    const std::int64_t last = nblocks > 0 && last_size == 0 ? block_size : last_size;
+    const std::int64_t total = nblocks > 0 ? (nblocks - 1) * block_size + last : 0;
+    if (nblocks < 0 || block_size < 0 || last < 0 || last > block_size || nblocks > (1 << 30) ||
+        total != static_cast<std::int64_t>(expected_bytes))
+        fail(raw ? at_byte(header_pos) : at_line(da.line),
+             "expected the compressed block header of " + what + " to give " + std::to_string(expected_bytes) +
+                 " bytes, found " + std::to_string(nblocks) + " blocks of " + std::to_string(block_size) +
+                 " (last " + std::to_string(last_size) + ")");
+    if (static_cast<std::size_t>(nblocks) > m_data.size() / hs + 1)
+        fail(raw ? at_byte(header_pos) : at_line(da.line),
+             what + ": the compressed block header lists " + std::to_string(nblocks) + " blocks, more than the file can hold");
+    const auto sizes = header_words(static_cast<std::size_t>(nblocks));
+    out.reserve(std::min(expected_bytes, 4 * m_data.size()));
+    std::vector<unsigned char> comp;
+    for (std::int64_t b = 0; b < nblocks; ++b) {
+        const std::int64_t cs = sizes[static_cast<std::size_t>(b)];
+        if (cs < 0 || cs > (std::int64_t(1) << 40))
+            fail(where(), what + ": compressed block " + std::to_string(b) + " has an invalid size " + std::to_string(cs));
+        comp.clear();
+        const std::size_t block_pos = src.pos;
+        if (!src.take(static_cast<std::size_t>(cs), comp)) short_data(static_cast<std::size_t>(cs), "compressed data");
+        const std::size_t expect = static_cast<std::size_t>(b + 1 == nblocks ? last : block_size);
+        if (!zlib_inflate(comp.data(), comp.size(), expect, out, raw ? at_byte(block_pos) : at_line(da.line)))
+            fail(raw ? at_byte(block_pos) : at_line(da.line),
+                 what + ": zlib block " + std::to_string(b) + " of " + std::to_string(nblocks) +
+                     " is corrupt or does not inflate to " + std::to_string(expect) + " bytes");
+    }
+    return out;
+}
+
+template <class T>
+std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected, const std::string& what)
+{
+    const std::string type_name = attr(da, "type");
+    const auto type = scalar_from_xml(type_name);
+    if (!type)
+        fail(at_line(da.line), "expected the type of " + what +
+                                   " to be one of Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, "
+                                   "Float32, Float64, found \"" + type_name + "\"");
+    const std::string format = attr(da, "format", false);
+    if (format == "ascii") return read_ascii<T>(da, *type, expected, what);
+    const std::size_t size = static_cast<std::size_t>(scalar_size(*type));
+    const std::size_t bytes = expected * size;
+    std::vector<unsigned char> payload;
+    if (format == "binary") {
+        std::size_t b = 0, e = 0;
+        if (!da.text.empty()) b = da.text.front().first, e = da.text.back().second;
+        std::string joined;
+        const char* pb = m_data.data() + b;
+        const char* pe = m_data.data() + e;
+        if (da.text.size() > 1) {   // text split by comments or child elements
+            for (const auto& [tb, te] : da.text) joined.append(m_data, tb, te - tb);
+            pb = joined.data();
+            pe = joined.data() + joined.size();
+        }
+        Base64Source src{Base64Reader(pb, pe)};
+        payload = read_block(src, da, bytes, what);
+    } else if (format == "appended") {
+        if (m_doc.appended_pos == std::string::npos)
+            fail(at_line(da.line), "expected <AppendedData> for " + what + " (format=\"appended\"), found none");
+        const std::int64_t offset = int_attr(da, "offset", 0);
+        const std::size_t start = m_doc.appended_pos + static_cast<std::size_t>(offset);
+        if (offset > static_cast<std::int64_t>(m_data.size()) || start > m_data.size())
+            fail(at_line(da.line), "expected the offset of " + what + " to lie inside the file, found offset=\"" +
+                                       std::to_string(offset) + "\" past its end");
+        if (m_doc.appended_encoding == "raw") {
+            RawSource src{m_data, start};
+            payload = read_block(src, da, bytes, what);
+        } else {
+            Base64Source src{Base64Reader(m_data.data() + start, m_data.data() + m_data.size())};
+            payload = read_block(src, da, bytes, what);
+        }
+    } else {
+        fail(at_line(da.line), "expected format=\"ascii\", \"binary\" or \"appended\" for " + what + ", found \"" + format + "\"");
+    }
+    std::vector<T> out(expected);
+    if constexpr (std::is_same_v<T, double>) convert_to_double(payload.data(), *type, expected, m_big_endian, out.data());
+    else convert_to_int64(payload.data(), *type, expected, m_big_endian, out.data());
+    return out;
+}
+
+TetMesh VtuReader::read()
+{
+    m_data = read_file(m_path);
+    m_doc = XmlParser(m_path, m_data).parse();
+    const XmlElement& root = m_doc.root;
+    if (root.name != "VTKFile") fail(at_line(root.line), "expected <VTKFile>, found <" + root.name + ">");
+    const std::string type = attr(root, "type");
+    if (type != "UnstructuredGrid")
+        fail(at_line(root.line), "expected type=\"UnstructuredGrid\" (the only VTK XML dataset tethash reads), found \"" + type + "\"");
+    if (const std::string* v = root.attr("version")) {
+        const auto dot = v->find('.');
+        const auto major = parse_int(std::string_view(*v).substr(0, dot));
+        if (!major || *major < 0 || *major > 2)
+            fail(at_line(root.line), "unknown VTK XML version \"" + *v + "\" (expected 0.1 to 2.x)");
+    }
+    const std::string order = attr(root, "byte_order", false);
+    if (order == "BigEndian") m_big_endian = true;
+    else if (!order.empty() && order != "LittleEndian")
+        fail(at_line(root.line), "expected byte_order=\"LittleEndian\" or \"BigEndian\", found \"" + order + "\"");
+    const std::string header = attr(root, "header_type", false);
+    if (header == "UInt64") m_header64 = true;
+    else if (!header.empty() && header != "UInt32")
+        fail(at_line(root.line), "expected header_type=\"UInt32\" or \"UInt64\", found \"" + header + "\"");
+    const std::string compressor = attr(root, "compressor", false);
+    if (compressor == "vtkZLibDataCompressor") {
+        m_zlib = true;
+        if (!vtu_zlib_supported())
+            fail(at_line(root.line), "zlib-compressed data (compressor=\"vtkZLibDataCompressor\"), but tethash was built without zlib");
+    } else if (!compressor.empty()) {
+        fail(at_line(root.line), "unsupported compressor \"" + compressor + "\" (expected vtkZLibDataCompressor or none)");
+    }
+    if (!m_doc.appended_encoding.empty() || m_doc.appended_pos != std::string::npos) {
+        if (m_doc.appended_encoding != "raw" && m_doc.appended_encoding != "base64")
+            fail(at_line(m_doc.appended_line), "expected encoding=\"raw\" or \"base64\" in <AppendedData>, found \"" +
+                                                   m_doc.appended_encoding + "\"");
+    }
+    const XmlElement* grid = root.child("UnstructuredGrid");
+    if (!grid) fail(at_line(root.line), "expected <UnstructuredGrid> in <VTKFile>, found none");
+
+    std::vector<double> coords;
+    std::vector<std::int64_t> tet_cells;
+    std::vector<Index> tet_ids;
+    std::map<std::int64_t, std::int64_t> skipped;
+    std::map<std::string, NamedArray> point_arrays, cell_arrays;
+    std::int64_t total_points = 0, total_cells = 0;
+
+    for (const XmlElement& piece : grid->children) {
+        if (piece.name != "Piece") continue;
+        const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
+        const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
+        if (nc > (std::int64_t(1) << 40)) fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
+        if (total_points + np > 2147483647)
+            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points + np) + ")");
+        const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
+
+        // Points
+        const XmlElement* points = piece.child("Points");
+        if (!points) fail(at_line(piece.line), "expected <Points> in <Piece>, found none");
+        const XmlElement* pda = points->child("DataArray");
+        if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
+        const std::string comps = attr(*pda, "NumberOfComponents", false);
+        if (comps != "3")
+            fail(at_line(pda->line), "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
+        const std::vector<double> pc = read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
+        for (std::size_t i = 0; i < npz; ++i)
+            for (int k = 0; k < 3; ++k)
+                if (!std::isfinite(pc[3 * i + k]))
+                    fail(at_value(*pda, 3 * i + k), "point " + std::to_string(total_points + static_cast<std::int64_t>(i)) +
+                                                        " has a non-finite coordinate");
+        coords.insert(coords.end(), pc.begin(), pc.end());
+
+        // Cells
+        const XmlElement* cells = piece.child("Cells");
+        if (!cells && nc > 0) fail(at_line(piece.line), "expected <Cells> in <Piece>, found none");
+        if (cells) {
+            const auto find = [&](const char* name) -> const XmlElement& {
+                for (const auto& c : cells->children)
+                    if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
+                fail(at_line(cells->line), "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
+            };
+            const XmlElement& oda = find("offsets");
+            const XmlElement& cda = find("connectivity");
+            const XmlElement& tda = find("types");
+            const auto offsets = read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
+            const auto types = read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
+            std::int64_t prev = 0;
+            for (std::size_t c = 0; c < ncz; ++c) {
+                if (offsets[c] < prev)
+                    fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
+                                               ", expected at least " + std::to_string(prev) + " (offsets must not decrease)");
+                prev = offsets[c];
+            }
+            const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
+            if (conn_size > (std::int64_t(1) << 40))
+                fail(at_value(oda, ncz - 1), "last offset " + std::to_string(conn_size) + " is implausibly large");
+            const auto conn = read_array<std::int64_t>(cda, static_cast<std::size_t>(conn_size),
+                                                       "DataArray 'connectivity' (" + std::to_string(conn_size) +
+                                                           " values, the last offset)");
+            for (std::size_t c = 0; c < ncz; ++c) {
+                if (types[c] != 10) {
+                    ++skipped[types[c]];
+                    continue;
+                }
+                const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
+                if (offsets[c] - first != 4)
+                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type 10 (tetra) but " +
+                                               std::to_string(offsets[c] - first) + " points, expected 4");
+                for (int k = 0; k < 4; ++k) {
+                    const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
+                    if (v < 0 || v >= np)
+                        fail(at_value(cda, static_cast<std::size_t>(first + k)),
+                             "tet " + std::to_string(tet_cells.size()) + " (cell " + std::to_string(c) +
+                                 ") refers to point " + std::to_string(v) + ", but the piece has only " +
+                                 std::to_string(np) + " points (0-based ids)");
+                    tet_ids.push_back(static_cast<Index>(v + total_points));
+                }
+                tet_cells.push_back(total_cells + static_cast<std::int64_t>(c));
+            }
+        }
+
+        // Point and cell arrays that may hold object ids or labels.
+        const auto gather = [&](const char* section, bool cell, std::size_t count, std::map<std::string, NamedArray>& into) {
+            const XmlElement* s = piece.child(section);
+            if (!s) return;
+            for (const auto& da : s->children) {
+                if (da.name != "DataArray" || !da.attr("Name")) continue;
+                const std::string& name = *da.attr("Name");
+                const std::string* nc_attr = da.attr("NumberOfComponents");
+                if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
+                auto values = read_array<double>(da, count, "DataArray '" + name + "'");
+                NamedArray& a = into[name];
+                if (a.name.empty()) a = {name, {}, at_line(da.line)};
+                // Pieces missing the array leave it short; apply_label_arrays then ignores it.
+                a.values.insert(a.values.end(), values.begin(), values.end());
+            }
+        };
+        gather("PointData", false, npz, point_arrays);
+        gather("CellData", true, ncz, cell_arrays);
+        total_points += np;
+        total_cells += nc;
+    }
+
+    TetMesh mesh;
+    mesh.positions.resize(total_points, 3);
+    std::copy(coords.begin(), coords.end(), mesh.positions.data());
+    mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
+    std::copy(tet_ids.begin(), tet_ids.end(), mesh.tets.data());
+    if (m_notes) {
+        for (const auto& [t, count] : skipped) {
+            m_notes->skipped_cells += count;
+            m_notes->messages.push_back(m_path + ": skipped " + std::to_string(count) + " cells of type " +
+                                        std::to_string(t) + " (" + cell_type_name(t) + ")");
+        }
+    }
+    std::vector<NamedArray> pa, ca;
+    for (auto& [k, a] : point_arrays) pa.push_back(std::move(a));
+    for (auto& [k, a] : cell_arrays) ca.push_back(std::move(a));
+    apply_label_arrays(mesh, pa, ca, tet_cells, static_cast<std::size_t>(total_cells), m_notes);
+    return mesh;
+}
+
+void write_whole(const std::string& path, const std::string& text)
+{
+    write_atomically(path, [&](const std::string& tmp) {
+        std::ofstream f(tmp, std::ios::binary);
+        if (!f) throw Error(path + ": cannot open '" + tmp + "' for writing");
+        f.write(text.data(), static_cast<std::streamsize>(text.size()));
+        f.close();
+        if (!f) throw Error(path + ": writing failed (disk full?)");
+    });
+}
+
+} // namespace
+
+TetMesh read_vtu(const std::string& path, ReadNotes* notes) { return VtuReader(path, notes).read(); }
+
+void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)
+{
+    std::vector<OutArray> point_arrays, cell_arrays;
+    collect_out_arrays(path, mesh, fields, true, point_arrays, cell_arrays);
+    const std::size_t n = static_cast<std::size_t>(mesh.num_vertices()), m = static_cast<std::size_t>(mesh.num_tets());
+    for (std::size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(mesh.positions(static_cast<Eigen::Index>(i), k)))
+                throw Error(path + ": point " + std::to_string(i) + " has a non-finite coordinate; not writing it");
+
+    const bool offsets64 = 4 * m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+    // Every array as (XML attributes, byte size, writer of its little-endian data).
+    struct Block {
+        std::string section;   // "PointData", "CellData", "Points", "Cells"
+        std::string attrs;
+        std::size_t bytes;
+        std::function<void(std::string&)> write;
+    };
+    std::vector<Block> blocks;
+    const auto add_fields = [&](const std::vector<OutArray>& arrays, const char* section, std::size_t count) {
+        for (const OutArray& a : arrays) {
+            const std::size_t values = count * static_cast<std::size_t>(a.components);
+            std::string at = std::string("type=\"") + (a.integer ? "Int32" : "Float64") + "\" Name=\"" + xml_escape(a.name) +
+                             "\" NumberOfComponents=\"" + std::to_string(a.components) + "\"";
+            blocks.push_back({section, at, values * (a.integer ? 4 : 8), [a, values](std::string& out) {
+                                  for (std::size_t i = 0; i < values; ++i) {
+                                      if (a.integer) append_bytes<std::int32_t>(out, (*a.ints)[i], false);
+                                      else append_bytes<double>(out, (*a.values)[i], false);
+                                  }
+                              }});
+        }
+    };
+    add_fields(point_arrays, "PointData", n);
+    add_fields(cell_arrays, "CellData", m);
+    blocks.push_back({"Points", "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * n * 8, [&](std::string& out) {
+                          for (std::size_t i = 0; i < 3 * n; ++i) append_bytes<double>(out, mesh.positions.data()[i], false);
+                      }});
+    blocks.push_back({"Cells", "type=\"Int32\" Name=\"connectivity\"", 4 * m * 4, [&](std::string& out) {
+                          for (std::size_t i = 0; i < 4 * m; ++i) append_bytes<std::int32_t>(out, mesh.tets.data()[i], false);
+                      }});
+    blocks.push_back({"Cells", std::string("type=\"") + (offsets64 ? "Int64" : "Int32") + "\" Name=\"offsets\"",
+                      m * (offsets64 ? 8 : 4), [&](std::string& out) {
+                          for (std::size_t t = 1; t <= m; ++t) {
+                              if (offsets64) append_bytes<std::int64_t>(out, static_cast<std::int64_t>(4 * t), false);
+                              else append_bytes<std::int32_t>(out, static_cast<std::int32_t>(4 * t), false);
+                          }
+                      }});
+    blocks.push_back({"Cells", "type=\"UInt8\" Name=\"types\"", m, [&](std::string& out) { out.append(m, '\x0a'); }});
+
+    bool header64 = false;
+    for (const Block& b : blocks) header64 = header64 || b.bytes > 0xffffffffu;
+    const std::size_t hs = header64 ? 8 : 4;
+
+    std::string xml = "<?xml version=\"1.0\"?>\n";
+    xml += std::string("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"") +
+           (header64 ? "UInt64" : "UInt32") + "\">\n";
+    xml += "  <UnstructuredGrid>\n";
+    xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
+    // The data go in reverse document order (the last DataArray at offset 0). VTK does not care;
+    // meshio's raw-appended reader looks arrays up by offset after renumbering the ones it has
+    // seen, and this order keeps a renumbered offset from shadowing one still to be read.
+    std::size_t offset = 0;
+    std::vector<std::size_t> offsets(blocks.size());
+    for (std::size_t i = blocks.size(); i-- > 0;) {
+        offsets[i] = offset;
+        offset += hs + blocks[i].bytes;
+    }
+    for (const char* section : {"PointData", "CellData", "Points", "Cells"}) {
+        bool any = false;
+        for (std::size_t i = 0; i < blocks.size(); ++i) {
+            if (blocks[i].section != section) continue;
+            if (!any) xml += std::string("      <") + section + ">\n";
+            any = true;
+            xml += "        <DataArray " + blocks[i].attrs + " format=\"appended\" offset=\"" + std::to_string(offsets[i]) + "\"/>\n";
+        }
+        if (any) xml += std::string("      </") + section + ">\n";
+        else if (std::string(section) == "PointData" || std::string(section) == "CellData")
+            xml += std::string("      <") + section + "/>\n";
+    }
+    xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
+    xml.reserve(xml.size() + offset + 64);
+    for (auto it = blocks.rbegin(); it != blocks.rend(); ++it) {
+        const Block& b = *it;
+        if (header64) append_bytes<std::uint64_t>(xml, b.bytes, false);
+        else append_bytes<std::uint32_t>(xml, static_cast<std::uint32_t>(b.bytes), false);
+        b.write(xml);
+    }
+    xml += "\n  </AppendedData>\n</VTKFile>\n";
+    write_whole(path, xml);
+}
+
+void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries)
+{
+    std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+    for (const auto& [time, file] : entries) {
+        if (!std::isfinite(time)) throw Error(path + ": time " + format_double(time) + " of '" + file + "' is not finite");
+        if (file.empty()) throw Error(path + ": an entry at time " + format_double(time) + " has an empty file name");
+        xml += "    <DataSet timestep=\"" + format_double(time) + "\" group=\"\" part=\"0\" file=\"" + xml_escape(file) + "\"/>\n";
+    }
+    xml += "  </Collection>\n</VTKFile>\n";
+    write_whole(path, xml);
+}
+
+std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
+{
+    const std::string data = read_file(path);
+    const XmlDocument doc = XmlParser(path, data).parse();
+    const auto at = [&](std::int64_t line) { return path + ":" + std::to_string(line); };
+    if (doc.root.name != "VTKFile") throw Error(at(doc.root.line) + ": expected <VTKFile>, found <" + doc.root.name + ">");
+    const std::string* type = doc.root.attr("type");
+    if (!type || *type != "Collection")
+        throw Error(at(doc.root.line) + ": expected type=\"Collection\", found \"" + (type ? *type : std::string()) + "\"");
+    const XmlElement* col = doc.root.child("Collection");
+    if (!col) throw Error(at(doc.root.line) + ": expected <Collection>, found none");
+    std::vector<std::pair<double, std::string>> r;
+    for (const auto& ds : col->children) {
+        if (ds.name != "DataSet") continue;
+        const std::string* file = ds.attr("file");
+        if (!file) throw Error(at(ds.line) + ": expected attribute file=\"...\" in <DataSet>, found none");
+        const std::string* ts = ds.attr("timestep");
+        double t = 0;
+        if (ts) {
+            const auto v = parse_double(*ts);
+            if (!v || !std::isfinite(*v)) throw Error(at(ds.line) + ": expected a number for timestep, found \"" + *ts + "\"");
+            t = *v;
+        }
+        r.emplace_back(t, *file);
+    }
+    return r;
+}
+
+} // namespace tethash::io

@@ -1,0 +1,368 @@
+#include "tethash/sim/model.hpp"
+
+#include "tethash/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace tethash::sim {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+Vec3 row(const Positions& x, Index i) { return x.row(i).transpose(); }
+
+/// Signed volume and its gradient with respect to the four vertices (rows of g).
+double volume_and_gradient(const Positions& x, const Index* t, Eigen::Matrix<double, 4, 3>& g)
+{
+    const Vec3 a = row(x, t[0]), b = row(x, t[1]), c = row(x, t[2]), d = row(x, t[3]);
+    const Vec3 ba = b - a, ca = c - a, da = d - a;
+    const Vec3 gb = ca.cross(da) / 6.0, gc = da.cross(ba) / 6.0, gd = ba.cross(ca) / 6.0;
+    g.row(1) = gb.transpose();
+    g.row(2) = gc.transpose();
+    g.row(3) = gd.transpose();
+    g.row(0) = -(gb + gc + gd).transpose();
+    return ba.dot(ca.cross(da)) / 6.0;
+}
+
+} // namespace
+
+Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
+{
+    Model m;
+    const Index n = mesh.num_vertices();
+    const Positions& rest = mesh.rest();
+    auto tet_obj = [&](Index t) { return mesh.tet_object.empty() ? 0 : mesh.tet_object[static_cast<size_t>(t)]; };
+    auto is_static = [&](Index o) { return static_cast<size_t>(o) < object_static.size() && object_static[static_cast<size_t>(o)]; };
+    auto material = [&](Index o) -> const Material& {
+        if (static_cast<size_t>(o) >= materials.size()) throw Error("model: no material for object " + std::to_string(o));
+        return materials[static_cast<size_t>(o)];
+    };
+
+    m.mass.assign(static_cast<size_t>(n), 0.0);
+    m.fixed.assign(static_cast<size_t>(n), 0);
+    for (Index i = 0; i < n; ++i) {
+        const Index o = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
+        if (is_static(o)) m.fixed[static_cast<size_t>(i)] = 1;
+    }
+
+    // Dynamic tets: masses and volume terms. A per-vertex "young" for springs from their adjacent tets.
+    std::vector<Index> dyn;
+    for (Index t = 0; t < mesh.num_tets(); ++t)
+        if (!is_static(tet_obj(t))) dyn.push_back(t);
+    m.volumes.tets.resize(static_cast<Index>(dyn.size()), 4);
+    m.volumes.rest.resize(dyn.size());
+    m.volumes.k.resize(dyn.size());
+    Eigen::Matrix<double, 4, 3> g;
+    for (size_t q = 0; q < dyn.size(); ++q) {
+        const Index t = dyn[q];
+        Index v[4] = {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2), mesh.tets(t, 3)};
+        double vol = volume_and_gradient(rest, v, g);
+        double lmean = 0;
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) lmean += (row(rest, v[a]) - row(rest, v[b])).norm() / 6.0;
+        if (!(std::abs(vol) > 1e-12 * lmean * lmean * lmean) || !std::isfinite(vol))
+            throw Error("model: tet " + std::to_string(t) + " has zero volume in the rest state (volume " +
+                        std::to_string(vol) + "); fix the mesh (tethash info reports such tets)");
+        if (vol < 0) {  // inverted at rest: orient the volume term so that its rest volume is positive
+            std::swap(v[2], v[3]);
+            vol = -vol;
+        }
+        const Material& mat = material(tet_obj(t));
+        for (int a = 0; a < 4; ++a) m.mass[static_cast<size_t>(v[a])] += mat.density * vol / 4.0;
+        const double young = mat.stiffness > 0 ? mat.stiffness / lmean : mat.young;
+        for (int a = 0; a < 4; ++a) m.volumes.tets(static_cast<Index>(q), a) = v[a];
+        // Nearly flat rest tets would give a huge stiffness k/V0·|∇V|²; the volume scale is floored at
+        // 1e-3·l³ (a regular tet has ≈ 0.118·l³) so that slivers stay as stiff as an ordinary tet.
+        // Stored so that k/V0 = volume_stiffness·young / max(V0, 1e-3·l³).
+        m.volumes.rest[q] = vol;
+        m.volumes.k[q] = mat.volume_stiffness * young * vol / std::max(vol, 1e-3 * lmean * lmean * lmean);
+    }
+
+    // Springs: unique edges of the dynamic tets.
+    Tets dyn_tets(static_cast<Index>(dyn.size()), 4);
+    for (size_t q = 0; q < dyn.size(); ++q) dyn_tets.row(static_cast<Index>(q)) = mesh.tets.row(dyn[q]);
+    m.springs.edges = unique_edges(dyn_tets);
+    const Index ne = static_cast<Index>(m.springs.edges.rows());
+    m.springs.rest.resize(static_cast<size_t>(ne));
+    m.springs.k.resize(static_cast<size_t>(ne));
+    m.springs.c.resize(static_cast<size_t>(ne));
+    for (Index e = 0; e < ne; ++e) {
+        const Index i = m.springs.edges(e, 0), j = m.springs.edges(e, 1);
+        const double len = (row(rest, i) - row(rest, j)).norm();
+        if (!(len > 0))
+            throw Error("model: edge (" + std::to_string(i) + ", " + std::to_string(j) + ") has zero rest length");
+        const Index o = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
+        const Material& mat = material(o);
+        const double k = mat.stiffness > 0 ? mat.stiffness : mat.young * len;
+        m.springs.rest[static_cast<size_t>(e)] = len;
+        m.springs.k[static_cast<size_t>(e)] = k;
+        m.springs.c[static_cast<size_t>(e)] = mat.damping * k;
+    }
+    for (Index i = 0; i < n; ++i)
+        if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
+            m.fixed[static_cast<size_t>(i)] = 1;  // unreferenced vertex: nothing moves it
+    return m;
+}
+
+void Model::add_spring_forces(const Positions& x, Positions& f) const
+{
+    const Index ne = static_cast<Index>(springs.edges.rows());
+    for (Index e = 0; e < ne; ++e) {
+        const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
+        const Vec3 d = row(x, i) - row(x, j);
+        const double len = d.norm();
+        if (!(len > 0)) continue;
+        const Vec3 fi = -springs.k[static_cast<size_t>(e)] * (len - springs.rest[static_cast<size_t>(e)]) / len * d;
+        f.row(i) += fi.transpose();
+        f.row(j) -= fi.transpose();
+    }
+}
+
+void Model::add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const
+{
+    const Index n = num_vertices();
+    const bool do_k = opt.parts & ForceOptions::springs, do_c = opt.parts & ForceOptions::damping;
+    const Index ne = (do_k || do_c) ? static_cast<Index>(springs.edges.rows()) : 0;
+    for (Index e = 0; e < ne; ++e) {
+        const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
+        const Vec3 d = row(x, i) - row(x, j);
+        const double len = d.norm();
+        if (!(len > 0)) continue;
+        const Vec3 u = d / len;
+        double mag = 0;
+        if (do_k) mag += springs.k[static_cast<size_t>(e)] * (len - springs.rest[static_cast<size_t>(e)]);
+        if (do_c) mag += springs.c[static_cast<size_t>(e)] * (row(v, i) - row(v, j)).dot(u);
+        f.row(i) -= mag * u.transpose();
+        f.row(j) += mag * u.transpose();
+    }
+    if (opt.parts & ForceOptions::volume) {
+        Eigen::Matrix<double, 4, 3> g;
+        for (Index t = 0; t < volumes.tets.rows(); ++t) {
+            const double vol = volume_and_gradient(x, &volumes.tets(t, 0), g);
+            const double v0 = volumes.rest[static_cast<size_t>(t)];
+            const double s = -opt.volume_scale * volumes.k[static_cast<size_t>(t)] * (vol - v0) / v0;
+            for (int a = 0; a < 4; ++a) f.row(volumes.tets(t, a)) += s * g.row(a);
+        }
+    }
+    if ((opt.parts & ForceOptions::gravity) && gravity.squaredNorm() > 0)
+        for (Index i = 0; i < n; ++i) f.row(i) += mass[static_cast<size_t>(i)] * gravity.transpose();
+    if ((opt.parts & ForceOptions::ground) && ground.enabled) {
+        const Vec3& nrm = ground.normal;
+        for (Index i = 0; i < n; ++i) {
+            const double pen = ground.height - nrm.dot(row(x, i));
+            if (pen <= 0) continue;
+            const Vec3 vi = row(v, i);
+            const double vn = nrm.dot(vi);
+            const double fn = std::max(0.0, opt.ground_scale * (ground.stiffness * pen - ground.damping * vn));
+            Vec3 force = fn * nrm;
+            if (ground.friction > 0) {
+                const Vec3 vt = vi - vn * nrm;
+                const double speed = vt.norm();
+                double ft = ground.friction * fn;  // Coulomb, smoothed below 1 mm/s of sliding
+                ft *= speed / std::max(speed, 1e-3);
+                if (opt.h > 0) ft = std::min(ft, mass[static_cast<size_t>(i)] * speed / opt.h);
+                if (speed > 0) force -= ft * vt / speed;
+            }
+            f.row(i) += force.transpose();
+        }
+    }
+}
+
+Energy Model::energy(const Positions& x, const Positions& v) const
+{
+    Energy en;
+    const Index n = num_vertices();
+    for (Index i = 0; i < n; ++i) {
+        if (fixed[static_cast<size_t>(i)]) continue;
+        en.kinetic += 0.5 * mass[static_cast<size_t>(i)] * v.row(i).squaredNorm();
+        en.gravity -= mass[static_cast<size_t>(i)] * gravity.dot(row(x, i));
+        if (ground.enabled) {
+            const double pen = ground.height - ground.normal.dot(row(x, i));
+            if (pen > 0) en.ground += 0.5 * ground.stiffness * pen * pen;
+        }
+    }
+    for (Index e = 0; e < springs.edges.rows(); ++e) {
+        const double len = (row(x, springs.edges(e, 0)) - row(x, springs.edges(e, 1))).norm();
+        const double s = len - springs.rest[static_cast<size_t>(e)];
+        en.spring += 0.5 * springs.k[static_cast<size_t>(e)] * s * s;
+    }
+    Eigen::Matrix<double, 4, 3> g;
+    for (Index t = 0; t < volumes.tets.rows(); ++t) {
+        const double vol = volume_and_gradient(x, &volumes.tets(t, 0), g);
+        const double v0 = volumes.rest[static_cast<size_t>(t)];
+        en.volume += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
+    }
+    return en;
+}
+
+namespace {
+/// Per-vertex Gershgorin sums of the stiffness (Σ |K_ij| over the block row) and damping.
+void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, std::vector<double>& csum)
+{
+    const size_t n = m.mass.size();
+    ksum.assign(n, 0.0);
+    csum.assign(n, 0.0);
+    for (Index e = 0; e < m.springs.edges.rows(); ++e) {
+        for (int s = 0; s < 2; ++s) {
+            ksum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.k[static_cast<size_t>(e)];
+            csum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.c[static_cast<size_t>(e)];
+        }
+    }
+    Eigen::Matrix<double, 4, 3> g;
+    for (Index t = 0; t < m.volumes.tets.rows(); ++t) {
+        volume_and_gradient(x, &m.volumes.tets(t, 0), g);
+        const double s = m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)];
+        double total = 0;
+        for (int a = 0; a < 4; ++a) total += g.row(a).norm();
+        for (int a = 0; a < 4; ++a) ksum[static_cast<size_t>(m.volumes.tets(t, a))] += s * g.row(a).norm() * total;
+    }
+}
+} // namespace
+
+double Model::omega_max_sq(const Positions& x) const
+{
+    std::vector<double> ksum, csum;
+    gershgorin(*this, x, ksum, csum);
+    double w2 = 0;
+    for (size_t i = 0; i < mass.size(); ++i)
+        if (!fixed[i]) w2 = std::max(w2, ksum[i] / mass[i]);
+    return w2;
+}
+
+double Model::explicit_dt_limit(const Positions& x, double extra_k) const
+{
+    std::vector<double> ksum, csum;
+    gershgorin(*this, x, ksum, csum);
+    double limit = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < mass.size(); ++i) {
+        if (fixed[i]) continue;
+        const double w2 = (ksum[i] + 2 * extra_k) / mass[i];
+        const double gam = csum[i] / mass[i];
+        if (w2 <= 0 && gam <= 0) continue;
+        const double h = w2 > 0 ? (-gam + std::sqrt(gam * gam + 4 * w2)) / w2 : 2.0 / gam;
+        limit = std::min(limit, h);
+    }
+    return limit;
+}
+
+void Model::add_matrix_triplets(const Positions& x, double scale_k, double scale_c,
+                                std::vector<Eigen::Triplet<double>>& out) const
+{
+    auto add_block = [&](Index bi, Index bj, const Mat3& b) {
+        if (fixed[static_cast<size_t>(bi)] || fixed[static_cast<size_t>(bj)]) return;
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                if (b(r, c) != 0) out.emplace_back(3 * bi + r, 3 * bj + c, b(r, c));
+    };
+    for (Index e = 0; e < springs.edges.rows(); ++e) {
+        const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
+        const Vec3 d = row(x, i) - row(x, j);
+        const double len = d.norm();
+        if (!(len > 0)) continue;
+        const Vec3 u = d / len;
+        const Mat3 uu = u * u.transpose();
+        const double k = springs.k[static_cast<size_t>(e)];
+        // −∂f/∂x of a spring, with the transverse term clamped at 0 (compressed springs) to stay semi-definite.
+        const double tr = std::max(0.0, 1.0 - springs.rest[static_cast<size_t>(e)] / len);
+        const Mat3 b = scale_k * k * (uu + tr * (Mat3::Identity() - uu)) + scale_c * springs.c[static_cast<size_t>(e)] * uu;
+        add_block(i, i, b);
+        add_block(j, j, b);
+        add_block(i, j, -b);
+        add_block(j, i, -b);
+    }
+    Eigen::Matrix<double, 4, 3> g;
+    for (Index t = 0; t < volumes.tets.rows(); ++t) {
+        volume_and_gradient(x, &volumes.tets(t, 0), g);
+        const double s = scale_k * volumes.k[static_cast<size_t>(t)] / volumes.rest[static_cast<size_t>(t)];
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b)
+                add_block(volumes.tets(t, a), volumes.tets(t, b), s * g.row(a).transpose() * g.row(b));
+    }
+    if (ground.enabled) {
+        const Mat3 nn = ground.normal * ground.normal.transpose();
+        for (Index i = 0; i < num_vertices(); ++i)
+            if (ground.height - ground.normal.dot(row(x, i)) > 0)
+                add_block(i, i, (scale_k * ground.stiffness + scale_c * ground.damping) * nn);
+    }
+}
+
+namespace {
+/// Spring block scale_k·K_e + scale_c·C_e of edge e at x (zero for a zero-length edge).
+Mat3 spring_block(const Model& m, const Positions& x, Index e, double scale_k, double scale_c)
+{
+    const Vec3 d = row(x, m.springs.edges(e, 0)) - row(x, m.springs.edges(e, 1));
+    const double len = d.norm();
+    if (!(len > 0)) return Mat3::Zero();
+    const Vec3 u = d / len;
+    const Mat3 uu = u * u.transpose();
+    const double tr = std::max(0.0, 1.0 - m.springs.rest[static_cast<size_t>(e)] / len);
+    return scale_k * m.springs.k[static_cast<size_t>(e)] * (uu + tr * (Mat3::Identity() - uu)) +
+           scale_c * m.springs.c[static_cast<size_t>(e)] * uu;
+}
+} // namespace
+
+void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, const Eigen::VectorXd& p,
+                         Eigen::VectorXd& out) const
+{
+    auto free = [&](Index i) { return !fixed[static_cast<size_t>(i)]; };
+    auto pv = [&](Index i) -> Vec3 { return free(i) ? Vec3(p.segment<3>(3 * i)) : Vec3::Zero(); };
+    for (Index e = 0; e < springs.edges.rows(); ++e) {
+        const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
+        if (!free(i) && !free(j)) continue;
+        const Vec3 y = spring_block(*this, x, e, scale_k, scale_c) * (pv(i) - pv(j));
+        if (free(i)) out.segment<3>(3 * i) += y;
+        if (free(j)) out.segment<3>(3 * j) -= y;
+    }
+    if (scale_k != 0) {
+        Eigen::Matrix<double, 4, 3> g;
+        for (Index t = 0; t < volumes.tets.rows(); ++t) {
+            volume_and_gradient(x, &volumes.tets(t, 0), g);
+            const double s = scale_k * volumes.k[static_cast<size_t>(t)] / volumes.rest[static_cast<size_t>(t)];
+            double gp = 0;
+            for (int a = 0; a < 4; ++a) gp += g.row(a).dot(pv(volumes.tets(t, a)));
+            for (int a = 0; a < 4; ++a)
+                if (free(volumes.tets(t, a))) out.segment<3>(3 * volumes.tets(t, a)) += s * gp * g.row(a).transpose();
+        }
+    }
+    if (ground.enabled) {
+        const double s = scale_k * ground.stiffness + scale_c * ground.damping;
+        for (Index i = 0; i < num_vertices(); ++i)
+            if (free(i) && ground.height - ground.normal.dot(row(x, i)) > 0)
+                out.segment<3>(3 * i) += s * ground.normal * ground.normal.dot(pv(i));
+    }
+}
+
+void Model::add_matrix_diagonal(const Positions& x, double scale_k, double scale_c, Eigen::VectorXd& diag) const
+{
+    auto free = [&](Index i) { return !fixed[static_cast<size_t>(i)]; };
+    for (Index e = 0; e < springs.edges.rows(); ++e) {
+        const Vec3 dg = spring_block(*this, x, e, scale_k, scale_c).diagonal();
+        for (int s = 0; s < 2; ++s)
+            if (free(springs.edges(e, s))) diag.segment<3>(3 * springs.edges(e, s)) += dg;
+    }
+    if (scale_k != 0) {
+        Eigen::Matrix<double, 4, 3> g;
+        for (Index t = 0; t < volumes.tets.rows(); ++t) {
+            volume_and_gradient(x, &volumes.tets(t, 0), g);
+            const double s = scale_k * volumes.k[static_cast<size_t>(t)] / volumes.rest[static_cast<size_t>(t)];
+            for (int a = 0; a < 4; ++a)
+                if (free(volumes.tets(t, a)))
+                    diag.segment<3>(3 * volumes.tets(t, a)) += s * g.row(a).transpose().cwiseProduct(g.row(a).transpose());
+        }
+    }
+    if (ground.enabled) {
+        const double s = scale_k * ground.stiffness + scale_c * ground.damping;
+        for (Index i = 0; i < num_vertices(); ++i)
+            if (free(i) && ground.height - ground.normal.dot(row(x, i)) > 0)
+                diag.segment<3>(3 * i) += s * ground.normal.cwiseProduct(ground.normal);
+    }
+}
+
+} // namespace tethash::sim

@@ -1,0 +1,108 @@
+#pragma once
+// Small scene generators for the detection tests (independent of io::generate): cube lattices split into
+// 6 tets per cube (Kuhn), placed, deformed and combined into multi-object scenes.
+#include "tethash/detect.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace tethash::test {
+
+struct Scene {
+    Positions positions;
+    Tets tets;
+    std::vector<Index> vertex_object, tet_object;
+    std::vector<ObjectOptions> objects;
+};
+
+/// Cube lattice of nx × ny × nz cubes of edge h at `origin`, 6 tets per cube (all positively oriented).
+inline Scene lattice_object(int nx, int ny, int nz, double h, const Eigen::Vector3d& origin)
+{
+    Scene s;
+    auto vid = [&](int i, int j, int k) { return static_cast<Index>((k * (ny + 1) + j) * (nx + 1) + i); };
+    s.positions.resize((nx + 1) * (ny + 1) * (nz + 1), 3);
+    for (int k = 0; k <= nz; ++k)
+        for (int j = 0; j <= ny; ++j)
+            for (int i = 0; i <= nx; ++i)
+                s.positions.row(vid(i, j, k)) = origin + h * Eigen::Vector3d(i, j, k);
+    // Kuhn split: the 6 monotone paths from corner 000 to 111.
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    s.tets.resize(6 * nx * ny * nz, 4);
+    int t = 0;
+    for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i)
+                for (const auto& p : perms) {
+                    int c[3] = {i, j, k};
+                    Index ids[4];
+                    ids[0] = vid(c[0], c[1], c[2]);
+                    for (int step = 0; step < 3; ++step) {
+                        ++c[p[step]];
+                        ids[step + 1] = vid(c[0], c[1], c[2]);
+                    }
+                    s.tets.row(t) << ids[0], ids[1], ids[2], ids[3];
+                    const Eigen::Vector3d a = s.positions.row(ids[0]), b = s.positions.row(ids[1]),
+                                          cc = s.positions.row(ids[2]), d = s.positions.row(ids[3]);
+                    if ((b - a).dot((cc - a).cross(d - a)) < 0) std::swap(s.tets(t, 2), s.tets(t, 3));
+                    ++t;
+                }
+    s.vertex_object.assign(s.positions.rows(), 0);
+    s.tet_object.assign(s.tets.rows(), 0);
+    return s;
+}
+
+/// Appends `o` as a new object.
+inline void append_object(Scene& s, const Scene& o)
+{
+    const Index base = static_cast<Index>(s.positions.rows());
+    const Index obj = s.vertex_object.empty() ? 0 : *std::max_element(s.vertex_object.begin(), s.vertex_object.end()) + 1;
+    Positions p(s.positions.rows() + o.positions.rows(), 3);
+    p << s.positions, o.positions;
+    Tets t(s.tets.rows() + o.tets.rows(), 4);
+    t.topRows(s.tets.rows()) = s.tets;
+    t.bottomRows(o.tets.rows()) = o.tets.array() + base;
+    s.positions = p;
+    s.tets = t;
+    s.vertex_object.insert(s.vertex_object.end(), o.positions.rows(), obj);
+    s.tet_object.insert(s.tet_object.end(), o.tets.rows(), obj);
+}
+
+/// `count` lattice objects with random placement and rotation, overlapping inside a box of size ~2,
+/// vertices jittered by `jitter` × h.
+inline Scene random_scene(std::uint32_t seed, int count, int cubes, double jitter)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Scene s;
+    s.positions.resize(0, 3);
+    s.tets.resize(0, 4);
+    for (int o = 0; o < count; ++o) {
+        const double h = 0.15 + 0.1 * (u(rng) + 1);
+        Scene obj = lattice_object(cubes, cubes, cubes, h, Eigen::Vector3d::Zero());
+        const Eigen::Matrix3d rot =
+            Eigen::AngleAxisd(3 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng) + 2).normalized()).toRotationMatrix();
+        const Eigen::Vector3d shift(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng));
+        for (Eigen::Index v = 0; v < obj.positions.rows(); ++v) {
+            Eigen::Vector3d p = obj.positions.row(v).transpose();
+            p = rot * p + shift + jitter * h * Eigen::Vector3d(u(rng), u(rng), u(rng));
+            obj.positions.row(v) = p.transpose();
+        }
+        append_object(s, obj);
+    }
+    return s;
+}
+
+/// Two copies of a cube lattice with exactly representable coordinates, the second moved by `shift`
+/// (e.g. half a cell or one lattice vector): vertices land exactly on faces, edges and corners.
+inline Scene lattice_pair(int cubes, double h, const Eigen::Vector3d& shift, const Eigen::Vector3d& origin)
+{
+    Scene s = lattice_object(cubes, cubes, cubes, h, origin);
+    append_object(s, lattice_object(cubes, cubes, cubes, h, origin + shift));
+    return s;
+}
+
+} // namespace tethash::test

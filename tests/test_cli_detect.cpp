@@ -1,0 +1,137 @@
+// `tethash detect`: scene from several files, CSV and JSON outputs, agreement with the oracle, bad options.
+#include "core_scenes.hpp"
+#include "support.hpp"
+#include "tethash/oracle.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <sstream>
+
+using namespace tethash;
+using namespace tethash::test;
+
+namespace {
+
+/// Shell-quoted path (own helper: GCC 12 warns falsely on "'" + string inlined from support.hpp's quote()).
+std::string sq(const std::filesystem::path& p)
+{
+    std::string s(1, '\'');
+    s.append(p.string());
+    s.push_back('\'');
+    return s;
+}
+
+/// Writes one object as a Medit .mesh file (1-based indices).
+void write_medit(const std::filesystem::path& p, const Scene& s)
+{
+    std::ostringstream o;
+    o.precision(17);
+    o << "MeshVersionFormatted 1\nDimension 3\nVertices\n" << s.positions.rows() << "\n";
+    for (Eigen::Index v = 0; v < s.positions.rows(); ++v)
+        o << s.positions(v, 0) << " " << s.positions(v, 1) << " " << s.positions(v, 2) << " 0\n";
+    o << "Tetrahedra\n" << s.tets.rows() << "\n";
+    for (Eigen::Index t = 0; t < s.tets.rows(); ++t)
+        o << s.tets(t, 0) + 1 << " " << s.tets(t, 1) + 1 << " " << s.tets(t, 2) + 1 << " " << s.tets(t, 3) + 1 << " 0\n";
+    o << "End\n";
+    write_text(p, o.str());
+}
+
+struct Files {
+    std::filesystem::path a, b;
+    Scene scene;   ///< a then b, as one scene
+};
+
+Files two_objects(const std::filesystem::path& dir)
+{
+    Files f;
+    const Scene a = lattice_object(3, 3, 3, 0.25, Eigen::Vector3d(0, 0, 0));
+    const Scene b = lattice_object(3, 3, 3, 0.25, Eigen::Vector3d(0.125, 0.125, 0.3));
+    f.a = dir / "a.mesh";
+    f.b = dir / "b.mesh";
+    write_medit(f.a, a);
+    write_medit(f.b, b);
+    f.scene = a;
+    append_object(f.scene, b);
+    return f;
+}
+
+} // namespace
+
+TEST(CliDetect, ContactsCsvMatchesOracleSortedWithHeader)
+{
+    const auto dir = temp_dir();
+    const Files f = two_objects(dir);
+    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --contacts " + sq(dir / "c.csv") +
+                               " --stats " + sq(dir / "s.json") + " --threads 2 --repeat 3 --cell-size x1.5");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("contacts:"), std::string::npos);
+    const std::vector<Contact> want = brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object,
+                                                           f.scene.tet_object);
+    ASSERT_FALSE(want.empty());
+    std::istringstream csv(read_text(dir / "c.csv"));
+    std::string line;
+    ASSERT_TRUE(std::getline(csv, line));
+    EXPECT_EQ(line, "vertex,tet,b0,b1,b2,b3");
+    std::size_t i = 0;
+    long prev_v = -1, prev_t = -1;
+    while (std::getline(csv, line)) {
+        long v = -1, t = -1;
+        double b[4];
+        ASSERT_EQ(std::sscanf(line.c_str(), "%ld,%ld,%lf,%lf,%lf,%lf", &v, &t, &b[0], &b[1], &b[2], &b[3]), 6) << line;
+        EXPECT_TRUE(v > prev_v || (v == prev_v && t > prev_t)) << "not sorted at row " << i;
+        prev_v = v;
+        prev_t = t;
+        ASSERT_LT(i, want.size());
+        EXPECT_EQ(v, want[i].vertex);
+        EXPECT_EQ(t, want[i].tet);
+        for (int k = 0; k < 4; ++k) EXPECT_NEAR(b[k], want[i].bary[k], 1e-9);
+        ++i;
+    }
+    EXPECT_EQ(i, want.size());
+    const std::string js = read_text(dir / "s.json");
+    for (const char* key : {"\"vertices\": 128", "\"tets\": 324", "\"threads\": 2", "\"cell_size\"", "\"table_size\"",
+                            "\"median_ms\"", "\"repeat\": 3"})
+        EXPECT_NE(js.find(key), std::string::npos) << key << " in\n" << js;
+    EXPECT_NE(js.find("\"contacts\": " + std::to_string(want.size())), std::string::npos) << js;
+}
+
+TEST(CliDetect, NoSelfAndStaticObjects)
+{
+    const auto dir = temp_dir();
+    const Files f = two_objects(dir);
+    std::vector<ObjectOptions> objs(2);
+    objs[0].self_collision = objs[1].self_collision = false;
+    const auto want = brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object, objs);
+    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --no-self --static 0 --hash teschner "
+                               "--table-size 17 --stats " + sq(dir / "s.json"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(read_text(dir / "s.json").find("\"contacts\": " + std::to_string(want.size())), std::string::npos);
+    EXPECT_NE(read_text(dir / "s.json").find("\"table_size\": 17"), std::string::npos);
+    const auto bad = run_tethash("detect " + sq(f.a) + " --static 3");
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_NE(bad.err.find("--static"), std::string::npos) << bad.err;
+}
+
+TEST(CliDetect, BadOptionsExitTwoNamingTheOption)
+{
+    const auto dir = temp_dir();
+    const Files f = two_objects(dir);
+    struct Case {
+        std::string args, fragment;
+    };
+    const Case cases[] = {{"--cell-size 0", "--cell-size"},     {"--cell-size -1", "--cell-size"},
+                          {"--cell-size x0", "--cell-size"},    {"--cell-size abc", "--cell-size"},
+                          {"--cell-size 1e999", "--cell-size"}, {"--table-size 0", "--table-size"},
+                          {"--table-size -4", "--table-size"},  {"--table-size 3.5", "--table-size"},
+                          {"--hash sha1", "sha1"},              {"--threads -1", "--threads"},
+                          {"--repeat 0", "--repeat"}};
+    for (const Case& c : cases) {
+        const auto r = run_tethash("detect " + sq(f.a) + " " + c.args);
+        EXPECT_EQ(r.status, 2) << c.args;
+        EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.args << ": " << r.err;
+    }
+    const auto missing = run_tethash("detect " + sq(dir / "nope.mesh"));
+    EXPECT_EQ(missing.status, 2);
+    EXPECT_NE(missing.err.find("nope.mesh"), std::string::npos) << missing.err;
+}

@@ -1,0 +1,219 @@
+// tethash study: the command end to end (CSV columns and rows, shards and merge, figures, bad input, Ctrl-C).
+#include "support.hpp"
+
+#include "tethash/io/generate.hpp"
+#include "tethash/io/mesh_io.hpp"
+#include "tethash/study/table.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+namespace tethash {
+namespace {
+
+using study::Table;
+using test::quote;
+using test::run_tethash;
+
+std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
+{
+    io::GenerateParams p;
+    p.shape = "box";
+    p.resolution = resolution;
+    TetMesh a = io::generate(p);
+    TetMesh b = a;
+    for (Eigen::Index v = 0; v < b.positions.rows(); ++v) b.positions.row(v) += Eigen::RowVector3d(0.31, 0.17, 0.23);
+    io::write_mesh((dir / "a.vtu").string(), a);
+    io::write_mesh((dir / "b.vtu").string(), b);
+    return quote((dir / "a.vtu").string() + "+" + (dir / "b.vtu").string());
+}
+
+/// The table without its timing columns.
+Table deterministic(const Table& t)
+{
+    Table d;
+    std::vector<std::size_t> keep;
+    for (std::size_t c = 0; c < t.columns.size(); ++c)
+        if (!study::is_timing_column(t.columns[c])) {
+            keep.push_back(c);
+            d.columns.push_back(t.columns[c]);
+        }
+    for (const auto& r : t.rows) {
+        study::Row x;
+        for (auto c : keep) x.push_back(r[c]);
+        d.rows.push_back(std::move(x));
+    }
+    return d;
+}
+
+TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
+{
+    const auto dir = test::temp_dir();
+    const auto mesh = two_boxes(dir);
+    const auto r = run_tethash("study cell-size --mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 "
+                               "--repeat 2 --no-plot --out " + quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : {"point", "repeat", "scene", "cell_factor", "cell_size", "table_size", "hash", "threads",
+                            "vertices", "tets", "cells_visited", "entries_scanned", "hash_collisions", "box_rejections",
+                            "own_vertex_skips", "inside_tests", "exact_fallbacks", "degenerate_tets", "contacts",
+                            "table_load", "memory_bytes", "oracle_contacts", "missed", "extra", "ms_total", "ms_vertices",
+                            "ms_tets", "ms_inside", "ms_sort"})
+        EXPECT_GE(t.index_of(col), 0) << col;
+    ASSERT_EQ(t.rows.size(), 5u * 2 * 2);   // 5 cell sizes × 2 table sizes × 2 repeats
+    for (const auto& row : t.rows) {
+        EXPECT_EQ(row[t.index_of("missed")], "0");
+        EXPECT_EQ(row[t.index_of("extra")], "0");
+        EXPECT_EQ(row[t.index_of("contacts")], row[t.index_of("oracle_contacts")]);
+    }
+    const std::string json = test::read_text(dir / "s" / "study.json");
+    EXPECT_NE(json.find("study cell-size"), std::string::npos);   // the command line is recorded
+    EXPECT_NE(r.err.find("study: point 1/10"), std::string::npos) << r.err;   // plain progress lines off a terminal
+}
+
+TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
+{
+    const auto dir = test::temp_dir();
+    const auto mesh = two_boxes(dir, 2);
+    const std::string common = "study table-size --mesh " + mesh + " --table-size x0.1:x10:3 --cell-size 0.7,1.4 "
+                               "--repeat 2 --no-plot --quiet";
+    ASSERT_EQ(run_tethash(common + " --out " + quote(dir / "all")).status, 0);
+    for (int i = 0; i < 3; ++i) {
+        const auto r = run_tethash(common + " --shard " + std::to_string(i) + "/3 --out " + quote(dir / ("s" + std::to_string(i))));
+        ASSERT_EQ(r.status, 0) << r.err;
+    }
+    const auto m = run_tethash("study merge " + quote(dir / "s2") + " " + quote(dir / "s0") + " " + quote(dir / "s1") +
+                               " --no-plot --out " + quote(dir / "merged"));
+    ASSERT_EQ(m.status, 0) << m.err;
+    EXPECT_EQ(m.out.find("missing"), std::string::npos) << m.out;
+    const Table all = Table::read_csv((dir / "all" / "study.csv").string());
+    const Table merged = Table::read_csv((dir / "merged" / "study.csv").string());
+    EXPECT_EQ(all.rows.size(), 3u * 2 * 2 * 2);
+    EXPECT_EQ(deterministic(all).columns, deterministic(merged).columns);
+    EXPECT_EQ(deterministic(all).rows, deterministic(merged).rows);
+
+    // Two shards only: the merge says which points are missing.
+    const auto part = run_tethash("study merge " + quote(dir / "s0") + " --no-plot --out " + quote(dir / "part"));
+    EXPECT_EQ(part.status, 0);
+    EXPECT_NE(part.out.find("missing"), std::string::npos) << part.out;
+    // The same shard twice is an error.
+    const auto twice = run_tethash("study merge " + quote(dir / "s0") + " " + quote(dir / "s0") + " --no-plot --out " +
+                                   quote(dir / "twice"));
+    EXPECT_EQ(twice.status, 2);
+    EXPECT_NE(twice.err.find("appears twice"), std::string::npos) << twice.err;
+}
+
+TEST(CliStudy, PlotScriptWritesFiguresWhenMatplotlibIsPresent)
+{
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "matplotlib");
+    const auto dir = test::temp_dir();
+    const auto mesh = two_boxes(dir, 2);
+    const auto r = run_tethash("study cell-size --mesh " + mesh + " --cell-size 0.5:2:3 --table-size 31,x1 --repeat 1 --out " +
+                               quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* f : {"stages_vs_cell.png", "stages_vs_cell.svg", "candidates_vs_cell.svg", "exactness.svg"})
+        EXPECT_TRUE(std::filesystem::exists(dir / "s" / f)) << f << "\n" << r.out << r.err;
+    const std::string svg = test::read_text(dir / "s" / "stages_vs_cell.svg");
+    EXPECT_NE(svg.find("cell size / mean edge length"), std::string::npos);   // labelled axes
+    EXPECT_NE(svg.find("command:"), std::string::npos);                       // the footer names the command
+
+    const auto t = run_tethash("study table-size --mesh " + mesh + " --table-size x0.1:x10:3 --repeat 1 --out " +
+                               quote(dir / "t"));
+    ASSERT_EQ(t.status, 0) << t.err;
+    EXPECT_TRUE(std::filesystem::exists(dir / "t" / "table_size.svg")) << t.out << t.err;
+}
+
+TEST(CliStudy, IntegratorSweepConvergesToTheReference)
+{
+    const auto dir = test::temp_dir();
+    test::write_text(dir / "tiny.toml", R"(dt = 0.01
+steps = 10
+gravity = [0, 0, -9.81]
+[[object]]
+name = "cube"
+generate = { shape = "box", resolution = 2, size = [0.2, 0.2, 0.2] }
+translate = [0, 0, 0.5]
+material = { density = 500, young = 1e4 }
+)");
+    const auto r = run_tethash("study integrator --scene " + quote(dir / "tiny.toml") +
+                               " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator implicit_euler,symplectic_euler "
+                               "--reference-factor 4 --no-plot --out " + quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration",
+                            "energy_drift", "wall_s_per_sim_s", "ref_dt"})
+        EXPECT_GE(t.index_of(col), 0) << col;
+    ASSERT_EQ(t.rows.size(), 6u);
+    for (std::size_t i = 0; i < t.rows.size(); ++i) {
+        const auto& row = t.rows[i];
+        EXPECT_EQ(row[t.index_of("status")], "ok");
+        EXPECT_DOUBLE_EQ(std::stod(row[t.index_of("ref_dt")]), 0.0025 / 4);
+        if (i % 3 != 0) {   // within one integrator: a larger dt gives a larger error (first-order methods)
+            EXPECT_GT(std::stod(row[t.index_of("err_rms")]), std::stod(t.rows[i - 1][t.index_of("err_rms")])) << i;
+        }
+    }
+}
+
+TEST(CliStudy, BadInputExitsTwoBeforeAnyWork)
+{
+    const auto dir = test::temp_dir();
+    const auto mesh = two_boxes(dir, 2);
+    const auto out = quote(dir / "out");
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"study cell-size --mesh " + quote(dir / "missing.vtu"), "file not found"},
+        {"study cell-size --mesh " + mesh + " --cell-size 0", "--cell-size"},
+        {"study cell-size --mesh " + mesh + " --cell-size=-2", "must be > 0"},
+        {"study cell-size --mesh " + mesh + " --from 4 --to 1 --points 3", "empty range"},
+        {"study cell-size --mesh " + mesh + " --cell-size 1:2:0", "empty range"},
+        {"study table-size --mesh " + mesh + " --table-size 0", "table size must be >= 1"},
+        {"study cell-size --mesh " + mesh + " --shard 3/3", "--shard"},
+        {"study cell-size --mesh " + mesh + " --shard x", "--shard"},
+        {"study cell-size --mesh " + mesh + " --repeat 0", "--repeat"},
+        {"study cell-size", "no scene"},
+        {"study size --mesh " + mesh, "unknown sweep 'size'"},
+        {"study merge " + quote(dir / "nothing"), "file not found"},
+        {"study integrator --mesh " + mesh, "integrator sweep"},
+        {"study integrator --dt 0", "--dt"},
+        {"study integrator --scene " + quote(dir / "none.toml"), "file not found"},
+    };
+    for (const auto& [args, message] : cases) {
+        const auto r = run_tethash(args + " --out " + out + " --no-plot");
+        EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+        EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+        EXPECT_FALSE(std::filesystem::exists(dir / "out" / "study.csv")) << args;
+    }
+}
+
+TEST(CliStudy, InterruptKeepsTheRowsMeasuredInAValidCsv)
+{
+    const auto dir = test::temp_dir();
+    const auto mesh = two_boxes(dir, 3);
+    const auto csv = dir / "s" / "study.csv";
+    // A long sweep in the background; SIGINT once a few rows are there.
+    const std::string cmd = std::string("'") + TETHASH_EXE + "' study cell-size --mesh " + mesh +
+                            " --cell-size 0.5:2:400 --repeat 20 --no-oracle --no-penetration --no-plot --out " +
+                            quote(dir / "s") + " >/dev/null 2>&1 & echo $! > " + quote(dir / "pid");
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    bool rows = false;
+    for (int i = 0; i < 600 && !rows; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        const std::string text = std::filesystem::exists(csv) ? test::read_text(csv) : std::string();
+        rows = std::count(text.begin(), text.end(), '\n') > 3;
+    }
+    ASSERT_TRUE(rows);
+    const std::string pid = test::read_text(dir / "pid");
+    ASSERT_EQ(std::system(("kill -INT " + pid).c_str()), 0);
+    bool finished = false;
+    for (int i = 0; i < 600 && !finished; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        finished = test::read_text(dir / "s" / "study.json").find("\"interrupted\": true") != std::string::npos;
+    }
+    ASSERT_TRUE(finished);
+    const Table t = Table::read_csv(csv.string());   // throws on a torn row
+    EXPECT_GT(t.rows.size(), 2u);
+    EXPECT_LT(t.rows.size(), 400u * 20);
+}
+
+} // namespace
+} // namespace tethash

@@ -1,0 +1,375 @@
+// Detector vs the brute-force oracle over many seeded scenes and every parameter kind; determinism;
+// object rules; API errors.
+#include "core_scenes.hpp"
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/hash_grid.hpp"
+#include "tethash/oracle.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+
+using namespace tethash;
+using tethash::test::Scene;
+
+namespace {
+
+std::vector<Contact> run_detector(const Scene& s, const DetectParams& p, DetectStats* stats = nullptr)
+{
+    Detector det(p);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    return det.detect(s.positions, stats);
+}
+
+std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
+{
+    return brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects, stats);
+}
+
+/// Identical (vertex, tet, objects) sequence, barycentric coordinates equal up to rounding.
+::testing::AssertionResult same_contacts(const std::vector<Contact>& got, const std::vector<Contact>& want)
+{
+    const std::size_t n = std::min(got.size(), want.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        const Contact &a = got[i], &b = want[i];
+        if (a.vertex != b.vertex || a.tet != b.tet)
+            return ::testing::AssertionFailure() << "contact " << i << ": got (" << a.vertex << ", " << a.tet
+                                                 << "), oracle (" << b.vertex << ", " << b.tet << ")";
+        if (a.vertex_object != b.vertex_object || a.tet_object != b.tet_object)
+            return ::testing::AssertionFailure() << "contact " << i << ": objects differ";
+        double sum = 0;
+        for (int k = 0; k < 4; ++k) {
+            sum += a.bary[k];
+            if (std::fabs(a.bary[k] - b.bary[k]) > 1e-6 || a.bary[k] < -1e-9)
+                return ::testing::AssertionFailure() << "contact " << i << ": bary[" << k << "] " << a.bary[k]
+                                                     << " vs oracle " << b.bary[k];
+            if ((a.bary[k] == 0.0) != (b.bary[k] == 0.0))
+                return ::testing::AssertionFailure() << "contact " << i << ": exact zero of bary[" << k << "] differs";
+        }
+        if (std::fabs(sum - 1.0) > 1e-9) return ::testing::AssertionFailure() << "contact " << i << ": bary sum " << sum;
+    }
+    if (got.size() != want.size())
+        return ::testing::AssertionFailure() << got.size() << " contacts, oracle " << want.size();
+    return ::testing::AssertionSuccess();
+}
+
+struct Variant {
+    double cell_factor;
+    std::int64_t table;
+    HashFunction hash;
+    int threads;
+};
+
+std::vector<Variant> variants(std::uint32_t seed)
+{
+    // Every kind appears for every scene: 5 cell sizes, 6 table sizes, both hashes, 1 and 2 threads,
+    // combined differently per seed (the full product would be slow at 1/20 cells).
+    const double cells[] = {1.0 / 20, 0.3, 1.0, 2.5, 20.0};
+    const std::int64_t tables[] = {0, 1, 2, 97, 1024, 1 << 20};
+    std::vector<Variant> out;
+    for (unsigned k = 0; k < 12; ++k)
+        out.push_back({cells[(k + seed) % 5], tables[(k + 3 * seed) % 6],
+                       (k + seed) % 2 ? HashFunction::teschner : HashFunction::column, 1 + static_cast<int>((k / 2) % 2)});
+    return out;
+}
+
+void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
+{
+    OracleStats os;
+    const std::vector<Contact> want = run_oracle(s, &os);
+    for (const Variant& v : variants(seed)) {
+        DetectParams p;
+        p.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
+        p.cell_size = v.cell_factor;
+        p.table_size = v.table;
+        p.hash = v.hash;
+        p.threads = v.threads;
+        DetectStats st;
+        const std::vector<Contact> got = run_detector(s, p, &st);
+        EXPECT_TRUE(same_contacts(got, want))
+            << what << " seed " << seed << " cell ×" << v.cell_factor << " table " << v.table << " hash "
+            << to_string(v.hash) << " threads " << v.threads;
+        EXPECT_EQ(st.degenerate_tets, os.degenerate_tets) << what;
+        EXPECT_EQ(st.contacts, static_cast<std::int64_t>(want.size()));
+    }
+}
+
+} // namespace
+
+TEST(CoreDetect, RandomDeformedOverlappingObjects)
+{
+    for (std::uint32_t seed = 1; seed <= 8; ++seed) {
+        const Scene s = test::random_scene(seed, 3 + seed % 3, 3, 0.3);
+        check_scene(s, seed, "random");
+    }
+}
+
+TEST(CoreDetect, StronglyDeformedWithInvertedTets)
+{
+    for (std::uint32_t seed = 20; seed < 26; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 1.2);   // jitter beyond half a cell: many inverted tets
+        // Explicitly inverted tets: swap two indices of every 7th tet.
+        for (Eigen::Index t = 0; t < s.tets.rows(); t += 7) std::swap(s.tets(t, 0), s.tets(t, 1));
+        check_scene(s, seed, "inverted");
+    }
+}
+
+TEST(CoreDetect, LatticeAlignedContactsOnFacesEdgesCorners)
+{
+    const double h = 0.25;   // exactly representable lattice
+    const Eigen::Vector3d shifts[] = {{h / 2, 0, 0}, {h / 2, h / 2, 0}, {h / 2, h / 2, h / 2}, {h, 0, 0},
+                                      {h, h, 0},     {0, 0, 0},         {h / 4, h / 2, 3 * h / 4}};
+    const Eigen::Vector3d origins[] = {{0, 0, 0}, {-37.0, -2.5, -0.75}, {1e6, 1e6, -1e6}};
+    std::uint32_t seed = 0;
+    for (const auto& o : origins)
+        for (const auto& sh : shifts) {
+            const Scene s = test::lattice_pair(3, h, sh, o);
+            const std::vector<Contact> want = run_oracle(s);
+            EXPECT_FALSE(want.empty());
+            check_scene(s, seed++, "lattice");
+        }
+}
+
+TEST(CoreDetect, OffsetAndNegativeCoordinates)
+{
+    for (std::uint32_t seed = 30; seed < 34; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 0.3);
+        s.positions.col(0).array() += (seed % 2 ? 1e6 : -1e6);
+        s.positions.col(1).array() -= 12345.5;
+        check_scene(s, seed, "offset");
+    }
+}
+
+TEST(CoreDetect, CoincidentVerticesAndFlatTets)
+{
+    for (std::uint32_t seed = 40; seed < 46; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 0.3);
+        std::mt19937 rng(seed);
+        std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
+        // Coincident vertices (distinct ids, across and within objects): tets holding both become flat.
+        for (int k = 0; k < 25; ++k) s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
+        // Flat tets: one vertex moved exactly onto another vertex of the same tet.
+        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41) s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+        // A vertex exactly at a corner of a tet of another object.
+        s.positions.row(0) = s.positions.row(s.tets(s.tets.rows() - 1, 2)).eval();
+        OracleStats os;
+        run_oracle(s, &os);
+        EXPECT_GT(os.degenerate_tets, 0);
+        check_scene(s, seed, "coincident");
+    }
+}
+
+TEST(CoreDetect, SelfCollisionOffAndStaticObjects)
+{
+    for (std::uint32_t seed = 50; seed < 56; ++seed) {
+        Scene s = test::random_scene(seed, 4, 3, 0.9);
+        s.objects.resize(4);
+        s.objects[seed % 4].self_collision = false;
+        s.objects[(seed + 1) % 4].is_static = true;
+        s.objects[(seed + 2) % 4].is_static = (seed % 2) != 0;
+        const std::vector<Contact> want = run_oracle(s);
+        for (const Contact& c : want) {
+            EXPECT_FALSE(s.objects[c.vertex_object].is_static && s.objects[c.tet_object].is_static);
+            if (c.vertex_object == c.tet_object) {
+                EXPECT_TRUE(s.objects[c.vertex_object].self_collision);
+            }
+        }
+        check_scene(s, seed, "objects");
+        // The same scene with all options on has more contacts.
+        Scene plain = s;
+        plain.objects.clear();
+        EXPECT_GT(run_oracle(plain).size(), want.size());
+    }
+}
+
+TEST(CoreDetect, StaticObjectsHashedOnceStillExactWhenOthersMove)
+{
+    Scene s = test::random_scene(61, 3, 3, 0.3);
+    s.objects.resize(3);
+    s.objects[0].is_static = true;
+    Detector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    for (int step = 0; step < 4; ++step) {
+        for (Eigen::Index v = 0; v < s.positions.rows(); ++v)
+            if (s.vertex_object[v] != 0) s.positions(v, 0) += 0.05 * step;
+        EXPECT_TRUE(same_contacts(det.detect(s.positions), run_oracle(s))) << "step " << step;
+    }
+}
+
+TEST(CoreDetect, DeterministicAcrossThreadsAndRepeats)
+{
+    const Scene s = test::random_scene(77, 8, 4, 0.4);
+    DetectParams p;
+    p.threads = 1;
+    Detector one(p);
+    one.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    const std::vector<Contact> a = one.detect(s.positions);
+    ASSERT_FALSE(a.empty());
+    for (int threads : {2, 3, 1}) {
+        p.threads = threads;
+        Detector det(p);
+        det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+        for (int rep = 0; rep < 3; ++rep) {
+            const std::vector<Contact>& b = det.detect(s.positions);
+            ASSERT_EQ(a.size(), b.size());
+            for (std::size_t i = 0; i < a.size(); ++i) {
+                ASSERT_EQ(a[i].vertex, b[i].vertex);
+                ASSERT_EQ(a[i].tet, b[i].tet);
+                for (int k = 0; k < 4; ++k) ASSERT_EQ(a[i].bary[k], b[i].bary[k]);   // bitwise
+            }
+        }
+    }
+    for (std::size_t i = 1; i < a.size(); ++i)
+        EXPECT_TRUE(a[i - 1].vertex < a[i].vertex || (a[i - 1].vertex == a[i].vertex && a[i - 1].tet < a[i].tet));
+}
+
+TEST(CoreDetect, SteadyStateKeepsBuffers)
+{
+    const Scene s = test::random_scene(5, 4, 3, 0.3);
+    Detector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    det.detect(s.positions);
+    const Contact* data = det.contacts().data();
+    DetectStats st1, st2;
+    det.detect(s.positions, &st1);
+    det.detect(s.positions, &st2);
+    EXPECT_EQ(det.contacts().data(), data);   // the output array was not reallocated
+    EXPECT_EQ(st1.memory_bytes, st2.memory_bytes);
+    EXPECT_GT(st2.memory_bytes, 0);
+    EXPECT_EQ(st2.entries_scanned, st2.hash_collisions + st2.box_rejections + st2.own_vertex_skips +
+                                       (st2.inside_tests));   // no object rules here: every survivor is tested
+    EXPECT_GE(st2.inside_tests, st2.contacts);
+}
+
+TEST(CoreDetect, AutoCellSizeIsMeanEdgeAndTableSizeDefaults)
+{
+    const Scene s = test::lattice_object(3, 3, 3, 0.5, Eigen::Vector3d::Zero());
+    const double mean = mean_edge_length(s.positions, s.tets);
+    // Kuhn cubes: axis edges 0.5, face diagonals 0.5√2, one body diagonal 0.5√3 per cube.
+    EXPECT_GT(mean, 0.5);
+    EXPECT_LT(mean, 0.5 * std::sqrt(3.0));
+    DetectStats st;
+    run_detector(s, DetectParams{}, &st);
+    EXPECT_DOUBLE_EQ(st.cell_size, mean);
+    EXPECT_EQ(st.table_size, auto_table_size(HashFunction::column, s.positions.rows()));
+    EXPECT_EQ(auto_table_size(HashFunction::column, 1000), 2048);
+    EXPECT_EQ(auto_table_size(HashFunction::teschner, 1000), 2003);
+    DetectParams p;
+    p.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
+    p.cell_size = 2.0;
+    run_detector(s, p, &st);
+    EXPECT_DOUBLE_EQ(st.cell_size, 2 * mean);
+    p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+    p.cell_size = 0.125;
+    p.table_size = 13;
+    run_detector(s, p, &st);
+    EXPECT_EQ(st.cell_size, 0.125);
+    EXPECT_EQ(st.table_size, 13);
+}
+
+TEST(CoreDetect, HashNames)
+{
+    EXPECT_EQ(parse_hash_function("teschner"), HashFunction::teschner);
+    EXPECT_EQ(parse_hash_function("column"), HashFunction::column);
+    EXPECT_STREQ(to_string(HashFunction::column), "column");
+    try {
+        parse_hash_function("md5");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("md5"), std::string::npos);
+    }
+}
+
+namespace {
+template <class F>
+void expect_error(F&& f, const std::string& fragment)
+{
+    try {
+        f();
+        ADD_FAILURE() << "no Error thrown; expected one mentioning '" << fragment << "'";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+}
+} // namespace
+
+TEST(CoreDetect, ApiErrorsNameTheProblem)
+{
+    Scene s = test::lattice_object(1, 1, 1, 1.0, Eigen::Vector3d::Zero());
+    const Index n = static_cast<Index>(s.positions.rows());
+    DetectParams p;
+    p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+    p.cell_size = 0;
+    expect_error([&] { Detector d(p); }, "cell_size");
+    p.cell_size = -1;
+    expect_error([&] { Detector d(p); }, "-1");
+    p.cell_size = std::nan("");
+    expect_error([&] { Detector d(p); }, "cell_size");
+    p = DetectParams{};
+    p.table_size = -5;
+    expect_error([&] { Detector d(p); }, "table_size");
+    p.table_size = std::int64_t{1} << 40;
+    expect_error([&] { Detector d(p); }, "table_size");
+    p = DetectParams{};
+    p.threads = -2;
+    expect_error([&] { Detector d(p); }, "threads");
+
+    Detector det;
+    Tets bad = s.tets;
+    bad(3, 2) = n;
+    expect_error([&] { det.set_topology(bad, n); }, "tet 3");
+    bad = s.tets;
+    bad(2, 1) = -1;
+    expect_error([&] { det.set_topology(bad, n); }, "out of range");
+    bad = s.tets;
+    bad(4, 3) = bad(4, 0);
+    expect_error([&] { det.set_topology(bad, n); }, "repeated");
+    std::vector<Index> short_obj(3, 0);
+    expect_error([&] { det.set_topology(s.tets, n, short_obj); }, "vertex_object");
+    std::vector<Index> neg(n, 0);
+    neg[5] = -1;
+    expect_error([&] { det.set_topology(s.tets, n, neg); }, "vertex 5");
+
+    det.set_topology(s.tets, n);
+    Positions wrong(n - 1, 3);
+    wrong.setZero();
+    expect_error([&] { det.detect(wrong); }, "rows");
+    Positions nan = s.positions;
+    nan(6, 1) = std::nan("");
+    expect_error([&] { det.detect(nan); }, "vertex 6");
+    det.detect(s.positions);
+    expect_error([&] { det.detect(nan); }, "vertex 6");   // also after the first call
+    Positions inf = s.positions;
+    inf(2, 2) = INFINITY;
+    expect_error([&] { det.detect(inf); }, "vertex 2");
+    expect_error([&] { brute_force_contacts(nan, s.tets); }, "vertex 6");
+
+    // Huge coordinates or tiny cells: a clear error, no wrap-around.
+    p = DetectParams{};
+    p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+    p.cell_size = 1e-12;
+    Detector tiny(p);
+    tiny.set_topology(s.tets, n);
+    Positions far = s.positions;
+    far.array() += 1e6;
+    expect_error([&] { tiny.detect(far); }, "cell size");
+    Detector d2;
+    d2.set_topology(s.tets, n);
+    Positions huge = s.positions * 1e300;
+    expect_error([&] { d2.detect(huge); }, "cell");
+}
+
+TEST(CoreDetect, EmptyInputs)
+{
+    Detector det;
+    Tets none(0, 4);
+    det.set_topology(none, 0);
+    Positions p(0, 3);
+    EXPECT_TRUE(det.detect(p).empty());
+    det.set_topology(none, 5);
+    Positions five = Positions::Random(5, 3);
+    EXPECT_TRUE(det.detect(five).empty());
+}

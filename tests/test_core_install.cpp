@@ -1,0 +1,40 @@
+// `cmake --install` of this build into a temporary prefix, then a separate consumer project configured with
+// find_package(tethash) and linked to tethash::core is built and run.
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace tethash::test;
+
+namespace {
+std::string sq(const std::filesystem::path& p)
+{
+    std::string s(1, '\'');
+    s.append(p.string());
+    s.push_back('\'');
+    return s;
+}
+} // namespace
+
+TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
+{
+    const auto dir = temp_dir();
+    const std::filesystem::path build = std::filesystem::path(TETHASH_TEST_TMP).parent_path().parent_path();
+    ASSERT_TRUE(std::filesystem::exists(build / "CMakeCache.txt")) << build;
+    const auto prefix = dir / "prefix";
+    const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
+    ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io"));   // core only
+
+    const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer";
+    const auto cbuild = dir / "consumer";
+    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) + " -DCMAKE_BUILD_TYPE=Release"
+                                " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+    ASSERT_EQ(conf.status, 0) << conf.out << conf.err;
+    const auto bld = run_shell("cmake --build " + sq(cbuild) + " -j2");
+    ASSERT_EQ(bld.status, 0) << bld.out << bld.err;
+    const auto run = run_shell(sq(cbuild / "consumer"));
+    EXPECT_EQ(run.status, 0) << run.out << run.err;
+    EXPECT_NE(run.out.find("contact vertex 7 tet 0"), std::string::npos) << run.out;
+}

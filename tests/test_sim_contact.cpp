@@ -1,0 +1,246 @@
+// Contacts in the simulator: resting on the ground, separation of overlapping bodies with momentum
+// conserved, and the stiff / extreme cases (stiffness 1e1..1e9, mass ratio 1e6, dt 1e-5..1e-1, a body
+// crossing another in one step, inverted and nearly flat tets at start).
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/io/generate.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <cmath>
+
+using namespace tethash;
+using namespace tethash::sim;
+
+namespace {
+
+ObjectSpec box_object(double size, const Eigen::Vector3d& at, int res = 2)
+{
+    ObjectSpec o;
+    io::GenerateParams g;
+    g.shape = "box";
+    g.resolution = res;
+    g.size = Eigen::Vector3d::Constant(size);
+    o.generate = g;
+    o.translate = at;
+    o.material.density = 100;
+    o.material.young = 1e4;
+    o.material.damping = 0.01;
+    o.self_collision = false;
+    return o;
+}
+
+Scene two_overlapping(Integrator integ)
+{
+    Scene s;
+    s.objects.push_back(box_object(1.0, {0, 0, 0}));
+    s.objects.push_back(box_object(1.0, {0.8, 0.1, 0.05}));
+    s.gravity.setZero();
+    s.dt = 2e-3;
+    s.integrator = integ;
+    s.solver = LinearSolver::ldlt;
+    s.output.every = 0;
+    return s;
+}
+
+double total_mass(const Simulation& sim)
+{
+    double m = 0;
+    for (size_t i = 0; i < sim.model().mass.size(); ++i)
+        if (!sim.model().fixed[i]) m += sim.model().mass[i];
+    return m;
+}
+
+/// Runs `steps` steps; returns the largest total energy seen.
+double run(Simulation& sim, int steps)
+{
+    double emax = sim.energy().total();
+    for (int i = 0; i < steps; ++i) {
+        sim.step();
+        emax = std::max(emax, sim.energy().total());
+    }
+    return emax;
+}
+
+} // namespace
+
+TEST(SimContact, BodyDroppedOnGroundComesToRestAtTheRightHeight)
+{
+    for (Integrator integ : {Integrator::implicit_euler, Integrator::local_global}) {
+        Scene s;
+        s.objects.push_back(box_object(0.5, {0, 0, 0.5}));
+        s.ground.enabled = true;
+        s.ground.height = 0;
+        s.dt = 2e-3;
+        s.integrator = integ;
+        s.output.every = 0;
+        Simulation sim(s);
+        for (int i = 0; i < 750; ++i) sim.step();
+        const Positions& x = sim.positions();
+        // Resting: bottom on the ground (penalty sinks it by m g / k per vertex at most), centre at half the size.
+        EXPECT_NEAR(x.col(2).minCoeff(), 0.0, 0.01) << to_string(integ);
+        EXPECT_NEAR(x.col(2).mean(), 0.25, 0.02) << to_string(integ);
+        EXPECT_LT(sim.energy().kinetic, 1e-3 * total_mass(sim) * 9.81 * 0.25) << to_string(integ);
+    }
+}
+
+TEST(SimContact, OverlappingBodiesSeparateAndConserveMomentum)
+{
+    for (Integrator integ : {Integrator::implicit_euler, Integrator::symplectic_euler}) {
+        Scene s = two_overlapping(integ);
+        if (integ == Integrator::symplectic_euler) s.substeps = 20;
+        Simulation sim(s);
+        ASSERT_GT(sim.contacts().size(), 0u);
+        const double scale = total_mass(sim) * 1.0;   // momentum of the whole mass at 1 length/s
+        int separated_at = -1;
+        for (int i = 0; i < 400 && separated_at < 0; ++i) {
+            sim.step();
+            EXPECT_LT(sim.momentum().norm(), 1e-6 * scale) << "step " << i << " " << to_string(integ);
+            if (sim.contacts().empty()) separated_at = i;
+        }
+        EXPECT_GE(separated_at, 0) << to_string(integ) << ": still " << sim.contacts().size() << " contacts, max depth "
+                                   << sim.max_penetration();
+        // Separated along x: A to the left, B to the right.
+        const auto [b0, bn] = sim.object_vertices(1);
+        EXPECT_GT(sim.positions().middleRows(b0, bn).col(0).mean() - sim.positions().topRows(b0).col(0).mean(), 0.85);
+    }
+}
+
+TEST(SimContact, StiffnessFrom1e1To1e9StaysFiniteAndBoundedWithImplicitEuler)
+{
+    for (double young : {1e1, 1e3, 1e5, 1e7, 1e9}) {
+        Scene s = two_overlapping(Integrator::implicit_euler);
+        for (ObjectSpec& o : s.objects) o.material.young = young;
+        s.dt = 1e-2;
+        Simulation sim(s);
+        const double e0 = sim.energy().total();
+        const double emax = run(sim, 25);
+        EXPECT_TRUE(sim.positions().allFinite()) << young;
+        // Penalty contacts found at discrete steps are not exactly conservative, but implicit Euler keeps the
+        // energy bounded by what the overlap stored at start.
+        EXPECT_LE(emax, 1.25 * e0) << "young " << young;
+        EXPECT_LT(sim.max_penetration(), 0.2) << "young " << young;
+    }
+}
+
+TEST(SimContact, MassRatio1e6)
+{
+    Scene s;
+    s.objects.push_back(box_object(0.5, {0, 0, 0.25}));
+    s.objects.push_back(box_object(0.5, {0.05, 0.0, 0.76}));
+    s.objects[1].material.density = 1e8;   // 1e6 × the lower box
+    s.ground.enabled = true;
+    s.dt = 2e-3;
+    s.output.every = 0;
+    Simulation sim(s);
+    const double e0 = sim.energy().total();
+    const double emax = run(sim, 150);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_TRUE(sim.velocities().allFinite());
+    EXPECT_LE(emax, e0 + 1e-6 * std::abs(e0));
+}
+
+TEST(SimContact, TimeStepsFrom1e5To1e1)
+{
+    for (double dt : {1e-5, 1e-3, 1e-1}) {
+        Scene s = two_overlapping(Integrator::implicit_euler);
+        s.ground.enabled = true;
+        s.ground.height = -0.6;
+        s.gravity = Eigen::Vector3d(0, 0, -9.81);
+        s.dt = dt;
+        Simulation sim(s);
+        const double e0 = sim.energy().total();
+        const double emax = run(sim, 30);
+        EXPECT_TRUE(sim.positions().allFinite()) << dt;
+        EXPECT_LE(emax, 1.25 * std::abs(e0)) << "dt " << dt;
+    }
+    // The explicit integrator refuses up front (a warning) and stops cleanly when it diverges.
+    Scene s = two_overlapping(Integrator::symplectic_euler);
+    s.dt = 1e-1;
+    Simulation sim(s);
+    EXPECT_FALSE(sim.warnings().empty());
+    EXPECT_THROW(run(sim, 100), RunFailure);
+    EXPECT_TRUE(sim.positions().allFinite());
+}
+
+TEST(SimContact, VelocityCrossingAnObjectInOneStep)
+{
+    Scene s;
+    s.objects.push_back(box_object(0.5, {0, 0, 0}));
+    s.objects.push_back(box_object(0.5, {-1.0, 0.0, 0.0}));
+    s.objects[1].velocity = Eigen::Vector3d(150, 0, 0);   // 1.5 length units per step: through and past A
+    s.gravity.setZero();
+    s.dt = 1e-2;
+    s.output.every = 0;
+    Simulation sim(s);
+    const double e0 = sim.energy().total();
+    const double emax = run(sim, 5);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_LE(emax, e0 * (1 + 1e-6));
+    EXPECT_LT(sim.momentum().norm(), 1.001 * e0);   // finite, nothing created
+}
+
+TEST(SimContact, InvertedTetsAtStartAreRestored)
+{
+    for (Integrator integ : {Integrator::implicit_euler, Integrator::symplectic_euler}) {
+        Scene s;
+        ObjectSpec o = box_object(1.0, {0, 0, 0}, 3);
+        io::GenerateParams g = *o.generate;
+        o.generate.reset();
+        TetMesh m = io::generate(g);
+        m.rest_positions = m.positions;
+        // Push one interior vertex through the opposite side of its star: its tets invert.
+        Index inner = -1;
+        for (Index i = 0; i < m.num_vertices(); ++i)
+            if (m.positions.row(i).cwiseAbs().maxCoeff() < 0.2) inner = i;
+        ASSERT_GE(inner, 0);
+        m.positions(inner, 0) += 0.4;
+        o.data = m;
+        s.objects.push_back(o);
+        s.gravity.setZero();
+        s.dt = 1e-3;
+        s.integrator = integ;
+        s.substeps = integ == Integrator::symplectic_euler ? 10 : 1;
+        s.output.every = 0;
+        Simulation sim(s);
+        auto inverted = [&] {
+            int count = 0;
+            for (Index t = 0; t < sim.mesh().num_tets(); ++t) {
+                const std::array<Index, 4> tet{sim.mesh().tets(t, 0), sim.mesh().tets(t, 1), sim.mesh().tets(t, 2), sim.mesh().tets(t, 3)};
+                count += signed_volume(sim.positions(), tet) <= 0 ? 1 : 0;
+            }
+            return count;
+        };
+        ASSERT_GT(inverted(), 0);
+        run(sim, 300);
+        EXPECT_TRUE(sim.positions().allFinite());
+        EXPECT_EQ(inverted(), 0) << to_string(integ);
+    }
+}
+
+TEST(SimContact, NearlyFlatTetsAtStartStayFinite)
+{
+    Scene s;
+    ObjectSpec o = box_object(1.0, {0, 0, 0}, 2);
+    TetMesh m = io::generate(*o.generate);
+    o.generate.reset();
+    // Flatten one boundary tet almost completely in the rest state: volume ~1e-6 of a normal one.
+    const Index t = 0;
+    const Eigen::RowVector3d a = m.positions.row(m.tets(t, 0)), b = m.positions.row(m.tets(t, 1)),
+                             c = m.positions.row(m.tets(t, 2));
+    const Eigen::RowVector3d d = m.positions.row(m.tets(t, 3));
+    const Eigen::RowVector3d centroid = (a + b + c) / 3.0;
+    m.positions.row(m.tets(t, 3)) = centroid + 1e-6 * (d - centroid);
+    m.rest_positions.resize(0, 3);
+    o.data = m;
+    s.objects.push_back(o);
+    s.ground.enabled = true;
+    s.ground.height = -0.6;
+    s.dt = 1e-3;
+    s.output.every = 0;
+    Simulation sim(s);
+    const double e0 = sim.energy().total();
+    const double emax = run(sim, 100);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_LE(emax, e0 + 1e-9 * std::abs(e0));
+}

@@ -1,0 +1,289 @@
+// The mass-spring model and the integrators without contacts: forces against energies, masses, the
+// matrix-free operator against the assembled matrix, energy behaviour, stability limit and blow-up.
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/io/generate.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <cmath>
+#include <random>
+
+using namespace tethash;
+using namespace tethash::sim;
+
+namespace {
+
+TetMesh box_mesh(int res = 2, double size = 1.0)
+{
+    io::GenerateParams g;
+    g.shape = "box";
+    g.resolution = res;
+    g.size = Eigen::Vector3d::Constant(size);
+    return io::generate(g);
+}
+
+/// One free box, no gravity, no ground, no collisions: only the elastic model acts.
+Scene free_box(Integrator integ, double dt, double damping = 0.0, double perturb = 0.05)
+{
+    Scene s;
+    ObjectSpec o;
+    TetMesh m = box_mesh(2);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-perturb, perturb);
+    m.rest_positions = m.positions;
+    for (Index i = 0; i < m.num_vertices(); ++i)
+        for (int c = 0; c < 3; ++c) m.positions(i, c) += u(rng);
+    o.data = m;
+    o.self_collision = false;
+    o.material.young = 1e4;
+    o.material.density = 100;
+    o.material.damping = damping;
+    s.objects.push_back(o);
+    s.gravity.setZero();
+    s.dt = dt;
+    s.integrator = integ;
+    s.output.every = 0;
+    return s;
+}
+
+} // namespace
+
+TEST(SimModel, MassesSumToDensityTimesVolume)
+{
+    TetMesh m = box_mesh(3, 2.0);
+    Material mat;
+    mat.density = 250;
+    Model model = Model::build(m, {mat}, {0});
+    double total = 0;
+    for (double v : model.mass) total += v;
+    EXPECT_NEAR(total, 250 * 8.0, 1e-9 * total);
+    EXPECT_EQ(model.springs.edges.rows(), unique_edges(m.tets).rows());
+}
+
+TEST(SimModel, StiffnessDirectOrScaledByEdgeLength)
+{
+    TetMesh m = box_mesh(2);
+    Material a;
+    a.young = 3e5;
+    Model ma = Model::build(m, {a}, {0});
+    for (size_t e = 0; e < ma.springs.k.size(); ++e) EXPECT_NEAR(ma.springs.k[e], 3e5 * ma.springs.rest[e], 1e-6);
+    Material b;
+    b.stiffness = 42;
+    b.damping = 0.5;
+    Model mb = Model::build(m, {b}, {0});
+    for (size_t e = 0; e < mb.springs.k.size(); ++e) {
+        EXPECT_EQ(mb.springs.k[e], 42);
+        EXPECT_EQ(mb.springs.c[e], 21);
+    }
+}
+
+TEST(SimModel, StaticObjectsHaveNoSpringsAndAreFixed)
+{
+    TetMesh a = box_mesh(2), b = box_mesh(2);
+    a.append(b);
+    Model m = Model::build(a, {Material{}, Material{}}, {0, 1});
+    EXPECT_EQ(m.springs.edges.rows(), unique_edges(b.tets).rows());
+    for (Index i = 0; i < a.num_vertices(); ++i) EXPECT_EQ(m.fixed[static_cast<size_t>(i)] != 0, i >= b.num_vertices());
+}
+
+TEST(SimModel, RestStateHasNoForceAndZeroElasticEnergy)
+{
+    TetMesh m = box_mesh(2);
+    Model model = Model::build(m, {Material{}}, {0});
+    Positions f = Positions::Zero(m.num_vertices(), 3), v = Positions::Zero(m.num_vertices(), 3);
+    model.add_forces(m.positions, v, f);
+    EXPECT_LT(f.cwiseAbs().maxCoeff(), 1e-9);
+    const Energy e = model.energy(m.positions, v);
+    EXPECT_NEAR(e.spring + e.volume, 0.0, 1e-12);
+}
+
+TEST(SimModel, ForcesAreMinusEnergyGradient)
+{
+    TetMesh m = box_mesh(2);
+    Material mat;
+    mat.volume_stiffness = 3.0;
+    Model model = Model::build(m, {mat}, {0});
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.1, 0.1);
+    Positions x = m.positions;
+    for (Index i = 0; i < x.rows(); ++i)
+        for (int c = 0; c < 3; ++c) x(i, c) += u(rng);
+    const Positions v = Positions::Zero(x.rows(), 3);
+    Positions f = Positions::Zero(x.rows(), 3);
+    model.add_forces(x, v, f);
+    auto elastic = [&](const Positions& p) {
+        const Energy e = model.energy(p, v);
+        return e.spring + e.volume;
+    };
+    const double h = 1e-6;
+    double worst = 0, scale = f.cwiseAbs().maxCoeff();
+    for (Index i = 0; i < x.rows(); i += 7)
+        for (int c = 0; c < 3; ++c) {
+            Positions xp = x, xm = x;
+            xp(i, c) += h;
+            xm(i, c) -= h;
+            const double grad = (elastic(xp) - elastic(xm)) / (2 * h);
+            worst = std::max(worst, std::abs(-grad - f(i, c)));
+        }
+    EXPECT_LT(worst, 1e-5 * scale);
+    // Internal forces sum to zero (momentum conserving).
+    EXPECT_LT(f.colwise().sum().cwiseAbs().maxCoeff(), 1e-9 * scale);
+}
+
+TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
+{
+    TetMesh m = box_mesh(2);
+    Material mat;
+    mat.damping = 0.1;
+    Model model = Model::build(m, {mat}, {0});
+    model.fixed[0] = 1;   // a pinned vertex: its rows and columns are skipped by both
+    model.ground.enabled = true;
+    model.ground.height = -0.45;
+    model.ground.stiffness = 1e3;
+    model.ground.damping = 5;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.08, 0.08);
+    Positions x = m.positions;
+    for (Index i = 0; i < x.rows(); ++i)
+        for (int c = 0; c < 3; ++c) x(i, c) += u(rng);
+    std::vector<Eigen::Triplet<double>> t;
+    model.add_matrix_triplets(x, 0.7, 0.3, t);
+    const Index N = 3 * x.rows();
+    Eigen::SparseMatrix<double> A(N, N);
+    A.setFromTriplets(t.begin(), t.end());
+    Eigen::VectorXd p = Eigen::VectorXd::Random(N);
+    p.head<3>().setZero();
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(N);
+    model.apply_matrix(x, 0.7, 0.3, p, out);
+    EXPECT_LT((A * p - out).norm(), 1e-9 * out.norm());
+    Eigen::VectorXd diag = Eigen::VectorXd::Zero(N);
+    model.add_matrix_diagonal(x, 0.7, 0.3, diag);
+    EXPECT_LT((Eigen::VectorXd(A.diagonal()) - diag).norm(), 1e-9 * diag.norm());
+    EXPECT_LT((Eigen::SparseMatrix<double>(A.transpose()) - A).norm(), 1e-9 * A.norm());   // symmetric
+}
+
+TEST(SimModel, ZeroVolumeRestTetIsRefused)
+{
+    TetMesh m = box_mesh(2);
+    const Index t = 5;
+    for (int k = 1; k < 4; ++k) m.positions.row(m.tets(t, k)) = m.positions.row(m.tets(t, 0));
+    try {
+        Model::build(m, {Material{}}, {0});
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("zero"), std::string::npos) << e.what();
+    }
+}
+
+TEST(SimIntegrators, SymplecticEulerEnergyOscillatesBounded)
+{
+    Scene s = free_box(Integrator::symplectic_euler, 1.0);
+    s.dt = 0.1 * Simulation(s).explicit_dt_limit();
+    Simulation sim(s);
+    EXPECT_TRUE(sim.warnings().empty());
+    const double e0 = sim.energy().total();
+    ASSERT_GT(e0, 0);
+    double lo = e0, hi = e0;
+    for (int i = 0; i < 2000; ++i) {
+        sim.step();
+        const double e = sim.energy().total();
+        lo = std::min(lo, e);
+        hi = std::max(hi, e);
+    }
+    // Symplectic: no drift, a bounded oscillation of a few percent at a tenth of the limit.
+    EXPECT_LT(hi - lo, 0.05 * e0) << "lo " << lo << " hi " << hi;
+    EXPECT_LT(sim.momentum().norm(), 1e-9);
+}
+
+TEST(SimIntegrators, ImplicitEulerEnergyNonIncreasing)
+{
+    for (LinearSolver solver : {LinearSolver::cg, LinearSolver::ldlt}) {
+        Scene s = free_box(Integrator::implicit_euler, 1.0);
+        Simulation probe(s);
+        s.dt = 20 * probe.explicit_dt_limit();  // far above the explicit limit
+        s.solver = solver;
+        s.tolerance = 1e-10;
+        Simulation sim(s);
+        double prev = sim.energy().total();
+        const double e0 = prev;
+        for (int i = 0; i < 200; ++i) {
+            sim.step();
+            const double e = sim.energy().total();
+            EXPECT_LE(e, prev * (1 + 1e-6) + 1e-12 * e0) << "step " << i << " solver " << to_string(solver);
+            prev = e;
+        }
+        EXPECT_LT(prev, 0.5 * e0);   // and it dissipates
+    }
+}
+
+TEST(SimIntegrators, LocalGlobalEnergyBoundedAtLargeSteps)
+{
+    Scene s = free_box(Integrator::local_global, 1.0);
+    Simulation probe(s);
+    s.dt = 20 * probe.explicit_dt_limit();
+    s.iterations = 10;
+    Simulation sim(s);
+    const double e0 = sim.energy().total();
+    for (int i = 0; i < 200; ++i) {
+        sim.step();
+        EXPECT_LE(sim.energy().total(), 1.05 * e0) << "step " << i;
+    }
+    EXPECT_TRUE(sim.positions().allFinite());
+}
+
+TEST(SimIntegrators, ExplicitAboveLimitWarnsThenStopsWithoutNaN)
+{
+    Scene s = free_box(Integrator::symplectic_euler, 1.0);
+    Simulation probe(s);
+    s.dt = 5 * probe.explicit_dt_limit();
+    Simulation sim(s);
+    ASSERT_FALSE(sim.warnings().empty());
+    EXPECT_NE(sim.warnings()[0].find("stability limit"), std::string::npos) << sim.warnings()[0];
+    try {
+        for (int i = 0; i < 10000; ++i) sim.step();
+        FAIL() << "no blow-up detected";
+    } catch (const RunFailure& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("step"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("stability limit"), std::string::npos) << msg;
+    }
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_TRUE(sim.velocities().allFinite());
+}
+
+TEST(SimIntegrators, SubstepsBringExplicitUnderTheLimit)
+{
+    Scene s = free_box(Integrator::symplectic_euler, 1.0);
+    Simulation probe(s);
+    s.dt = 3 * probe.explicit_dt_limit();
+    s.substeps = 6;
+    Simulation sim(s);
+    EXPECT_TRUE(sim.warnings().empty());
+    for (int i = 0; i < 300; ++i) sim.step();
+    EXPECT_TRUE(sim.positions().allFinite());
+}
+
+TEST(SimIntegrators, PinnedVerticesStayPut)
+{
+    for (Integrator integ : {Integrator::symplectic_euler, Integrator::implicit_euler, Integrator::local_global}) {
+        Scene s = free_box(integ, 1e-4, 0.01, 0.0);
+        s.gravity = Eigen::Vector3d(0, 0, -9.81);
+        PinRegion p;
+        p.has_box = true;
+        p.box_min = Eigen::Vector3d(-1, -1, 0.4);
+        p.box_max = Eigen::Vector3d(1, 1, 1);
+        s.pins.push_back(p);
+        Simulation sim(s);
+        const Positions x0 = sim.positions();
+        for (int i = 0; i < 50; ++i) sim.step();
+        Index pinned = 0;
+        for (Index i = 0; i < x0.rows(); ++i)
+            if (x0(i, 2) >= 0.4) {
+                ++pinned;
+                EXPECT_EQ((sim.positions().row(i) - x0.row(i)).norm(), 0.0);
+            }
+        EXPECT_GT(pinned, 0);
+        EXPECT_LT(sim.positions().col(2).minCoeff(), x0.col(2).minCoeff());   // the rest sags
+    }
+}

@@ -1,0 +1,166 @@
+// Scene files: every key read, defaults, the shipped scenes parse, bad keys and types name key and line.
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/sim/scene.hpp"
+
+#include <filesystem>
+
+using namespace tethash;
+using namespace tethash::sim;
+
+namespace {
+std::string error_of(const std::string& text)
+{
+    try {
+        parse_scene(text, "s.toml", ".");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+const std::string kObject = "\n[[object]]\ngenerate = { shape = \"box\", resolution = 2 }\n";
+} // namespace
+
+TEST(SimScene, ReadsEveryKey)
+{
+    const Scene s = parse_scene(R"(
+dt = 0.005
+steps = 12
+substeps = 3
+integrator = "local_global"
+solver = "ldlt"
+iterations = 7
+tolerance = 1e-8
+gravity = [0, -9.8, 0]
+[ground]
+height = 0.5
+normal = [0, 2, 0]
+friction = 0.25
+[contact]
+stiffness = 1e5
+damping = 3
+friction = 0.1
+in_matrix = false
+[detector]
+cell_size = "x1.5"
+table_size = 1009
+hash = "teschner"
+threads = 1
+[output]
+every = 4
+fields = ["velocity", "depth"]
+[[object]]
+name = "a"
+generate = { shape = "bar", resolution = 5, size = [2, 0.5, 0.5] }
+scale = 2
+rotate = [0, 90, 0]
+translate = [1, 2, 3]
+velocity = [0, 0, -1]
+self_collision = false
+material = { density = 7, young = 8, damping = 0.5, volume_stiffness = 0.25 }
+[[object]]
+mesh = "sub/thing.vtu"
+static = true
+[[pin]]
+object = 0
+vertices = [0, 3]
+box_min = [0, 0, 0]
+box_max = [1, 1, 1]
+)", "s.toml", "/base");
+    EXPECT_EQ(s.dt, 0.005);
+    EXPECT_EQ(s.steps, 12);
+    EXPECT_EQ(s.substeps, 3);
+    EXPECT_EQ(s.integrator, Integrator::local_global);
+    EXPECT_EQ(s.solver, LinearSolver::ldlt);
+    EXPECT_EQ(s.iterations, 7);
+    EXPECT_EQ(s.gravity.y(), -9.8);
+    EXPECT_TRUE(s.ground.enabled);
+    EXPECT_NEAR(s.ground.normal.y(), 1.0, 1e-15);
+    EXPECT_EQ(s.contact.stiffness, 1e5);
+    EXPECT_FALSE(s.contact.in_matrix);
+    EXPECT_EQ(s.detect.cell_size_mode, DetectParams::CellSizeMode::factor_of_mean_edge);
+    EXPECT_EQ(s.detect.cell_size, 1.5);
+    EXPECT_EQ(s.detect.table_size, 1009);
+    EXPECT_EQ(s.detect.hash, HashFunction::teschner);
+    EXPECT_EQ(s.output.every, 4);
+    EXPECT_EQ(s.output.fields.size(), 2u);
+    ASSERT_EQ(s.objects.size(), 2u);
+    EXPECT_EQ(s.objects[0].name, "a");
+    ASSERT_TRUE(s.objects[0].generate.has_value());
+    EXPECT_EQ(s.objects[0].generate->shape, "bar");
+    EXPECT_EQ(s.objects[0].generate->size.x(), 2);
+    EXPECT_EQ(s.objects[0].scale.z(), 2);
+    EXPECT_EQ(s.objects[0].translate.z(), 3);
+    EXPECT_FALSE(s.objects[0].self_collision);
+    EXPECT_EQ(s.objects[0].material.volume_stiffness, 0.25);
+    EXPECT_EQ(s.objects[1].mesh, "/base/sub/thing.vtu");
+    EXPECT_TRUE(s.objects[1].is_static);
+    ASSERT_EQ(s.pins.size(), 1u);
+    EXPECT_EQ(s.pins[0].vertices.size(), 2u);
+    EXPECT_TRUE(s.pins[0].has_box);
+}
+
+TEST(SimScene, UnknownKeysNameKeyAndLine)
+{
+    std::string e = error_of("dt = 0.01\nstepz = 4\n" + kObject);
+    EXPECT_NE(e.find("s.toml:2"), std::string::npos) << e;
+    EXPECT_NE(e.find("stepz"), std::string::npos) << e;
+    e = error_of(kObject + "material = { densty = 3 }\n");
+    EXPECT_NE(e.find("s.toml:4"), std::string::npos) << e;
+    EXPECT_NE(e.find("object[0].material.densty"), std::string::npos) << e;
+    e = error_of("[ground]\nhieght = 1\n" + kObject);
+    EXPECT_NE(e.find("s.toml:2"), std::string::npos) << e;
+    EXPECT_NE(e.find("ground.hieght"), std::string::npos) << e;
+}
+
+TEST(SimScene, WrongTypesAndValuesNameKeyAndLine)
+{
+    struct Case {
+        std::string text, key, line;
+    } cases[] = {
+        {"dt = \"fast\"\n" + kObject, "'dt'", "s.toml:1"},
+        {"\n\nsteps = 2.5\n" + kObject, "'steps'", "s.toml:3"},
+        {"dt = -1\n" + kObject, "'dt'", "s.toml:1"},
+        {"gravity = [0, 1]\n" + kObject, "'gravity'", "s.toml:1"},
+        {"integrator = \"rk4\"\n" + kObject, "'integrator'", "s.toml:1"},
+        {kObject + "self_collision = 1\n", "object[0].self_collision", "s.toml:4"},
+        {"[[object]]\ngenerate = { shape = \"cube\" }\n", "object[0].generate.shape", "s.toml:2"},
+        {"[detector]\ncell_size = \"big\"\n" + kObject, "detector.cell_size", "s.toml:2"},
+        {"[[object]]\nname = \"x\"\n", "object[0]", "s.toml:"},
+        {"dt = = 1\n", "TOML", "s.toml:1"},
+    };
+    for (const Case& c : cases) {
+        const std::string e = error_of(c.text);
+        EXPECT_NE(e.find(c.key), std::string::npos) << c.text << " -> " << e;
+        EXPECT_NE(e.find(c.line), std::string::npos) << c.text << " -> " << e;
+    }
+}
+
+TEST(SimScene, ShippedScenesAndDefaultParse)
+{
+    const Scene d = default_scene();
+    EXPECT_GE(d.objects.size(), 2u);
+    const std::filesystem::path dir = std::filesystem::path(TETHASH_SOURCE_DIR) / "meshes" / "scenes";
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+        if (entry.path().extension() != ".toml") continue;
+        EXPECT_NO_THROW(load_scene(entry.path().string())) << entry.path();
+        ++count;
+    }
+    EXPECT_GE(count, 6);
+    // The shipped default.toml is the embedded default.
+    EXPECT_EQ(tethash::test::read_text(dir / "default.toml"), default_scene_text());
+    const Scene pile = load_scene((dir / "pile.toml").string());
+    EXPECT_GE(pile.objects.size(), 100u);
+}
+
+TEST(SimScene, MissingFileIsAnError)
+{
+    try {
+        load_scene("/nonexistent/scene.toml");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.toml"), std::string::npos);
+    }
+}

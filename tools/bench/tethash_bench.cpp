@@ -1,0 +1,420 @@
+// tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all threads for the
+// five scenarios of Teschner et al. 2003 rebuilt with io::generate (objects overlapping heavily), plus the
+// meshes of ../shared/meshes; and, in the same run, a plain implementation of the 2003 algorithm (per-bucket
+// vertex lists with timestamps, xor-prime hash mod a prime, plain barycentric test) as the baseline.
+//
+//   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--cell-factor F]
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/hash_grid.hpp"
+#include "tethash/io/generate.hpp"
+#include "tethash/io/mesh_io.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <time.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+using namespace tethash;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// CPU time of the calling thread in ms (robust against other load on the machine for 1-thread runs).
+double thread_cpu_ms()
+{
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// ---- scenes ------------------------------------------------------------------------------------
+
+/// Own fallback: cube lattice, 6 tets per cube (used if io::generate fails).
+TetMesh lattice_box(int k)
+{
+    TetMesh m;
+    auto vid = [&](int i, int j, int l) { return static_cast<Index>((l * (k + 1) + j) * (k + 1) + i); };
+    m.positions.resize((k + 1) * (k + 1) * (k + 1), 3);
+    for (int l = 0; l <= k; ++l)
+        for (int j = 0; j <= k; ++j)
+            for (int i = 0; i <= k; ++i) m.positions.row(vid(i, j, l)) << i / double(k) - 0.5, j / double(k) - 0.5, l / double(k) - 0.5;
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    m.tets.resize(6 * k * k * k, 4);
+    int t = 0;
+    for (int l = 0; l < k; ++l)
+        for (int j = 0; j < k; ++j)
+            for (int i = 0; i < k; ++i)
+                for (const auto& p : perms) {
+                    int c[3] = {i, j, l};
+                    m.tets(t, 0) = vid(c[0], c[1], c[2]);
+                    for (int s = 0; s < 3; ++s) {
+                        ++c[p[s]];
+                        m.tets(t, s + 1) = vid(c[0], c[1], c[2]);
+                    }
+                    ++t;
+                }
+    return m;
+}
+
+/// One object of about `tets` tets: io::generate's sphere at the resolution that comes closest.
+TetMesh make_object(int tets, std::string& how)
+{
+    TetMesh best;
+    try {
+        for (int r = 2; r < 80; ++r) {
+            io::GenerateParams g;
+            g.shape = "sphere";
+            g.resolution = r;
+            TetMesh m = io::generate(g);
+            if (best.num_tets() == 0 || std::abs(m.num_tets() - tets) < std::abs(best.num_tets() - tets)) best = m;
+            if (m.num_tets() > tets) break;
+        }
+        how = "io::generate sphere";
+        // Normalise to unit size.
+        const Eigen::RowVector3d lo = best.positions.colwise().minCoeff(), hi = best.positions.colwise().maxCoeff();
+        const double ext = (hi - lo).maxCoeff();
+        for (Eigen::Index v = 0; v < best.positions.rows(); ++v)
+            best.positions.row(v) = (best.positions.row(v) - 0.5 * (lo + hi)) / ext;
+        best.rest_positions.resize(0, 3);
+        best.vertex_object.clear();
+        best.tet_object.clear();
+        return best;
+    } catch (const std::exception&) {
+        how = "own cube lattice";
+        int k = 1;
+        while (6 * (k + 1) * (k + 1) * (k + 1) <= tets) ++k;
+        return lattice_box(k);
+    }
+}
+
+/// `objects` copies of an object of ~tets/objects tets, randomly rotated and placed so that they overlap
+/// heavily (centres in a cube of side 0.5·objects^(1/3) object sizes).
+TetMesh make_scene(int objects, int tets, std::uint32_t seed, std::string& how)
+{
+    const TetMesh obj = make_object(tets / objects, how);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double side = 0.5 * std::cbrt(static_cast<double>(objects));
+    TetMesh scene;
+    for (int o = 0; o < objects; ++o) {
+        TetMesh m = obj;
+        const Eigen::Matrix3d rot =
+            Eigen::AngleAxisd(3.14159 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+        const Eigen::RowVector3d shift(side * u(rng) / 2, side * u(rng) / 2, side * u(rng) / 2);
+        for (Eigen::Index v = 0; v < m.positions.rows(); ++v)
+            m.positions.row(v) = (rot * m.positions.row(v).transpose()).transpose() + shift;
+        if (o == 0) {
+            scene = m;
+            scene.ensure_object_ids();
+        } else {
+            // append as a new object (own code: independent of mesh.cpp's append)
+            const Index base = scene.num_vertices();
+            Positions p(scene.positions.rows() + m.positions.rows(), 3);
+            p << scene.positions, m.positions;
+            Tets t(scene.tets.rows() + m.tets.rows(), 4);
+            t << scene.tets, (m.tets.array() + base).matrix();
+            scene.positions = p;
+            scene.tets = t;
+            scene.vertex_object.insert(scene.vertex_object.end(), m.positions.rows(), o);
+            scene.tet_object.insert(scene.tet_object.end(), m.tets.rows(), o);
+        }
+    }
+    return scene;
+}
+
+// ---- the plain 2003 baseline -------------------------------------------------------------------------
+
+/// Teschner et al. 2003 as written: hash table of per-bucket vertex lists, stamped with the step instead of
+/// cleared; each tet looks up every cell its box touches (xor-prime hash mod a prime), checks box and own
+/// vertices, and computes barycentric coordinates in double (no exactness). Pairs found through several
+/// cells sharing a bucket are filtered by comparing the vertex's cell with the visited cell.
+class Baseline {
+public:
+    void run(const TetMesh& m, double l, std::vector<std::pair<Index, Index>>& out)
+    {
+        const Index n = m.num_vertices();
+        if (m_table == 0) {
+            m_table = static_cast<std::size_t>(next_prime(2 * n));
+            m_buckets.assign(m_table, {});
+            m_stamp.assign(m_table, 0);
+        }
+        ++m_step;
+        m_cell.resize(3 * static_cast<std::size_t>(n));
+        const double inv = 1.0 / l;
+        for (Index v = 0; v < n; ++v) {
+            const std::int32_t c[3] = {static_cast<std::int32_t>(std::floor(m.positions(v, 0) * inv)),
+                                       static_cast<std::int32_t>(std::floor(m.positions(v, 1) * inv)),
+                                       static_cast<std::int32_t>(std::floor(m.positions(v, 2) * inv))};
+            for (int k = 0; k < 3; ++k) m_cell[3 * v + k] = c[k];
+            const std::size_t b = teschner_hash(c[0], c[1], c[2]) % m_table;
+            if (m_stamp[b] != m_step) {
+                m_stamp[b] = m_step;
+                m_buckets[b].clear();
+            }
+            m_buckets[b].push_back(v);
+        }
+        out.clear();
+        for (Index t = 0; t < m.num_tets(); ++t) {
+            const Index id[4] = {m.tets(t, 0), m.tets(t, 1), m.tets(t, 2), m.tets(t, 3)};
+            Eigen::Vector3d p[4];
+            for (int k = 0; k < 4; ++k) p[k] = m.positions.row(id[k]).transpose();
+            const Eigen::Vector3d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]).cwiseMin(p[3]);
+            const Eigen::Vector3d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]).cwiseMax(p[3]);
+            const Eigen::Vector3d e1 = p[1] - p[0], e2 = p[2] - p[0], e3 = p[3] - p[0];
+            const double vol = e1.dot(e2.cross(e3));
+            if (vol == 0) continue;
+            std::int32_t c0[3], c1[3];
+            for (int k = 0; k < 3; ++k) {
+                c0[k] = static_cast<std::int32_t>(std::floor(lo[k] * inv));
+                c1[k] = static_cast<std::int32_t>(std::floor(hi[k] * inv));
+            }
+            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
+                for (std::int32_t y = c0[1]; y <= c1[1]; ++y)
+                    for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
+                        const std::size_t b = teschner_hash(x, y, z) % m_table;
+                        if (m_stamp[b] != m_step) continue;
+                        for (Index v : m_buckets[b]) {
+                            if (v == id[0] || v == id[1] || v == id[2] || v == id[3]) continue;
+                            if (m_cell[3 * v] != x || m_cell[3 * v + 1] != y || m_cell[3 * v + 2] != z) continue;
+                            const Eigen::Vector3d q = m.positions.row(v).transpose();
+                            if ((q.array() < lo.array()).any() || (q.array() > hi.array()).any()) continue;
+                            const Eigen::Vector3d d = q - p[0];
+                            const double b1 = d.dot(e2.cross(e3)) / vol, b2 = e1.dot(d.cross(e3)) / vol,
+                                         b3 = e1.dot(e2.cross(d)) / vol;
+                            if (b1 >= 0 && b2 >= 0 && b3 >= 0 && b1 + b2 + b3 <= 1) out.emplace_back(v, t);
+                        }
+                    }
+        }
+    }
+
+private:
+    std::size_t m_table = 0;
+    std::vector<std::vector<Index>> m_buckets;
+    std::vector<std::uint32_t> m_stamp;
+    std::uint32_t m_step = 0;
+    std::vector<std::int32_t> m_cell;
+};
+
+// ---- measuring -------------------------------------------------------------------------------------
+
+struct Measured {
+    double ms = 0;
+    double cpu_ms = 0;   ///< CPU time of the calling thread (meaningful at 1 thread)
+    DetectStats stats;
+};
+
+Measured measure(const TetMesh& m, DetectParams p, int repeat)
+{
+    Detector det(p);
+    det.set_topology(m);
+    DetectStats st;
+    det.detect(m.positions);   // warm-up (auto cell size, buffers)
+    std::vector<double> ms, cpu, s1, s2, s3, s4;
+    for (int r = 0; r < repeat; ++r) {
+        const double c0 = thread_cpu_ms();
+        const auto t0 = Clock::now();
+        det.detect(m.positions);
+        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        cpu.push_back(thread_cpu_ms() - c0);
+    }
+    // Stage split from separate runs with statistics on (they count degenerate tets too).
+    for (int r = 0; r < std::max(3, repeat / 3); ++r) {
+        det.detect(m.positions, &st);
+        s1.push_back(st.ms_vertices);
+        s2.push_back(st.ms_tets);
+        s3.push_back(st.ms_inside);
+        s4.push_back(st.ms_sort);
+    }
+    st.ms_vertices = median(s1);
+    st.ms_tets = median(s2);
+    st.ms_inside = median(s3);
+    st.ms_sort = median(s4);
+    return {median(ms), median(cpu), st};
+}
+
+double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& contacts, double& cpu_ms)
+{
+    Baseline b;
+    std::vector<std::pair<Index, Index>> out;
+    b.run(m, l, out);
+    std::vector<double> ms, cpu;
+    for (int r = 0; r < repeat; ++r) {
+        const double c0 = thread_cpu_ms();
+        const auto t0 = Clock::now();
+        b.run(m, l, out);
+        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        cpu.push_back(thread_cpu_ms() - c0);
+    }
+    contacts = out.size();
+    cpu_ms = median(cpu);
+    return median(ms);
+}
+
+void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline)
+{
+    DetectParams p1 = base;
+    p1.threads = 1;
+    DetectParams pn = base;
+    pn.threads = threads_all;
+    const Measured one = measure(m, p1, repeat);
+    const Measured all = measure(m, pn, repeat);
+    std::printf("%-28s objects %4d  tets %8d  vertices %8d  contacts %8lld\n", name, m.num_objects(), m.num_tets(),
+                m.num_vertices(), static_cast<long long>(one.stats.contacts));
+    auto line = [&](const char* label, const Measured& r) {
+        std::printf("  %-14s %8.3f ms (cpu %.3f)  %7.1f ns/tet  [vertices %.3f  tets+scan %.3f  inside %.3f  sort %.3f]\n",
+                    label, r.ms, r.cpu_ms, 1e6 * r.ms / m.num_tets(), r.stats.ms_vertices, r.stats.ms_tets, r.stats.ms_inside,
+                    r.stats.ms_sort);
+    };
+    line("1 thread", one);
+    char label[32];
+    std::snprintf(label, sizeof label, "%d threads", all.stats.threads);
+    line(label, all);
+    const DetectStats& s = one.stats;
+    std::printf("  cell %.4g  table %lld  cells %lld  scanned %lld  collisions %lld  box-rejected %lld  own %lld  "
+                "inside tests %lld  exact %lld  degenerate %lld  memory %.1f B/tet\n",
+                s.cell_size, static_cast<long long>(s.table_size), static_cast<long long>(s.cells_visited),
+                static_cast<long long>(s.entries_scanned), static_cast<long long>(s.hash_collisions),
+                static_cast<long long>(s.box_rejections), static_cast<long long>(s.own_vertex_skips),
+                static_cast<long long>(s.inside_tests), static_cast<long long>(s.exact_fallbacks),
+                static_cast<long long>(s.degenerate_tets), double(s.memory_bytes) / std::max(1, m.num_tets()));
+    if (all.stats.contacts != one.stats.contacts) std::printf("  ERROR: contact counts differ between thread counts\n");
+    if (baseline) {
+        std::size_t bc = 0;
+        double bcpu = 0;
+        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), bc, bcpu);
+        std::printf("  baseline 2003  %8.3f ms (1 thread, cpu %.3f ms, %zu contacts)   ratio: %.1fx at 1 thread "
+                    "(cpu %.1fx), %.1fx at %d threads\n",
+                    bms, bcpu, bc, bms / one.ms, bcpu / one.cpu_ms, bms / all.ms, all.stats.threads);
+    }
+    std::fflush(stdout);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    int repeat = 21, threads = 0, only = -1;
+    bool sweep = false, meshes = true;
+    double cell_factor = 1.0;
+    std::string hash = "column";
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto next = [&]() -> std::string {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "tethash_bench: %s needs a value\n", a.c_str());
+                std::exit(2);
+            }
+            return argv[++i];
+        };
+        if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
+        else if (a == "--threads") threads = std::stoi(next());
+        else if (a == "--scenario") only = std::stoi(next());
+        else if (a == "--sweep") sweep = true;
+        else if (a == "--no-meshes") meshes = false;
+        else if (a == "--cell-factor") cell_factor = std::stod(next());
+        else if (a == "--hash") hash = next();
+        else {
+            std::fprintf(stderr,
+                         "usage: tethash_bench [--repeat K] [--threads N] [--scenario 1..5] [--sweep] [--no-meshes] "
+                         "[--cell-factor F] [--hash column|teschner]\n");
+            return 2;
+        }
+    }
+#ifdef _OPENMP
+    const int threads_all = threads > 0 ? threads : omp_get_max_threads();
+#else
+    const int threads_all = 1;
+#endif
+    DetectParams base;
+    base.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
+    base.cell_size = cell_factor;
+    base.hash = parse_hash_function(hash);
+    std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
+                "table auto, hash %s\n",
+                TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, repeat, cell_factor, hash.c_str());
+    {
+        std::ifstream cpu("/proc/cpuinfo");
+        std::string line;
+        while (std::getline(cpu, line))
+            if (line.rfind("model name", 0) == 0) {
+                std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
+                break;
+            }
+    }
+    const char* simd = std::getenv("TETHASH_SIMD");
+    std::printf("scan kernel: %s\n\n", simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
+
+    if (sweep) {
+        std::printf("flatness sweep: objects of ~500 tets, same overlap density\n");
+        for (int tets : {1000, 3000, 10000, 30000, 100000, 300000, 1000000}) {
+            std::string how;
+            const TetMesh m = make_scene(std::max(2, tets / 500), tets, 7, how);
+            DetectParams p = base;
+            p.threads = 1;
+            const Measured r = measure(m, p, std::max(3, repeat / (tets >= 300000 ? 4 : 1)));
+            std::printf("  tets %8d  vertices %8d  %9.3f ms (cpu %.3f)  %6.1f ns/tet  %6.1f B/tet  contacts %lld\n", m.num_tets(),
+                        m.num_vertices(), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / m.num_tets(), double(r.stats.memory_bytes) / m.num_tets(),
+                        static_cast<long long>(r.stats.contacts));
+            std::fflush(stdout);
+        }
+        return 0;
+    }
+
+    const int scen[5][2] = {{100, 1000}, {8, 4000}, {20, 10000}, {2, 20514}, {100, 50000}};
+    for (int k = 0; k < 5; ++k) {
+        if (only > 0 && only != k + 1) continue;
+        std::string how;
+        const TetMesh m = make_scene(scen[k][0], scen[k][1], 100 + k, how);
+        char name[64];
+        std::snprintf(name, sizeof name, "scenario %d (%s)", k + 1, how.c_str());
+        report(name, m, base, threads_all, repeat, true);
+    }
+    if (meshes && only < 0) {
+        const std::filesystem::path dir = TETHASH_SHARED_MESHES;
+        if (std::filesystem::exists(dir)) {
+            std::vector<std::filesystem::path> files;
+            for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path());
+            std::sort(files.begin(), files.end());
+            for (const auto& f : files) {
+                if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;
+                try {
+                    TetMesh one = io::read_mesh(f.string());
+                    // Two copies, the second shifted by a fraction of the size: overlapping objects.
+                    const Eigen::RowVector3d lo = one.positions.colwise().minCoeff(),
+                                             hi = one.positions.colwise().maxCoeff();
+                    one.vertex_object.clear();
+                    one.tet_object.clear();
+                    one.ensure_object_ids();
+                    TetMesh two = one;
+                    two.positions.rowwise() += 0.2 * (hi - lo);
+                    one.append(two);
+                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), true);
+                } catch (const std::exception& e) {
+                    std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
+                }
+            }
+        }
+    }
+    return 0;
+}

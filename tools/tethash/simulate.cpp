@@ -1,0 +1,151 @@
+// tethash simulate: runs a scene (TOML, or the built-in default) and writes VTU frames + a .pvd series.
+#include "command.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/io/vtk.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <cstdio>
+#include <filesystem>
+
+namespace tethash::cli {
+namespace {
+
+struct SimulateOptions {
+    std::string scene;
+    static constexpr int unset = std::numeric_limits<int>::min();
+    int steps = unset;
+    double dt = std::numeric_limits<double>::quiet_NaN();
+    int substeps = unset;
+    std::string integrator;
+    int threads = 0;
+    std::string out = "out";
+};
+
+void run_simulate(const SimulateOptions& o)
+{
+    sim::Scene scene = o.scene.empty() ? sim::default_scene() : sim::load_scene(o.scene);
+    if (o.steps != SimulateOptions::unset) {
+        if (o.steps < 0) throw Error(fmt::format("--steps must be ≥ 0, found {}", o.steps));
+        scene.steps = o.steps;
+    }
+    if (!std::isnan(o.dt)) {
+        if (!(o.dt > 0)) throw Error(fmt::format("--dt must be positive, found {}", o.dt));
+        scene.dt = o.dt;
+    }
+    if (o.substeps != SimulateOptions::unset) {
+        if (o.substeps < 1) throw Error(fmt::format("--substeps must be ≥ 1, found {}", o.substeps));
+        scene.substeps = o.substeps;
+    }
+    if (!o.integrator.empty()) {
+        try {
+            scene.integrator = sim::parse_integrator(o.integrator);
+        } catch (const Error& e) {
+            throw Error(std::string("--integrator: ") + e.what());
+        }
+    }
+    if (o.threads < 0) throw Error(fmt::format("--threads must be ≥ 0, found {}", o.threads));
+    const int threads = set_threads(o.threads);
+    if (o.threads > 0) scene.detect.threads = o.threads;
+
+    sim::Simulation sim(scene);
+    for (const std::string& w : sim.warnings()) std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
+
+    std::error_code ec;
+    std::filesystem::create_directories(o.out, ec);
+    if (ec) throw Error("--out: cannot create folder '" + o.out + "': " + ec.message());
+    std::vector<std::pair<double, std::string>> series;
+    const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
+    auto write_frame = [&]() {
+        const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
+        io::write_vtu((std::filesystem::path(o.out) / name).string(), sim.mesh(), sim.output_fields());
+        series.emplace_back(sim.time(), name);
+        io::write_pvd(pvd, series);
+    };
+    const int every = scene.output.every;
+    if (every > 0) write_frame();
+
+    const sim::Energy e0 = sim.energy();
+    std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
+    std::fprintf(stdout, "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %d threads\n",
+                 static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
+                 static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt,
+                 scene.substeps, scene.steps, threads);
+    std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
+    std::fflush(stdout);
+
+    const bool tty = stderr_is_terminal();
+    double ms_detect = 0, ms_response = 0, ms_integrate = 0, max_depth = 0, depth_sum = 0;
+    std::int64_t contacts = 0, iterations = 0;
+    const auto start = std::chrono::steady_clock::now();
+    auto last_print = start;
+    const int plain_every = std::max(1, scene.steps / 10);
+    try {
+        for (int s = 0; s < scene.steps; ++s) {
+            sim.step();
+            const sim::StepStats& st = sim.last_stats();
+            ms_detect += st.ms_detect;
+            ms_response += st.ms_response;
+            ms_integrate += st.ms_integrate;
+            contacts += st.contacts;
+            iterations += st.solver_iterations;
+            max_depth = std::max(max_depth, st.max_depth);
+            depth_sum += st.mean_depth * static_cast<double>(st.contacts);
+            if (every > 0 && sim.step_index() % every == 0) write_frame();
+            const auto now = std::chrono::steady_clock::now();
+            const double secs = std::chrono::duration<double>(now - start).count();
+            const double rate = secs > 0 ? (s + 1) / secs : 0.0;
+            if (tty) {
+                if (std::chrono::duration<double>(now - last_print).count() > 0.1 || s + 1 == scene.steps) {
+                    const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, scene.steps));
+                    std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g   ",
+                                 std::string(static_cast<size_t>(filled), '#').c_str(),
+                                 std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps, rate,
+                                 static_cast<long long>(st.contacts), st.max_depth);
+                    last_print = now;
+                }
+            } else if ((s + 1) % plain_every == 0 || s + 1 == scene.steps) {
+                std::fprintf(stderr, "step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g\n", s + 1, scene.steps, rate,
+                             static_cast<long long>(st.contacts), st.max_depth);
+            }
+        }
+    } catch (const RunFailure&) {
+        if (tty) std::fprintf(stderr, "\n");
+        throw;
+    }
+    if (tty) std::fprintf(stderr, "\n");
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const int n = std::max(1, scene.steps);
+    const sim::Energy e1 = sim.energy();
+    std::fprintf(stdout, "steps: %d in %.3f s (%.2f ms/step: detection %.3f, response %.3f, integration %.3f)\n",
+                 scene.steps, wall, 1e3 * wall / n, ms_detect / n, ms_response / n, ms_integrate / n);
+    std::fprintf(stdout, "contacts per step: %.1f\n", static_cast<double>(contacts) / n);
+    if (iterations) std::fprintf(stdout, "linear solver: %.1f CG iterations per step\n", static_cast<double>(iterations) / n);
+    std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
+                 contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
+    std::fprintf(stdout, "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, contact %.4g)\n",
+                 e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
+    if (every > 0) std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView)\n", series.size(), o.out.c_str());
+}
+
+Registrar reg{{"simulate", "Simulate a scene of deformable tet meshes (mass-spring) and write VTU frames",
+               [](CLI::App& sub) {
+                   auto o = std::make_shared<SimulateOptions>();
+                   sub.add_option("scene", o->scene, "Scene file (TOML); without it the built-in default scene runs");
+                   sub.add_option("--steps", o->steps, "Number of steps (overrides the scene)");
+                   sub.add_option("--dt", o->dt, "Time step in s (overrides the scene)");
+                   sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
+                   sub.add_option("--integrator", o->integrator, "symplectic_euler, implicit_euler or local_global");
+                   sub.add_option("--threads", o->threads, "Threads (0: OpenMP default)");
+                   sub.add_option("--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
+                   sub.callback([o] { run_simulate(*o); });
+               }}};
+
+} // namespace
+} // namespace tethash::cli
