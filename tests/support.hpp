@@ -67,8 +67,25 @@ inline RunResult run_shell(const std::string& cmdline)
     return r;
 }
 
+/// Single-quoted for the shell (built by appending: g++ 12 warns falsely on "'" + string + "'").
+inline std::string quote(const std::filesystem::path& p)
+{
+    std::string q;
+    q.reserve(p.string().size() + 2);
+    q.push_back('\'');
+    q.append(p.string());
+    q.push_back('\'');
+    return q;
+}
+
 /// Runs the tethash program with the given arguments (already shell-quoted where needed).
-inline RunResult run_tethash(const std::string& args) { return run_shell(std::string("'") + TETHASH_EXE + "' " + args); }
+inline RunResult run_tethash(const std::string& args)
+{
+    std::string cmd = quote(TETHASH_EXE);
+    cmd.push_back(' ');
+    cmd.append(args);
+    return run_shell(cmd);
+}
 
 /// A Python interpreter that imports every module in `modules` (space separated), or nullopt.
 /// Tries /usr/bin/python3 (Debian's packages install there) before the python3 first on PATH.
@@ -92,7 +109,6 @@ inline std::optional<std::filesystem::path> shared_mesh(const std::string& name)
     return std::nullopt;
 }
 
-inline std::string quote(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
 
 } // namespace tethash::test
 

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 
@@ -17,11 +18,27 @@ using tethash::test::Scene;
 
 namespace {
 
+bool identical(const std::vector<Contact>& a, const std::vector<Contact>& b)
+{
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a[i].vertex != b[i].vertex || a[i].tet != b[i].tet ||
+            std::memcmp(a[i].bary, b[i].bary, sizeof a[i].bary) != 0)
+            return false;
+    return true;
+}
+
+/// Runs the detector without statistics (the lean scan kernel) and with them (every entry classified):
+/// both must give the same contacts bit for bit; returns them.
 std::vector<Contact> run_detector(const Scene& s, const DetectParams& p, DetectStats* stats = nullptr)
 {
     Detector det(p);
     det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
-    return det.detect(s.positions, stats);
+    const std::vector<Contact> lean = det.detect(s.positions);
+    DetectStats local;
+    const std::vector<Contact>& full = det.detect(s.positions, stats ? stats : &local);
+    EXPECT_TRUE(identical(lean, full)) << "contacts with and without statistics differ";
+    return full;
 }
 
 std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)

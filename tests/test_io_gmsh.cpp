@@ -181,6 +181,20 @@ TEST(GmshBinary, Reads41LittleAndBigEndian)
     }
 }
 
+TEST(GmshBinary, SkipsBinarySectionsItDoesNotNeed)
+{
+    const auto dir = temp_dir();
+    Bytes data{false, {}};
+    data.text("$NodeData\n1\n\"t\"\n1\n0.0\n3\n0\n1\n5\n");
+    for (std::int32_t t = 1; t <= 5; ++t) {
+        data.int_(t);
+        data.put(t == 3 ? 36.0 : -1.5);   // arbitrary bytes, including '$' and line breaks
+    }
+    data.text("\n$End\n$EndNodeData\n");
+    write_text(dir / "nd.msh", binary41(false) + data.s);
+    expect_two_tets(io::read_msh((dir / "nd.msh").string()), {7, 7}, "binary $NodeData");
+}
+
 TEST(GmshBinary, Reads22LittleAndBigEndian)
 {
     const auto dir = temp_dir();

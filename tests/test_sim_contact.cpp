@@ -244,3 +244,24 @@ TEST(SimContact, NearlyFlatTetsAtStartStayFinite)
     EXPECT_TRUE(sim.positions().allFinite());
     EXPECT_LE(emax, e0 + 1e-9 * std::abs(e0));
 }
+
+TEST(SimContact, FoldedBarEndsWithoutDeepSelfPenetration)
+{
+    // The shipped folding bar at a lower resolution: it buckles and folds onto itself (self-contacts).
+    Scene s = load_scene(std::string(TETHASH_SOURCE_DIR) + "/meshes/scenes/folding_bar.toml");
+    s.objects[0].generate->resolution = 12;
+    s.output.every = 0;
+    Simulation sim(s);
+    std::int64_t self_contacts = 0;
+    for (int i = 0; i < 300; ++i) {
+        sim.step();
+        for (const Contact& c : sim.contacts()) self_contacts += c.vertex_object == c.tet_object ? 1 : 0;
+    }
+    EXPECT_GT(self_contacts, 0);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_LT(sim.positions().col(2).maxCoeff(), 2.0);   // it did fold over
+    // Bound: a quarter of the bar's thickness (0.3), measured against the exact distance to the boundary.
+    const std::vector<double> exact = sim.exact_depths();
+    for (double d : exact) EXPECT_LT(d, 0.075);
+    EXPECT_LT(sim.max_penetration(), 0.075);
+}

@@ -25,6 +25,14 @@ inline constexpr double max_cell_coordinate = 1073741824.0;   // 2^30
 /// Largest allowed table size.
 inline constexpr std::int64_t max_table_size = std::int64_t{1} << 27;
 
+/// floor(x) as an integer for |x| < 2^31 (the caller guards the range): the same value as std::floor, without
+/// the library call that a build without SSE4.1 makes for it (measured: 8 % of all instructions of a detection).
+inline std::int32_t floor_to_int(double x)
+{
+    const auto i = static_cast<std::int32_t>(x);   // truncation toward zero, exact in range
+    return i - (x < static_cast<double>(i));
+}
+
 inline std::uint64_t teschner_hash(std::int32_t x, std::int32_t y, std::int32_t z)
 {
     return static_cast<std::uint32_t>(static_cast<std::uint32_t>(x) * 73856093u ^

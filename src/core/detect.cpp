@@ -209,6 +209,7 @@ public:
     // per-scene state fixed at the first detect() after set_topology/set_params
     bool prepared = false;
     double cell_size = 0;
+    double inv_cell = 1;   // 1 / cell_size, the one factor both the vertex table and the tet boxes use
     double origin[3] = {0, 0, 0};
     std::int64_t table_sizes[2] = {1, 1};
     VertexTable tables[2];   // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
@@ -220,7 +221,7 @@ public:
     void prepare(const PositionsRef& positions);
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
-    void stage_tets(ThreadState& ts, Index t, const double* P, bool count_degenerate);
+    void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const double* P);
     std::int64_t memory_bytes() const;
 };
@@ -242,6 +243,7 @@ void DetectorImpl::prepare(const PositionsRef& positions)
     }
     if (!(cell_size > 0) || !std::isfinite(cell_size))
         throw Error("cell size must be positive and finite, got " + std::to_string(cell_size));
+    inv_cell = 1.0 / cell_size;
     if (num_vertices > 0) {
         const Eigen::RowVector3d lo = positions.colwise().minCoeff(), hi = positions.colwise().maxCoeff();
         for (int a = 0; a < 3; ++a) origin[a] = 0.5 * (lo(a) + hi(a));
@@ -287,31 +289,30 @@ std::int64_t DetectorImpl::memory_bytes() const
     return m;
 }
 
-// Stage 2 for one tet: box, cell range, bucket ranges, SIMD scan → candidate run.
-void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool count_degenerate)
+// Stage 2 for one tet: box, cell range, bucket ranges, SIMD scan → candidate run. `with_stats`: also count
+// degenerate tets and every scan statistic (a slower scan kernel that classifies every entry).
+void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats)
 {
     const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
     const double* a = P + 3 * static_cast<std::size_t>(tv[0]);
     const double* b = P + 3 * static_cast<std::size_t>(tv[1]);
     const double* c = P + 3 * static_cast<std::size_t>(tv[2]);
     const double* d = P + 3 * static_cast<std::size_t>(tv[3]);
-    if (count_degenerate) {
+    if (with_stats) {
         const predicates::Orientation o = predicates::orient3d(a, b, c, d);
         if (o.sign == 0) ++ts.counters.degenerate;
     }
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(std::min(a[k], b[k]), std::min(c[k], d[k]));
-        hi[k] = std::max(std::max(a[k], b[k]), std::max(c[k], d[k]));
-    }
-    const double inv = 1.0 / cell_size;
     detail::ScanQuery q;
     std::int32_t c0[3], c1[3];
     for (int k = 0; k < 3; ++k) {
-        c0[k] = static_cast<std::int32_t>(std::floor(lo[k] * inv));
-        c1[k] = static_cast<std::int32_t>(std::floor(hi[k] * inv));
-        q.lo[k] = static_cast<float>(lo[k] - origin[k]);
-        q.hi[k] = static_cast<float>(hi[k] - origin[k]);
+        const double lo = std::min(std::min(a[k], b[k]), std::min(c[k], d[k]));
+        const double hi = std::max(std::max(a[k], b[k]), std::max(c[k], d[k]));
+        // The same expressions as the vertex table's (p · (1/l), floor): monotone, so a vertex in the box has
+        // its cell in [c0, c1]. Float box relative to the origin: rounding is monotone too, never a false reject.
+        c0[k] = floor_to_int(lo * inv_cell);
+        c1[k] = floor_to_int(hi * inv_cell);
+        q.lo[k] = static_cast<float>(lo - origin[k]);
+        q.hi[k] = static_cast<float>(hi - origin[k]);
     }
     for (int k = 0; k < 4; ++k) q.own[k] = tv[k];
     const std::int64_t nx = std::int64_t{c1[0]} - c0[0] + 1, ny = std::int64_t{c1[1]} - c0[1] + 1,
@@ -322,61 +323,87 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool co
         ts.too_many_cells = true;
         return;
     }
-    ts.counters.cells += nx * ny * nz;
+    if (with_stats) ts.counters.cells += nx * ny * nz;
 
     const std::int32_t run_begin = static_cast<std::int32_t>(ts.used);
-    const Index to = tet_object[static_cast<std::size_t>(t)];
     // Table 0 holds the moving vertices, table 1 the static ones: static tets never look at table 1.
-    const int num_tables = any_static && !flags.is_static[static_cast<std::size_t>(to)] ? 2 : 1;
+    const int num_tables =
+        any_static && !flags.is_static[static_cast<std::size_t>(tet_object[static_cast<std::size_t>(t)])] ? 2 : 1;
     detail::ScanCounters sc;
     for (int ti = 0; ti < num_tables; ++ti) {
         const VertexTable& table = tables[ti];
         if (table.size() == 0) continue;
         const TableModulus& mod = table.modulus();
         const std::int32_t* start = table.start.data();
-        // Collect the bucket ranges of the tet, then scan them in one call.
-        ts.ranges.clear();
+        // Bucket ranges collected in a fixed local array and scanned in batches (no per-range call).
+        constexpr int max_ranges = 64;
+        detail::ScanRange ranges[max_ranges];
+        int nr = 0;
         std::size_t total = 0;
+        auto flush = [&]() {
+            if (nr == 0) return;
+            const std::size_t need = ts.used + total;
+            if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
+            ts.used += static_cast<std::size_t>(
+                detail::scan_ranges(table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats));
+            nr = 0;
+            total = 0;
+        };
         auto add = [&](std::int32_t begin, std::int32_t end, std::int32_t x, std::int32_t y, std::int32_t z0,
                        std::int32_t z1) {
             if (begin >= end) return;
-            ts.ranges.push_back({begin, end, x, y, z0, z1});
+            ranges[nr++] = {begin, end, x, y, z0, z1};
             total += static_cast<std::size_t>(end - begin);
+            if (nr == max_ranges) flush();
         };
-        for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
-            for (std::int32_t y = c0[1]; y <= c1[1]; ++y) {
-                if (column) {
-                    const std::uint64_t h = column_mix(x, y);
-                    if (static_cast<std::uint64_t>(nz) >= mod.n) {
-                        add(0, table.size(), x, y, c0[2], c1[2]);
+        if (column && mod.pow2 && static_cast<std::uint64_t>(nz) < mod.n) {
+            // The common case: one contiguous range per column unless it wraps around the table's end.
+            const std::uint64_t mask = mod.mask;
+            const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(c0[2]));
+            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
+                for (std::int32_t y = c0[1]; y <= c1[1]; ++y) {
+                    const std::uint64_t b0 = (column_mix(x, y) + zoff) & mask;
+                    const std::uint64_t e = b0 + static_cast<std::uint64_t>(nz);
+                    if (e <= mod.n) {
+                        add(start[b0], start[e], x, y, c0[2], c1[2]);
                     } else {
-                        const std::uint64_t b0 = mod.column_bucket(h, c0[2]);
-                        const std::uint64_t b1 = b0 + static_cast<std::uint64_t>(nz) - 1;
-                        if (b1 < mod.n) {
-                            add(start[b0], start[b1 + 1], x, y, c0[2], c1[2]);
-                        } else {
-                            add(start[b0], start[mod.n], x, y, c0[2], c1[2]);
-                            add(start[0], start[b1 - mod.n + 1], x, y, c0[2], c1[2]);
-                        }
-                    }
-                } else {
-                    for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
-                        const std::uint64_t bk = mod.reduce(teschner_hash(x, y, z));
-                        add(start[bk], start[bk + 1], x, y, z, z);
+                        add(start[b0], start[mod.n], x, y, c0[2], c1[2]);
+                        add(start[0], start[e - mod.n], x, y, c0[2], c1[2]);
                     }
                 }
-            }
-        if (ts.ranges.empty()) continue;
-        const std::size_t need = ts.used + total;
-        if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4);
-        ts.used += static_cast<std::size_t>(detail::scan_ranges(table, ts.ranges.data(),
-                                                                static_cast<std::int32_t>(ts.ranges.size()), q,
-                                                                ts.candidates.data() + ts.used, sc));
+        } else {
+            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
+                for (std::int32_t y = c0[1]; y <= c1[1]; ++y) {
+                    if (column) {
+                        const std::uint64_t h = column_mix(x, y);
+                        if (static_cast<std::uint64_t>(nz) >= mod.n) {
+                            add(0, table.size(), x, y, c0[2], c1[2]);
+                        } else {
+                            const std::uint64_t b0 = mod.column_bucket(h, c0[2]);
+                            const std::uint64_t b1 = b0 + static_cast<std::uint64_t>(nz) - 1;
+                            if (b1 < mod.n) {
+                                add(start[b0], start[b1 + 1], x, y, c0[2], c1[2]);
+                            } else {
+                                add(start[b0], start[mod.n], x, y, c0[2], c1[2]);
+                                add(start[0], start[b1 - mod.n + 1], x, y, c0[2], c1[2]);
+                            }
+                        }
+                    } else {
+                        for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
+                            const std::uint64_t bk = mod.reduce(teschner_hash(x, y, z));
+                            add(start[bk], start[bk + 1], x, y, z, z);
+                        }
+                    }
+                }
+        }
+        flush();
     }
-    ts.counters.scanned += sc.scanned;
-    ts.counters.collisions += sc.collisions;
-    ts.counters.box_rejections += sc.box_rejections;
-    ts.counters.own += sc.own;
+    if (with_stats) {
+        ts.counters.scanned += sc.scanned;
+        ts.counters.collisions += sc.collisions;
+        ts.counters.box_rejections += sc.box_rejections;
+        ts.counters.own += sc.own;
+    }
     const std::int32_t run_end = static_cast<std::int32_t>(ts.used);
     if (run_end > run_begin) ts.runs.push_back({t, run_begin, run_end});
 }
@@ -486,7 +513,7 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
 
     // Stages 2 and 3, parallel over tets; each thread then tests its own candidates.
     const Index m = static_cast<Index>(tets.size() / 4);
-    const bool count_degenerate = stats != nullptr;
+    const bool with_stats = stats != nullptr;
     for (ThreadState& ts : threads) {
         ts.used = 0;
         ts.runs.clear();
@@ -503,7 +530,7 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
 #endif
         const auto t0 = Clock::now();
 #pragma omp for schedule(dynamic, 256) nowait
-        for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, count_degenerate);
+        for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
         ts.ms_tets = ms_since(t0);
         const auto t1 = Clock::now();
         stage_inside(ts, P);

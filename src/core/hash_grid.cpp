@@ -72,9 +72,7 @@ bool VertexTable::build(const double* positions, const Index* ids, Index count, 
             bad = 1;
             continue;
         }
-        const auto ix = static_cast<std::int32_t>(std::floor(sx));
-        const auto iy = static_cast<std::int32_t>(std::floor(sy));
-        const auto iz = static_cast<std::int32_t>(std::floor(sz));
+        const std::int32_t ix = floor_to_int(sx), iy = floor_to_int(sy), iz = floor_to_int(sz);
         m_cell[3 * i] = ix;
         m_cell[3 * i + 1] = iy;
         m_cell[3 * i + 2] = iz;

@@ -163,7 +163,7 @@ std::vector<std::string> ValidationReport::problems() const
     add(repeated_index, "tets with a repeated vertex");
     add(non_finite, "vertices with a non-finite coordinate");
     add(degenerate_tets, "degenerate (zero-volume) tets");
-    add(inverted_tets, "inverted tets (negative volume; --reorient fixes them)");
+    add(inverted_tets, "inverted tets (negative volume; tethash convert --reorient flips them)");
     add(unreferenced_vertices, "unreferenced vertices");
     add(non_manifold_faces, "non-manifold faces (shared by more than two tets)");
     return out;

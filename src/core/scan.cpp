@@ -102,6 +102,53 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const Verte
     c.own += own;
     return n;
 }
+
+// The lean kernel: box test 8 at a time (the tet's own box, the same for every range), own-vertex test, and the
+// cell test (column and z-range of the range) only for the few box survivors. No statistics.
+__attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const VertexTable& t,
+                                                                           const ScanRange* ranges,
+                                                                           std::int32_t count, const ScanQuery& q,
+                                                                           Index* out, ScanCounters&)
+{
+    const __m256 lx = _mm256_set1_ps(q.lo[0]), ly = _mm256_set1_ps(q.lo[1]), lz = _mm256_set1_ps(q.lo[2]);
+    const __m256 hx = _mm256_set1_ps(q.hi[0]), hy = _mm256_set1_ps(q.hi[1]), hz = _mm256_set1_ps(q.hi[2]);
+    const __m256i o0 = _mm256_set1_epi32(q.own[0]), o1 = _mm256_set1_epi32(q.own[1]);
+    const __m256i o2 = _mm256_set1_epi32(q.own[2]), o3 = _mm256_set1_epi32(q.own[3]);
+    const float* X = t.x.data();
+    const float* Y = t.y.data();
+    const float* Z = t.z.data();
+    const std::int32_t* ID = t.id.data();
+    const std::int32_t* CX = t.cx.data();
+    const std::int32_t* CY = t.cy.data();
+    const std::int32_t* CZ = t.cz.data();
+    std::int32_t n = 0;
+    for (std::int32_t r = 0; r < count; ++r) {
+        const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
+        const std::int32_t rx = ranges[r].cx, ry = ranges[r].cy, z0 = ranges[r].z0;
+        const auto zspan = static_cast<std::uint32_t>(ranges[r].z1 - ranges[r].z0);
+        for (std::int32_t i = begin; i < end; i += 8) {
+            // Lanes past `end` read the next entries or the padding (NaN coordinates): masked off.
+            const int mv = end - i >= 8 ? 0xff : (1 << (end - i)) - 1;
+            const __m256 x = _mm256_loadu_ps(X + i), y = _mm256_loadu_ps(Y + i), z = _mm256_loadu_ps(Z + i);
+            const __m256 inx = _mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ));
+            const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
+            const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
+            const int mb = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(inx, iny), inz)) & mv;
+            if (!mb) continue;
+            const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
+            const __m256i isown = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
+                                                  _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
+            int keep = mb & ~_mm256_movemask_ps(_mm256_castsi256_ps(isown));
+            while (keep) {
+                const std::int32_t j = i + __builtin_ctz(static_cast<unsigned>(keep));
+                keep &= keep - 1;
+                // Entry from this range's cells (not a foreign cell sharing the bucket: a duplicate or a miss).
+                if (CX[j] == rx && CY[j] == ry && static_cast<std::uint32_t>(CZ[j] - z0) <= zspan) out[n++] = ID[j];
+            }
+        }
+    }
+    return n;
+}
 #endif
 
 void filter_scalar(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
@@ -183,6 +230,11 @@ ScanFn choose()
 }
 
 const ScanFn chosen = choose();
+#ifdef TETHASH_X86
+const ScanFn chosen_lean = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean : chosen;
+#else
+const ScanFn chosen_lean = chosen;
+#endif
 const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 #ifdef TETHASH_X86
                                                      : filter_avx2;
@@ -193,9 +245,9 @@ const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 } // namespace
 
 std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
-                         Index* out, ScanCounters& counters)
+                         Index* out, ScanCounters& counters, bool full_counts)
 {
-    return chosen(table, ranges, count, q, out, counters);
+    return (full_counts ? chosen : chosen_lean)(table, ranges, count, q, out, counters);
 }
 
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,

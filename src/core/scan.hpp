@@ -24,9 +24,11 @@ struct ScanRange {
 };
 
 /// Scans every range of `ranges` for the box and own vertices of `q` (q.cx/cy/z0/z1 ignored); appends the ids
-/// to `out` (room for the sum of the range lengths); returns how many.
+/// to `out` (room for the sum of the range lengths); returns how many. With `full_counts` every entry is
+/// classified for `counters` (cell, box, own); without, a leaner kernel tests the box first and the cell only
+/// for box survivors, and leaves `counters` alone. Both append the same ids in the same order.
 std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
-                         Index* out, ScanCounters& counters);
+                         Index* out, ScanCounters& counters, bool full_counts = true);
 
 /// Appends to `out` the ids of the entries [begin, end) of `table` that match `q`; returns how many.
 /// `out` must have room for end − begin ids.

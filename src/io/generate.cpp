@@ -161,16 +161,25 @@ TetMesh generate(const GenerateParams& params)
     const Vec3 to_nat = nat.cwiseQuotient(ext);         // natural units per output unit, per axis
     const double dist_scale = ext.cwiseQuotient(nat).minCoeff();
     std::function<double(const Vec3&)> sdf;
+    std::function<Vec3(const Vec3&, const Vec3&)> project;
     if (params.shape == "box" || params.shape == "bar") {
         const Vec3 half = 0.5 * ext;                      // exact distance for boxes of any size
         sdf = [half](const Vec3& p) { return sd_box(p, half); };
+        // Boundary vertices sit h/8 inside or 3h/8 outside a face (see make_lattice): put every
+        // coordinate that close to a face onto it, so edges and corners get vertices too.
+        project = [half](const Vec3& p, const Vec3& h) {
+            Vec3 q = p;
+            for (int a = 0; a < 3; ++a)
+                if (std::abs(p[a]) > half[a] - 0.45 * h[a]) q[a] = std::copysign(half[a], p[a]);
+            return q;
+        };
     } else {
         sdf = [&shape, nat_centre, to_nat, dist_scale](const Vec3& p) {
             return shape.sdf(nat_centre + p.cwiseProduct(to_nat)) * dist_scale;
         };
     }
     try {
-        return tetrahedralize_sdf(sdf, -0.5 * ext, 0.5 * ext, params.resolution, params.snap);
+        return tetrahedralize_sdf(sdf, -0.5 * ext, 0.5 * ext, params.resolution, params.snap, project);
     } catch (const Error& e) {
         throw Error("generate " + params.shape + " at resolution " + std::to_string(params.resolution) + ": " +
                     e.what());

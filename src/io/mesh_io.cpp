@@ -69,8 +69,10 @@ void write_atomically(const std::string& path, const std::function<void(const st
     const fs::path target(path);
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(dir)) throw Error(path + ": folder '" + dir.string() + "' does not exist");
-    const fs::path tmp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                                std::to_string(counter++));
+    std::string name = target.filename().string(); // appended piecewise: g++ 12 warns falsely on "." + string
+    name.insert(name.begin(), '.');
+    name.append(".tmp").append(std::to_string(::getpid())).append("_").append(std::to_string(counter++));
+    const fs::path tmp = dir / name;
     try {
         write(tmp.string());
         std::error_code ec;

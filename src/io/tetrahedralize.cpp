@@ -543,7 +543,8 @@ void check_surface(const SurfaceMesh& s)
 } // namespace
 
 TetMesh tetrahedralize_sdf(const std::function<double(const Eigen::Vector3d&)>& sdf, const Eigen::Vector3d& box_min,
-                           const Eigen::Vector3d& box_max, int resolution, bool snap)
+                           const Eigen::Vector3d& box_max, int resolution, bool snap,
+                           const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&)>& project)
 {
     const Lattice lat = make_lattice(box_min, box_max, resolution);
     auto inside = [&](const std::vector<Vec3>& pts) {
@@ -555,6 +556,10 @@ TETHASH_OMP("omp parallel for schedule(static)")
     };
     const double hmin = lat.h.minCoeff();
     std::function<bool(const Vec3&, Vec3&)> target = [&](const Vec3& p, Vec3& out) {
+        if (project) {
+            out = project(p, lat.h);
+            return out.allFinite();
+        }
         // Newton steps along the gradient (central differences) onto the zero level set.
         const double eps = 1e-4 * hmin;
         Vec3 x = p;

@@ -3,12 +3,14 @@
 // meshes of ../shared/meshes; and, in the same run, a plain implementation of the 2003 algorithm (per-bucket
 // vertex lists with timestamps, xor-prime hash mod a prime, plain barycentric test) as the baseline.
 //
-//   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--cell-factor F]
+//   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--no-baseline] [--cell-factor F]
+//                 [--hash column|teschner] [--table-factor F]
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/hash_grid.hpp"
 #include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/study/scenarios.hpp"
 
 #include <Eigen/Geometry>
 
@@ -271,11 +273,28 @@ double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& con
     return median(ms);
 }
 
+/// --profile N: N detections without statistics and nothing else, for
+/// `valgrind --tool=callgrind --toggle-collect='*profile_detects*'` (instruction counts independent of load).
+__attribute__((noinline)) std::size_t profile_detects(Detector& det, const TetMesh& m, int calls)
+{
+    std::size_t n = 0;
+    for (int r = 0; r < calls; ++r) n += det.detect(m.positions).size();
+    return n;
+}
+
+double g_table_factor = 0;   ///< --table-factor F (0: automatic table size)
+
 void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline)
 {
     DetectParams p1 = base;
+    if (g_table_factor > 0) {   // --table-factor: the power of two nearest to F × vertices
+        const double want = g_table_factor * m.num_vertices();
+        std::int64_t n = 1;
+        while (static_cast<double>(n) * 1.41421356 < want) n <<= 1;
+        p1.table_size = n;
+    }
     p1.threads = 1;
-    DetectParams pn = base;
+    DetectParams pn = p1;
     pn.threads = threads_all;
     const Measured one = measure(m, p1, repeat);
     const Measured all = measure(m, pn, repeat);
@@ -314,8 +333,8 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
 
 int main(int argc, char** argv)
 {
-    int repeat = 21, threads = 0, only = -1;
-    bool sweep = false, meshes = true;
+    int repeat = 21, threads = 0, only = -1, profile = 0;
+    bool sweep = false, meshes = true, baseline = true;
     double cell_factor = 1.0;
     std::string hash = "column";
     for (int i = 1; i < argc; ++i) {
@@ -332,12 +351,15 @@ int main(int argc, char** argv)
         else if (a == "--scenario") only = std::stoi(next());
         else if (a == "--sweep") sweep = true;
         else if (a == "--no-meshes") meshes = false;
+        else if (a == "--no-baseline") baseline = false;
+        else if (a == "--profile") profile = std::stoi(next());
+        else if (a == "--table-factor") g_table_factor = std::stod(next());
         else if (a == "--cell-factor") cell_factor = std::stod(next());
         else if (a == "--hash") hash = next();
         else {
             std::fprintf(stderr,
                          "usage: tethash_bench [--repeat K] [--threads N] [--scenario 1..5] [--sweep] [--no-meshes] "
-                         "[--cell-factor F] [--hash column|teschner]\n");
+                         "[--no-baseline] [--profile N] [--table-factor F] [--cell-factor F] [--hash column|teschner]\n");
             return 2;
         }
     }
@@ -381,14 +403,26 @@ int main(int argc, char** argv)
         return 0;
     }
 
-    const int scen[5][2] = {{100, 1000}, {8, 4000}, {20, 10000}, {2, 20514}, {100, 50000}};
+    if (profile > 0) {   // one scenario (default 5) at --threads (default 1), N detections, no statistics
+        const study::Scenario sc = study::teschner_scenario(only > 0 ? only - 1 : 4);
+        DetectParams p = base;
+        p.threads = threads > 0 ? threads : 1;
+        Detector det(p);
+        det.set_topology(sc.mesh);
+        det.detect(sc.mesh.positions);
+        const std::size_t n = profile_detects(det, sc.mesh, profile);
+        std::printf("profile: scenario %d, %d detections, %zu contacts in all\n", only > 0 ? only : 5, profile, n);
+        return 0;
+    }
+    // The five scenarios exactly as `tethash study --teschner-scenarios` builds them (study/scenarios.hpp),
+    // so that the benchmark and the study measure the same scenes.
     for (int k = 0; k < 5; ++k) {
         if (only > 0 && only != k + 1) continue;
-        std::string how;
-        const TetMesh m = make_scene(scen[k][0], scen[k][1], 100 + k, how);
-        char name[64];
-        std::snprintf(name, sizeof name, "scenario %d (%s)", k + 1, how.c_str());
-        report(name, m, base, threads_all, repeat, true);
+        const study::Scenario sc = study::teschner_scenario(k);
+        char name[96];
+        std::snprintf(name, sizeof name, "scenario %d (%s r%d; paper %d/%d/%d)", k + 1, sc.shape.c_str(), sc.resolution,
+                      sc.spec.objects, sc.spec.tets, sc.spec.vertices);
+        report(name, sc.mesh, base, threads_all, repeat, baseline);
     }
     if (meshes && only < 0) {
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;
@@ -409,7 +443,7 @@ int main(int argc, char** argv)
                     TetMesh two = one;
                     two.positions.rowwise() += 0.2 * (hi - lo);
                     one.append(two);
-                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), true);
+                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), baseline);
                 } catch (const std::exception& e) {
                     std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
                 }

@@ -48,9 +48,13 @@ TetMesh generate(const GenerateParams& params);
 /// `resolution` cells along the box's longest extent. The function need not be an exact distance
 /// (a sign-correct implicit function with a sensible gradient works; snapping uses Newton steps).
 /// Throws Error for resolution < 1 or > 1000, an empty box, or when nothing is inside.
+/// `project(p, h)`, when given, is where boundary vertex p should go on a lattice of spacing h (per
+/// axis), e.g. onto the edges and corners of a box (a closest-point projection would cut them off).
 TetMesh tetrahedralize_sdf(const std::function<double(const Eigen::Vector3d&)>& sdf,
                            const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max,
-                           int resolution, bool snap);
+                           int resolution, bool snap,
+                           const std::function<Eigen::Vector3d(const Eigen::Vector3d& p, const Eigen::Vector3d& h)>&
+                               project = {});
 
 struct TetrahedralizeParams {
     int resolution = 16;                 ///< lattice cells along the surface's longest bounding-box extent
@@ -62,8 +66,9 @@ struct TetrahedralizeParams {
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeParams& params);
 
 /// Generalized winding number of `surface` at each query point (1 inside a closed outward-oriented
-/// surface, 0 outside, fractional near holes). Hierarchical (far triangle groups as dipoles), so
-/// accurate to about 1e-3 away from the surface; exact near it.
+/// surface, 0 outside, fractional near holes). Hierarchical: triangle groups farther than twice their
+/// radius count as dipoles (first order), which is off by up to a few per cent; that is far from the
+/// 1/2 that decides inside, and triangles near the point are summed exactly.
 std::vector<double> winding_numbers(const SurfaceMesh& surface, const std::vector<Eigen::Vector3d>& points);
 
 } // namespace tethash::io

@@ -1,0 +1,198 @@
+// Tests of io/surface.hpp (assimp bridge) and of tetrahedralize() / winding_numbers() on surfaces.
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/io/generate.hpp"
+#include "tethash/io/surface.hpp"
+#include "tethash/mesh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <numbers>
+
+using namespace tethash;
+using tethash::test::temp_dir;
+
+namespace {
+
+#define SKIP_WITHOUT_ASSIMP() \
+    if (!io::have_assimp()) GTEST_SKIP() << "built without assimp"
+
+io::SurfaceMesh sphere_surface(int resolution)
+{
+    io::GenerateParams p;
+    p.shape = "sphere";
+    p.resolution = resolution;
+    return io::boundary_surface(io::generate(p));
+}
+
+/// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).
+double enclosed_volume(const io::SurfaceMesh& s)
+{
+    double v = 0;
+    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
+        const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)), b = s.vertices.row(s.triangles(t, 1)),
+                              c = s.vertices.row(s.triangles(t, 2));
+        v += a.dot(b.cross(c)) / 6.0;
+    }
+    return v;
+}
+
+double volume(const TetMesh& m) { return volume_stats(m.positions, m.tets).total; }
+
+} // namespace
+
+TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
+{
+    io::GenerateParams p;
+    p.shape = "box";
+    p.resolution = 5;
+    const TetMesh m = io::generate(p);
+    const io::SurfaceMesh s = io::boundary_surface(m);
+    EXPECT_EQ(s.triangles.rows(), boundary_faces(m.tets).rows());
+    EXPECT_LT(s.vertices.rows(), m.num_vertices()); // interior vertices dropped
+    EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);     // outward orientation, closed
+    // Every surface vertex is used.
+    std::vector<int> used(static_cast<std::size_t>(s.vertices.rows()), 0);
+    for (Eigen::Index i = 0; i < s.triangles.size(); ++i) used[static_cast<std::size_t>(s.triangles.data()[i])] = 1;
+    EXPECT_TRUE(std::all_of(used.begin(), used.end(), [](int u) { return u == 1; }));
+}
+
+TEST(Surface, RoundTripThroughEveryWrittenFormat)
+{
+    SKIP_WITHOUT_ASSIMP();
+    const io::SurfaceMesh s = sphere_surface(6);
+    const auto dir = temp_dir();
+    for (const char* ext : {".obj", ".ply", ".stl", ".gltf", ".glb"}) {
+        SCOPED_TRACE(ext);
+        const std::string path = (dir / (std::string("sphere") + ext)).string();
+        io::write_surface(path, s);
+        const io::SurfaceMesh r = io::read_surface(path);
+        ASSERT_EQ(r.triangles.rows(), s.triangles.rows());
+        ASSERT_EQ(r.vertices.rows(), s.vertices.rows()); // shared vertices joined again
+        // Every vertex comes back (to float precision; the order may differ).
+        for (Eigen::Index i = 0; i < s.vertices.rows(); ++i) {
+            double best = 1e300;
+            for (Eigen::Index j = 0; j < r.vertices.rows(); ++j)
+                best = std::min(best, (s.vertices.row(i) - r.vertices.row(j)).norm());
+            ASSERT_LT(best, 1e-6) << "vertex " << i;
+        }
+        EXPECT_NEAR(enclosed_volume(r), enclosed_volume(s), 1e-5); // same orientation
+    }
+    // The .gltf refers to its buffer by the final name, and no temporary is left behind.
+    EXPECT_TRUE(std::filesystem::exists(dir / "sphere.bin"));
+    EXPECT_NE(tethash::test::read_text(dir / "sphere.gltf").find("sphere.bin"), std::string::npos);
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        EXPECT_NE(e.path().filename().string()[0], '.') << e.path();
+}
+
+TEST(Surface, ReadErrorsNameTheFile)
+{
+    SKIP_WITHOUT_ASSIMP();
+    const auto dir = temp_dir();
+    const std::string missing = (dir / "missing.obj").string();
+    try {
+        io::read_surface(missing);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+    }
+    const auto garbage = dir / "garbage.stl";
+    tethash::test::write_text(garbage, "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0\n");
+    try {
+        io::read_surface(garbage.string());
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(garbage.string()), std::string::npos) << e.what();
+    }
+    const auto points = dir / "points.obj"; // vertices only: no triangles
+    tethash::test::write_text(points, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    EXPECT_THROW(io::read_surface(points.string()), Error);
+    EXPECT_THROW(io::write_surface((dir / "x.xyz").string(), sphere_surface(4)), Error);
+}
+
+TEST(Surface, ReadsHandWrittenObjWithQuads)
+{
+    SKIP_WITHOUT_ASSIMP();
+    const auto path = temp_dir() / "cube.obj";
+    tethash::test::write_text(path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                                    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+    const io::SurfaceMesh s = io::read_surface(path.string());
+    EXPECT_EQ(s.triangles.rows(), 12);
+    EXPECT_EQ(s.vertices.rows(), 8);
+    EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);
+    const TetMesh m = io::tetrahedralize(s, {8, true});
+    EXPECT_NEAR(volume(m), 1.0, 0.02);
+    EXPECT_EQ(validate(m).inverted_tets, 0);
+}
+
+TEST(Tetrahedralize, WindingNumbersInsideAndOutside)
+{
+    const io::SurfaceMesh s = sphere_surface(8);
+    const auto w = io::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
+                                           Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
+    // Far triangle groups are dipoles: a few per cent off, far from the 1/2 that decides inside.
+    EXPECT_NEAR(w[0], 1.0, 0.06);
+    EXPECT_NEAR(w[1], 1.0, 0.06);
+    EXPECT_NEAR(w[2], 0.0, 0.06);
+    EXPECT_NEAR(w[3], 0.0, 0.06);
+}
+
+TEST(Tetrahedralize, RecoversTheVolumeOfAGeneratedSphere)
+{
+    const io::SurfaceMesh s = sphere_surface(16);
+    const double expect = enclosed_volume(s);
+    const TetMesh m = io::tetrahedralize(s, {16, true});
+    EXPECT_NEAR(volume(m), expect, 0.03 * expect);
+    const ValidationReport r = validate(m);
+    EXPECT_TRUE(r.ok());
+    EXPECT_EQ(r.inverted_tets, 0);
+    EXPECT_EQ(r.degenerate_tets, 0);
+    EXPECT_EQ(r.unreferenced_vertices, 0);
+    // Deterministic.
+    const TetMesh again = io::tetrahedralize(s, {16, true});
+    EXPECT_TRUE(again.positions == m.positions);
+    EXPECT_TRUE(again.tets == m.tets);
+}
+
+TEST(Tetrahedralize, ToleratesAHoleAndAnInwardOrientation)
+{
+    io::SurfaceMesh s = sphere_surface(12);
+    const double expect = enclosed_volume(s);
+    // Cut two triangles out: a small hole.
+    io::SurfaceMesh holed = s;
+    holed.triangles = s.triangles.bottomRows(s.triangles.rows() - 2);
+    const TetMesh m = io::tetrahedralize(holed, {12, true});
+    EXPECT_NEAR(volume(m), expect, 0.05 * expect);
+    EXPECT_EQ(validate(m).inverted_tets, 0);
+    // Every triangle flipped.
+    io::SurfaceMesh flipped = s;
+    flipped.triangles.col(1).swap(flipped.triangles.col(2));
+    EXPECT_NEAR(volume(io::tetrahedralize(flipped, {12, true})), expect, 0.05 * expect);
+}
+
+TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
+{
+    io::SurfaceMesh tri;
+    tri.vertices.resize(3, 3);
+    tri.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0.5;
+    tri.triangles.resize(1, 3);
+    tri.triangles << 0, 1, 2;
+    try {
+        io::tetrahedralize(tri, {8, true});
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
+    }
+    io::SurfaceMesh empty;
+    EXPECT_THROW(io::tetrahedralize(empty, {8, true}), Error);
+    tri.triangles << 0, 1, 7;
+    try {
+        io::tetrahedralize(tri, {8, true});
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("triangle 0"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(io::tetrahedralize(sphere_surface(4), {0, true}), Error);
+}
