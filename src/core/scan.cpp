@@ -151,6 +151,76 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
 }
 #endif
 
+std::int32_t scan_block_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count,
+                               const BlockQuery& q, BlockHit* out)
+{
+    std::int32_t n = 0;
+    for (std::int32_t r = 0; r < count; ++r) {
+        const ScanRange& R = ranges[r];
+        const auto zspan = static_cast<std::uint32_t>(R.z1 - R.z0);
+        for (std::int32_t i = R.begin; i < R.end; ++i) {
+            if (t.cx[i] != R.cx || t.cy[i] != R.cy || static_cast<std::uint32_t>(t.cz[i] - R.z0) > zspan) continue;
+            const float x = t.x[i], y = t.y[i], z = t.z[i];
+            const Index v = t.id[i];
+            int m = 0;
+            for (int k = 0; k < 8; ++k)
+                if (x >= q.lo[0][k] && x <= q.hi[0][k] && y >= q.lo[1][k] && y <= q.hi[1][k] && z >= q.lo[2][k] &&
+                    z <= q.hi[2][k] && v != q.own[0][k] && v != q.own[1][k] && v != q.own[2][k] && v != q.own[3][k])
+                    m |= 1 << k;
+            if (m) out[n++] = {v, m};
+        }
+    }
+    return n;
+}
+
+#ifdef TETHASH_X86
+// Each entry broadcast against the eight boxes: 6 compares give the lanes whose box holds it, 4 more the lanes
+// it is an own vertex of, and the cell test masks foreign cells. Branch-free per entry (about a third of the
+// entries are inside some box, in no predictable pattern): every entry writes a record, only records with
+// lanes left advance the output.
+__attribute__((target("avx2,popcnt"))) std::int32_t scan_block_avx2(const VertexTable& t, const ScanRange* ranges,
+                                                                     std::int32_t count, const BlockQuery& q,
+                                                                     BlockHit* out)
+{
+    const __m256 lx = _mm256_load_ps(q.lo[0]), ly = _mm256_load_ps(q.lo[1]), lz = _mm256_load_ps(q.lo[2]);
+    const __m256 hx = _mm256_load_ps(q.hi[0]), hy = _mm256_load_ps(q.hi[1]), hz = _mm256_load_ps(q.hi[2]);
+    const __m256i o0 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[0]));
+    const __m256i o1 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[1]));
+    const __m256i o2 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[2]));
+    const __m256i o3 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[3]));
+    const float* X = t.x.data();
+    const float* Y = t.y.data();
+    const float* Z = t.z.data();
+    const std::int32_t* ID = t.id.data();
+    const std::int32_t* CX = t.cx.data();
+    const std::int32_t* CY = t.cy.data();
+    const std::int32_t* CZ = t.cz.data();
+    std::int32_t n = 0;
+    for (std::int32_t r = 0; r < count; ++r) {
+        const ScanRange& R = ranges[r];
+        const std::int32_t rx = R.cx, ry = R.cy, z0 = R.z0;
+        const auto zspan = static_cast<std::uint32_t>(R.z1 - R.z0);
+        for (std::int32_t i = R.begin; i < R.end; ++i) {
+            const __m256 x = _mm256_broadcast_ss(X + i), y = _mm256_broadcast_ss(Y + i), z = _mm256_broadcast_ss(Z + i);
+            const __m256 in = _mm256_and_ps(
+                _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ)),
+                              _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ))),
+                _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ)));
+            const Index v = ID[i];
+            const __m256i vv = _mm256_set1_epi32(v);
+            const __m256i own = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(vv, o0), _mm256_cmpeq_epi32(vv, o1)),
+                                                _mm256_or_si256(_mm256_cmpeq_epi32(vv, o2), _mm256_cmpeq_epi32(vv, o3)));
+            // Only entries of this range's cells (a foreign cell sharing the bucket would be a duplicate or a miss).
+            const int cell = (CX[i] == rx) & (CY[i] == ry) & (static_cast<std::uint32_t>(CZ[i] - z0) <= zspan);
+            const int m = _mm256_movemask_ps(_mm256_andnot_ps(_mm256_castsi256_ps(own), in)) & -cell;
+            out[n] = {v, m};
+            n += m != 0;
+        }
+    }
+    return n;
+}
+#endif
+
 void filter_scalar(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
                    std::int8_t* code)
 {
@@ -261,6 +331,15 @@ void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, 
                        std::int8_t* code)
 {
     chosen_filter(f, P, cand, count, val, code);
+}
+
+std::int32_t scan_block(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const BlockQuery& q,
+                        BlockHit* out)
+{
+#ifdef TETHASH_X86
+    if (chosen == scan_ranges_avx2) return scan_block_avx2(table, ranges, count, q, out);
+#endif
+    return scan_block_scalar(table, ranges, count, q, out);
 }
 
 const char* scan_kernel_name() { return chosen == scan_ranges_scalar ? "scalar" : "avx2"; }

@@ -35,6 +35,26 @@ std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std:
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
                                Index* out, ScanCounters& counters);
 
+/// Eight tets scanned together (stage 2, block path): lane k is one tet (float box relative to the table origin,
+/// own vertex ids); lanes without a tet have an empty box (lo = +inf, hi = −inf).
+struct alignas(32) BlockQuery {
+    float lo[3][8], hi[3][8];
+    Index own[4][8];
+};
+
+/// One hit of the block scan: vertex `vertex` lies in the boxes of the lanes set in `lanes` (bit k: lane k) and is
+/// not one of their own vertices.
+struct BlockHit {
+    Index vertex;
+    std::int32_t lanes;
+};
+
+/// Scans every range of `ranges` (each: the bucket range of one column and the block's z-range) once for all
+/// eight lanes of `q`: an entry of the range's column and z-range is tested against the eight boxes at once.
+/// Appends to `out` (room for the sum of the range lengths + 1) and returns how many hits.
+std::int32_t scan_block(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const BlockQuery& q,
+                        BlockHit* out);
+
 /// "avx2" or "scalar": the version scan_bucket_range uses (environment TETHASH_SIMD=scalar forces scalar).
 const char* scan_kernel_name();
 

@@ -50,6 +50,7 @@ struct XmlElement {
     std::vector<std::pair<std::string, std::string>> attrs;
     std::vector<XmlElement> children;
     std::vector<std::pair<std::size_t, std::size_t>> text;   ///< [begin, end) byte ranges of direct text
+    std::vector<std::int64_t> text_line;                      ///< line at the start of each text range
     std::int64_t line = 0;
 
     const std::string* attr(std::string_view key) const
@@ -168,7 +169,10 @@ XmlDocument XmlParser::parse()
             }
             break;
         }
-        if (!stack.empty() && lt > m_pos) stack.back()->text.emplace_back(m_pos, lt);
+        if (!stack.empty() && lt > m_pos) {
+            stack.back()->text.emplace_back(m_pos, lt);
+            stack.back()->text_line.push_back(m_line);
+        }
         advance_to(lt);
         if (starts("<?")) {
             skip_past("?>", "a processing instruction");
@@ -176,8 +180,12 @@ XmlDocument XmlParser::parse()
             skip_past("-->", "a comment");
         } else if (starts("<![CDATA[")) {
             const std::size_t b = m_pos + 9;
+            const std::int64_t line = m_line;
             skip_past("]]>", "a CDATA section");
-            if (!stack.empty()) stack.back()->text.emplace_back(b, m_pos - 3);
+            if (!stack.empty()) {
+                stack.back()->text.emplace_back(b, m_pos - 3);
+                stack.back()->text_line.push_back(line);
+            }
         } else if (starts("<!")) {
             skip_past(">", "a declaration");
         } else if (starts("</")) {
@@ -320,19 +328,15 @@ std::string VtuReader::at_value(const XmlElement& da, std::size_t k) const
 {
     const std::string* format = da.attr("format");
     if (!format || *format != "ascii") return at_line(da.line) + ": " + array_label(da) + ", value " + std::to_string(k);
-    // Count lines up to the k-th token of the text (error path only).
-    std::int64_t line = da.line;
-    std::size_t scanned = da.text.empty() ? 0 : da.text.front().first;
-    // Lines from the tag to the text start.
-    std::size_t tag_pos = scanned;
-    while (tag_pos > 0 && m_data[tag_pos - 1] != '<') --tag_pos;
-    for (std::size_t p = tag_pos; p < scanned; ++p)
-        if (m_data[p] == '\n') ++line;
+    // Find the line of the k-th token of the text (error path only).
     std::size_t count = 0;
-    for (const auto& [b, e] : da.text) {
-        for (std::size_t p = std::max(b, scanned); p < e;) {
-            if (m_data[p] == '\n') ++line;
+    std::int64_t line = da.line;
+    for (std::size_t r = 0; r < da.text.size(); ++r) {
+        const auto [b, e] = da.text[r];
+        line = da.text_line[r];
+        for (std::size_t p = b; p < e;) {
             if (is_space(m_data[p])) {
+                if (m_data[p] == '\n') ++line;
                 ++p;
                 continue;
             }
@@ -340,7 +344,6 @@ std::string VtuReader::at_value(const XmlElement& da, std::size_t k) const
             while (p < e && !is_space(m_data[p])) ++p;
             ++count;
         }
-        scanned = e;
     }
     return at_line(line);
 }
@@ -351,18 +354,11 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
     std::vector<T> out;
     out.reserve(std::min(expected, m_data.size() / 2 + 1));   // a count from a broken file may be huge
     std::int64_t line = da.line;
-    std::size_t prev = da.text.empty() ? 0 : da.text.front().first;
-    {
-        std::size_t tag_pos = prev;
-        while (tag_pos > 0 && m_data[tag_pos - 1] != '<') --tag_pos;
-        for (std::size_t p = tag_pos; p < prev; ++p)
-            if (m_data[p] == '\n') ++line;
-    }
     std::size_t count = 0;
     std::int64_t last_line = line;
-    for (const auto& [b, e] : da.text) {
-        for (std::size_t p = prev; p < b; ++p)
-            if (m_data[p] == '\n') ++line;
+    for (std::size_t r = 0; r < da.text.size(); ++r) {
+        const auto [b, e] = da.text[r];
+        line = da.text_line[r];
         std::size_t p = b;
         while (p < e) {
             if (is_space(m_data[p])) {
@@ -377,11 +373,15 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
             if (count >= expected) {
                 // Count the rest for the message.
                 std::size_t total = count;
-                for (std::size_t q = s; q < m_data.size() && q < da.text.back().second;) {
-                    while (q < m_data.size() && is_space(m_data[q])) ++q;
-                    if (q >= da.text.back().second) break;
-                    ++total;
-                    while (q < m_data.size() && !is_space(m_data[q]) && m_data[q] != '<') ++q;
+                for (const auto& [rb, re] : da.text) {
+                    for (std::size_t q = std::max(rb, s); q < re;) {
+                        if (is_space(m_data[q])) {
+                            ++q;
+                            continue;
+                        }
+                        ++total;
+                        while (q < re && !is_space(m_data[q])) ++q;
+                    }
                 }
                 fail(at_line(line), "expected " + std::to_string(expected) + " values in " + what + ", found " +
                                         std::to_string(total));
@@ -401,7 +401,6 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
             }
             ++count;
         }
-        prev = e;
     }
     if (count != expected)
         fail(at_line(last_line), "expected " + std::to_string(expected) + " values in " + what + ", found " + std::to_string(count));
@@ -479,9 +478,10 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
     const auto h = header_words(3);
     const std::int64_t nblocks = h[0], block_size = h[1], last_size = h[2];
     const std::int64_t last = nblocks > 0 && last_size == 0 ? block_size : last_size;
-    const std::int64_t total = nblocks > 0 ? (nblocks - 1) * block_size + last : 0;
-    if (nblocks < 0 || block_size < 0 || last < 0 || last > block_size || nblocks > (1 << 30) ||
-        total != static_cast<std::int64_t>(expected_bytes))
+    const bool sane = nblocks >= 0 && nblocks <= (1 << 30) && block_size >= 0 && block_size <= (std::int64_t(1) << 32) &&
+                      last >= 0 && last <= block_size;
+    const std::int64_t total = sane && nblocks > 0 ? (nblocks - 1) * block_size + last : 0;
+    if (!sane || total != static_cast<std::int64_t>(expected_bytes))
         fail(raw ? at_byte(header_pos) : at_line(da.line),
              "expected the compressed block header of " + what + " to give " + std::to_string(expected_bytes) +
                  " bytes, found " + std::to_string(nblocks) + " blocks of " + std::to_string(block_size) +

@@ -160,7 +160,7 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
             if (pen <= 0) continue;
             const Vec3 vi = row(v, i);
             const double vn = nrm.dot(vi);
-            const double fn = std::max(0.0, opt.ground_scale * (ground.stiffness * pen - ground.damping * vn));
+            const double fn = std::max(0.0, opt.ground_scale * (ground_k_at(i) * pen - ground_c_at(i) * vn));
             Vec3 force = fn * nrm;
             if (ground.friction > 0) {
                 const Vec3 vt = vi - vn * nrm;
@@ -185,7 +185,7 @@ Energy Model::energy(const Positions& x, const Positions& v) const
         en.gravity -= mass[static_cast<size_t>(i)] * gravity.dot(row(x, i));
         if (ground.enabled) {
             const double pen = ground.height - ground.normal.dot(row(x, i));
-            if (pen > 0) en.ground += 0.5 * ground.stiffness * pen * pen;
+            if (pen > 0) en.ground += 0.5 * ground_k_at(i) * pen * pen;
         }
     }
     for (Index e = 0; e < springs.edges.rows(); ++e) {
@@ -238,13 +238,19 @@ double Model::omega_max_sq(const Positions& x) const
 
 double Model::explicit_dt_limit(const Positions& x, double extra_k) const
 {
+    return explicit_dt_limit(x, std::vector<double>(mass.size(), extra_k), {});
+}
+
+double Model::explicit_dt_limit(const Positions& x, const std::vector<double>& extra_k,
+                                const std::vector<double>& extra_c) const
+{
     std::vector<double> ksum, csum;
     gershgorin(*this, x, ksum, csum);
     double limit = std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < mass.size(); ++i) {
         if (fixed[i]) continue;
-        const double w2 = (ksum[i] + 2 * extra_k) / mass[i];
-        const double gam = csum[i] / mass[i];
+        const double w2 = (ksum[i] + 2 * (i < extra_k.size() ? extra_k[i] : 0.0)) / mass[i];
+        const double gam = (csum[i] + 2 * (i < extra_c.size() ? extra_c[i] : 0.0)) / mass[i];
         if (w2 <= 0 && gam <= 0) continue;
         const double h = w2 > 0 ? (-gam + std::sqrt(gam * gam + 4 * w2)) / w2 : 2.0 / gam;
         limit = std::min(limit, h);
@@ -289,7 +295,7 @@ void Model::add_matrix_triplets(const Positions& x, double scale_k, double scale
         const Mat3 nn = ground.normal * ground.normal.transpose();
         for (Index i = 0; i < num_vertices(); ++i)
             if (ground.height - ground.normal.dot(row(x, i)) > 0)
-                add_block(i, i, (scale_k * ground.stiffness + scale_c * ground.damping) * nn);
+                add_block(i, i, (scale_k * ground_k_at(i) + scale_c * ground_c_at(i)) * nn);
     }
 }
 
@@ -332,10 +338,10 @@ void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, con
         }
     }
     if (ground.enabled) {
-        const double s = scale_k * ground.stiffness + scale_c * ground.damping;
         for (Index i = 0; i < num_vertices(); ++i)
             if (free(i) && ground.height - ground.normal.dot(row(x, i)) > 0)
-                out.segment<3>(3 * i) += s * ground.normal * ground.normal.dot(pv(i));
+                out.segment<3>(3 * i) += (scale_k * ground_k_at(i) + scale_c * ground_c_at(i)) * ground.normal *
+                                         ground.normal.dot(pv(i));
     }
 }
 
@@ -358,10 +364,10 @@ void Model::add_matrix_diagonal(const Positions& x, double scale_k, double scale
         }
     }
     if (ground.enabled) {
-        const double s = scale_k * ground.stiffness + scale_c * ground.damping;
         for (Index i = 0; i < num_vertices(); ++i)
             if (free(i) && ground.height - ground.normal.dot(row(x, i)) > 0)
-                diag.segment<3>(3 * i) += s * ground.normal.cwiseProduct(ground.normal);
+                diag.segment<3>(3 * i) +=
+                    (scale_k * ground_k_at(i) + scale_c * ground_c_at(i)) * ground.normal.cwiseProduct(ground.normal);
     }
 }
 

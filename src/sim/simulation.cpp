@@ -92,7 +92,13 @@ public:
     Penetration penetration;
     std::vector<Contact> contacts;
     std::vector<double> contact_weight;  // 1 / number of contacts of (vertex, object)
-    double kc = 0, cc = 0, mu = 0;
+    std::vector<double> contact_k, contact_c, contact_mred;  // per contact: stiffness, damping, reduced mass
+    std::vector<double> object_k;        // per object: stiffest spring (0 for static objects)
+    double mu = 0;
+    double msum = 0;                     // total free mass
+    Vec3 centre0{0, 0, 0};               // bounding box centre at start
+    double radius0 = 0;                  // half the bounding box diagonal at start
+    double speed_bound = 0;              // no vertex can reach this speed on the energy available at start
     StepStats stats;
     std::vector<std::string> warnings;
     std::int64_t steps_done = 0;
@@ -109,7 +115,12 @@ public:
 
     explicit SimulationImpl(const Scene& s);
     void detect_and_respond(double& ms_detect, double& ms_response);
-    void add_contact_forces(const Positions& x, const Positions& vel, Positions& f, double k_scale) const;
+    /// Penalty + friction forces of the contacts for a step h (friction capped so that it cannot reverse a
+    /// relative sliding velocity within h). `cap`: each contact's stiffness and damping also capped at the
+    /// explicit limit of h (local/global, where contacts are explicit).
+    void add_contact_forces(const Positions& vel, Positions& f, double h, bool cap) const;
+    double pair_stiffness(Index a, Index b) const;
+    void contact_coefficients();
     void add_contact_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const;
     double contact_energy() const;
     void contact_apply(double scale_k, double scale_c, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
@@ -119,6 +130,7 @@ public:
     void substep_local_global(double h);
     void setup_local_global(double h);
     bool state_finite() const;
+    std::string check_state(double t_end) const;
     std::string likely_cause(double h) const;
 };
 
@@ -183,11 +195,14 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         for (Index i = obj_vertices[k].first; i < obj_vertices[k].first + obj_vertices[k].second; ++i)
             if (!model.fixed[static_cast<size_t>(i)]) v.row(i) = scene.objects[k].velocity.transpose();
 
-    // Masses of free vertices; automatic contact parameters.
-    double kmax = 0, msum = 0;
+    // Masses of free vertices; stiffest spring of each object (for the automatic contact stiffness).
     std::int64_t nfree = 0;
     min_free_mass = std::numeric_limits<double>::infinity();
-    for (double k : model.springs.k) kmax = std::max(kmax, k);
+    object_k.assign(scene.objects.size(), 0.0);
+    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
+        double& ko = object_k[static_cast<size_t>(mesh.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
+        ko = std::max(ko, model.springs.k[static_cast<size_t>(e)]);
+    }
     for (Index i = 0; i < n; ++i)
         if (!model.fixed[static_cast<size_t>(i)]) {
             msum += model.mass[static_cast<size_t>(i)];
@@ -196,14 +211,22 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         }
     mean_free_mass = nfree ? msum / static_cast<double>(nfree) : 1.0;
     if (!nfree) min_free_mass = 1.0;
-    if (kmax == 0) kmax = 1e4;
-    kc = scene.contact.stiffness > 0 ? scene.contact.stiffness : 10 * kmax;
-    cc = scene.contact.damping > 0 ? scene.contact.damping : std::sqrt(kc * mean_free_mass);
     mu = scene.contact.friction;
+    // Ground: automatic stiffness per vertex = the contact stiffness of its object against a partner as stiff
+    // as itself (10 × its stiffest spring), automatic damping per vertex sqrt(k m) (half critical).
     model.ground = scene.ground;
-    if (model.ground.enabled) {
-        if (!(model.ground.stiffness > 0)) model.ground.stiffness = kc;
-        if (!(model.ground.damping > 0)) model.ground.damping = std::sqrt(model.ground.stiffness * mean_free_mass);
+    if (model.ground.enabled && (!(model.ground.stiffness > 0) || !(model.ground.damping > 0))) {
+        model.ground_k.assign(static_cast<size_t>(n), model.ground.stiffness);
+        model.ground_c.assign(static_cast<size_t>(n), model.ground.damping);
+        for (Index i = 0; i < n; ++i) {
+            const size_t o = static_cast<size_t>(mesh.vertex_object[static_cast<size_t>(i)]);
+            double& k = model.ground_k[static_cast<size_t>(i)];
+            if (!(k > 0)) k = scene.contact.stiffness > 0 ? scene.contact.stiffness : pair_stiffness(static_cast<Index>(o), static_cast<Index>(o));
+            double& c = model.ground_c[static_cast<size_t>(i)];
+            if (!(c > 0)) c = std::sqrt(k * model.mass[static_cast<size_t>(i)]);
+        }
+        if (model.ground.stiffness > 0) model.ground_k.clear();
+        if (model.ground.damping > 0) model.ground_c.clear();
     }
 
     // Detection only when some pair can collide.
@@ -220,11 +243,28 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         penetration.set_topology(mesh);
     }
 
-    // Stability limit of the explicit integrator (springs, volumes, damping, and the stiffer of contact/ground).
+    // Stability limit of the explicit integrator (springs, volumes, damping, and per vertex the stiffer of its
+    // stiffest possible contact and the ground, with their damping).
     const double h = scene.dt / scene.substeps;
-    double extra = detect_enabled ? kc : 0.0;
-    if (model.ground.enabled) extra = std::max(extra, model.ground.stiffness);
-    dt_limit = model.explicit_dt_limit(mesh.positions, extra);
+    {
+        std::vector<double> extra_k(static_cast<size_t>(n), 0.0), extra_c(static_cast<size_t>(n), 0.0);
+        const Index nobj = static_cast<Index>(scene.objects.size());
+        std::vector<double> obj_contact_k(static_cast<size_t>(nobj), 0.0);
+        if (detect_enabled)
+            for (Index a = 0; a < nobj; ++a)
+                for (Index b = 0; b < nobj; ++b)
+                    if ((a != b || scene.objects[static_cast<size_t>(a)].self_collision) &&
+                        !(scene.objects[static_cast<size_t>(a)].is_static && scene.objects[static_cast<size_t>(b)].is_static))
+                        obj_contact_k[static_cast<size_t>(a)] = std::max(obj_contact_k[static_cast<size_t>(a)], pair_stiffness(a, b));
+        for (Index i = 0; i < n; ++i) {
+            const size_t u = static_cast<size_t>(i);
+            double k = obj_contact_k[static_cast<size_t>(mesh.vertex_object[u])];
+            if (model.ground.enabled) k = std::max(k, model.ground_k_at(i));
+            extra_k[u] = k;
+            extra_c[u] = scene.contact.damping > 0 && !model.ground.enabled ? scene.contact.damping : std::sqrt(k * model.mass[u]);
+        }
+        dt_limit = model.explicit_dt_limit(mesh.positions, extra_k, extra_c);
+    }
     if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
         warnings.push_back("time step " + num(h) + " s (dt/substeps) exceeds the explicit stability limit ≈ " +
                            num(dt_limit) + " s estimated from the largest stiffness/mass ratio; symplectic_euler "
@@ -234,6 +274,8 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     const Energy e0 = model.energy(mesh.positions, v);
     const auto [lo, hi] = bounding_box(mesh.positions);
     double extent = (hi - lo).norm();
+    centre0 = 0.5 * (lo + hi);
+    radius0 = 0.5 * extent;
     if (model.ground.enabled) extent += std::abs(model.ground.normal.dot(lo) - model.ground.height);
     energy_ref = e0.internal() + msum * model.gravity.norm() * extent;
     if (detect_enabled) {
@@ -242,6 +284,46 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     }
     energy_ref += contact_energy();
     energy_ref = std::max(energy_ref, 1e-12 * std::max(1.0, msum));
+    // Fastest any vertex can move if all the energy the blow-up test allows went into it.
+    speed_bound = std::sqrt(2 * 1e3 * energy_ref / min_free_mass);
+}
+
+double SimulationImpl::pair_stiffness(Index a, Index b) const
+{
+    // 10 × the harmonic mean of the stiffest springs of the two objects: dominated by the softer one, so a
+    // very stiff object pressing on a soft one gets a contact about as stiff as the soft one can bear. A static
+    // object (no springs) counts as stiff as its partner.
+    if (scene.contact.stiffness > 0) return scene.contact.stiffness;
+    double ka = object_k[static_cast<size_t>(a)], kb = object_k[static_cast<size_t>(b)];
+    if (!(ka > 0)) ka = kb;
+    if (!(kb > 0)) kb = ka;
+    if (!(ka > 0)) return 1e4;   // two objects without springs (cannot happen for a contact the detector reports)
+    return 10 * 2 * ka * kb / (ka + kb);
+}
+
+void SimulationImpl::contact_coefficients()
+{
+    const size_t nc = contacts.size();
+    contact_k.resize(nc);
+    contact_c.resize(nc);
+    contact_mred.resize(nc);
+    for (size_t q = 0; q < nc; ++q) {
+        const Contact& c = contacts[q];
+        contact_k[q] = pair_stiffness(mesh.vertex_object[static_cast<size_t>(c.vertex)], c.tet_object);
+        // Reduced mass of the vertex and the penetrated tet's point (fixed vertices have infinite mass).
+        double inv_v = model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
+        double mt = 0;
+        bool tet_fixed = false;
+        for (int k = 0; k < 4; ++k) {
+            const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
+            if (model.fixed[j] && c.bary[k] > 0.25) tet_fixed = true;
+            mt += c.bary[k] * model.mass[j];
+        }
+        const double inv_t = tet_fixed || !(mt > 0) ? 0.0 : 1.0 / mt;
+        const double inv = inv_v + inv_t;
+        contact_mred[q] = inv > 0 ? 1.0 / inv : 0.0;
+        contact_c[q] = scene.contact.damping > 0 ? scene.contact.damping : std::sqrt(contact_k[q] * contact_mred[q]);
+    }
 }
 
 void SimulationImpl::detect_and_respond(double& ms_detect, double& ms_response)
@@ -249,6 +331,7 @@ void SimulationImpl::detect_and_respond(double& ms_detect, double& ms_response)
     if (!detect_enabled) {
         contacts.clear();
         contact_weight.clear();
+        contact_coefficients();
         return;
     }
     auto t0 = Clock::now();
@@ -257,6 +340,7 @@ void SimulationImpl::detect_and_respond(double& ms_detect, double& ms_response)
     t0 = Clock::now();
     contacts.assign(found.begin(), found.end());
     penetration.compute(mesh.positions, contacts);
+    contact_coefficients();
     // Weight: a vertex inside k tets of one object (on shared faces) gets 1/k of the response from each.
     contact_weight.assign(contacts.size(), 1.0);
     for (size_t a = 0; a < contacts.size();) {
@@ -272,9 +356,8 @@ void SimulationImpl::detect_and_respond(double& ms_detect, double& ms_response)
     ms_response += ms_since(t0);
 }
 
-void SimulationImpl::add_contact_forces(const Positions& x, const Positions& vel, Positions& f, double k_scale) const
+void SimulationImpl::add_contact_forces(const Positions& vel, Positions& f, double h, bool cap) const
 {
-    (void)x;
     for (size_t q = 0; q < contacts.size(); ++q) {
         const Contact& c = contacts[q];
         if (!(c.depth > 0)) continue;
@@ -283,12 +366,18 @@ void SimulationImpl::add_contact_forces(const Positions& x, const Positions& vel
         for (int k = 0; k < 4; ++k) vrel -= c.bary[k] * vel.row(mesh.tets(c.tet, k)).transpose();
         const double vn = vrel.dot(nrm);
         const double w = contact_weight[q];
-        const double fn = w * std::max(0.0, k_scale * (kc * c.depth - cc * vn));
+        double scale = 1.0;
+        if (cap && contact_k[q] > 0) scale = std::min(1.0, 0.5 * contact_mred[q] / (h * h * contact_k[q]));
+        const double fn = w * std::max(0.0, scale * (contact_k[q] * c.depth - contact_c[q] * vn));
         Vec3 force = fn * nrm;
         if (mu > 0 && fn > 0) {
+            // Coulomb friction along the relative tangential velocity, smoothed below 1 mm/s and capped so
+            // that it cannot reverse the relative sliding in one step.
             const Vec3 vt = vrel - vn * nrm;
             const double speed = vt.norm();
-            if (speed > 0) force -= mu * fn * std::min(1.0, speed / 1e-3) * vt / speed;
+            double ft = mu * fn * std::min(1.0, speed / 1e-3);
+            if (h > 0 && contact_mred[q] > 0) ft = std::min(ft, w * contact_mred[q] * speed / h);
+            if (speed > 0) force -= ft * vt / speed;
         }
         f.row(c.vertex) += force.transpose();
         for (int k = 0; k < 4; ++k) f.row(mesh.tets(c.tet, k)) -= c.bary[k] * force.transpose();
@@ -301,7 +390,7 @@ void SimulationImpl::add_contact_triplets(double scale_k, double scale_c, std::v
         const Contact& c = contacts[q];
         if (!(c.depth > 0)) continue;
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
-        const Mat3 nn = contact_weight[q] * (scale_k * kc + scale_c * cc) * nrm * nrm.transpose();
+        const Mat3 nn = contact_weight[q] * (scale_k * contact_k[q] + scale_c * contact_c[q]) * nrm * nrm.transpose();
         const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2), mesh.tets(c.tet, 3)};
         const double coef[5] = {1.0, -c.bary[0], -c.bary[1], -c.bary[2], -c.bary[3]};
         for (int a = 0; a < 5; ++a) {
@@ -321,11 +410,43 @@ double SimulationImpl::contact_energy() const
 {
     double e = 0;
     for (size_t q = 0; q < contacts.size(); ++q)
-        if (contacts[q].depth > 0) e += 0.5 * contact_weight[q] * kc * contacts[q].depth * contacts[q].depth;
+        if (contacts[q].depth > 0) e += 0.5 * contact_weight[q] * contact_k[q] * contacts[q].depth * contacts[q].depth;
     return e;
 }
 
 bool SimulationImpl::state_finite() const { return mesh.positions.allFinite() && v.allFinite(); }
+
+std::string SimulationImpl::check_state(double t_end) const
+{
+    // Cheap per-substep divergence test (O(n)): finite state, every free vertex within the distance it could
+    // have travelled on the energy available at start (with margin), and a kinetic energy below the bound of
+    // the per-step energy test. Catches a blow-up before positions become so large that detection fails.
+    const Index n = mesh.num_vertices();
+    const double g = model.gravity.norm();
+    const double reach = 10 * (radius0 + speed_bound * t_end + 0.5 * g * t_end * t_end) + 1.0;
+    double kinetic = 0, far = 0;
+    Index far_vertex = -1;
+    for (Index i = 0; i < n; ++i) {
+        if (model.fixed[static_cast<size_t>(i)]) continue;
+        const Vec3 xi = mesh.positions.row(i).transpose(), vi = v.row(i).transpose();
+        if (!xi.allFinite() || !vi.allFinite())
+            return "vertex " + std::to_string(i) + " has a non-finite position or velocity (NaN/Inf)";
+        const double d = (xi - centre0).norm();
+        if (d > far) {
+            far = d;
+            far_vertex = i;
+        }
+        kinetic += 0.5 * model.mass[static_cast<size_t>(i)] * vi.squaredNorm();
+    }
+    if (far > reach)
+        return "vertex " + std::to_string(far_vertex) + " is " + num(far) + " from the scene centre, beyond the " +
+               num(reach) + " it could reach on the energy available at start";
+    const double kinetic_bound = 1e3 * energy_ref + msum * g * (reach + radius0);
+    if (kinetic > kinetic_bound)
+        return "the kinetic energy grew to " + num(kinetic) + ", " + num(kinetic / energy_ref) +
+               " times all the energy available at start";
+    return {};
+}
 
 void SimulationImpl::substep_symplectic(double h)
 {
@@ -334,7 +455,7 @@ void SimulationImpl::substep_symplectic(double h)
     Model::ForceOptions opt;
     opt.h = h;
     model.add_forces(mesh.positions, v, f, opt);
-    add_contact_forces(mesh.positions, v, f, 1.0);
+    add_contact_forces(v, f, h, false);
     for (Index i = 0; i < n; ++i) {
         if (model.fixed[static_cast<size_t>(i)]) continue;
         v.row(i) += h / model.mass[static_cast<size_t>(i)] * f.row(i);
@@ -354,7 +475,7 @@ void SimulationImpl::contact_apply(double scale_k, double scale_c, const Eigen::
         double jp = 0;
         for (int a = 0; a < 5; ++a)
             if (free(node[a])) jp += coef[a] * nrm.dot(p.segment<3>(3 * node[a]));
-        const Vec3 y = contact_weight[q] * (scale_k * kc + scale_c * cc) * jp * nrm;
+        const Vec3 y = contact_weight[q] * (scale_k * contact_k[q] + scale_c * contact_c[q]) * jp * nrm;
         for (int a = 0; a < 5; ++a)
             if (free(node[a])) out.segment<3>(3 * node[a]) += coef[a] * y;
     }
@@ -368,7 +489,7 @@ void SimulationImpl::contact_diagonal(double scale_k, double scale_c, Eigen::Vec
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
         const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2), mesh.tets(c.tet, 3)};
         const double coef[5] = {1.0, -c.bary[0], -c.bary[1], -c.bary[2], -c.bary[3]};
-        const double s = contact_weight[q] * (scale_k * kc + scale_c * cc);
+        const double s = contact_weight[q] * (scale_k * contact_k[q] + scale_c * contact_c[q]);
         for (int a = 0; a < 5; ++a)
             if (!model.fixed[static_cast<size_t>(node[a])])
                 diag.segment<3>(3 * node[a]) += coef[a] * coef[a] * s * nrm.cwiseProduct(nrm);
@@ -385,7 +506,7 @@ int SimulationImpl::substep_implicit(double h)
     Model::ForceOptions opt;
     opt.h = h;
     model.add_forces(mesh.positions, v, f, opt);
-    add_contact_forces(mesh.positions, v, f, 1.0);
+    add_contact_forces(v, f, h, false);
     const bool cin = scene.contact.in_matrix;
     const Eigen::VectorXd vflat = Eigen::Map<const Eigen::VectorXd>(v.data(), N);
     Eigen::VectorXd cv = Eigen::VectorXd::Zero(N);
@@ -503,11 +624,13 @@ void SimulationImpl::substep_local_global(double h)
     opt.h = h;
     opt.volume_scale = lg_vol_scale;
     if (model.ground.enabled) {
-        const double lim = 0.5 * min_free_mass / (h * h);
-        opt.ground_scale = std::min(1.0, lim / model.ground.stiffness);
+        double ratio = 0;   // largest ground stiffness / mass
+        for (Index i = 0; i < n; ++i)
+            if (!model.fixed[static_cast<size_t>(i)]) ratio = std::max(ratio, model.ground_k_at(i) / model.mass[static_cast<size_t>(i)]);
+        if (ratio > 0) opt.ground_scale = std::min(1.0, 0.5 / (h * h * ratio));
     }
     model.add_forces(mesh.positions, v, f, opt);
-    add_contact_forces(mesh.positions, v, f, std::min(1.0, 0.5 * min_free_mass / (h * h) / kc));
+    add_contact_forces(v, f, h, true);
     const Positions xn = mesh.positions;
     Positions y = xn;
     for (Index i = 0; i < n; ++i)
@@ -548,11 +671,14 @@ std::string SimulationImpl::likely_cause(double h) const
     if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
         return "the time step " + num(h) + " s exceeds the explicit stability limit ≈ " + num(dt_limit) +
                " s (stiffness/mass too high for symplectic_euler): use substeps, a smaller dt or implicit_euler";
-    double depth = 0;
-    for (const Contact& c : contacts)
-        if (c.depth > depth) depth = c.depth;
+    double depth = 0, kmax = 0;
+    for (size_t q = 0; q < contacts.size(); ++q)
+        if (contacts[q].depth > depth) {
+            depth = contacts[q].depth;
+            kmax = std::max(kmax, contact_k[q]);
+        }
     if (depth > 0)
-        return "contact response (max penetration " + num(depth) + ", contact stiffness " + num(kc) +
+        return "contact response (max penetration " + num(depth) + ", contact stiffness up to " + num(kmax) +
                "): lower contact.stiffness or dt, or raise substeps";
     return "stiffness too high for the time step " + num(h) + " s (explicit limit ≈ " + num(dt_limit) +
            " s): lower dt, raise substeps or use implicit_euler";
@@ -572,18 +698,24 @@ void Simulation::step()
     const double h = s.scene.dt / s.scene.substeps;
     StepStats st;
     const std::int64_t step_no = s.steps_done + 1;
+    int sub = 0;
     auto fail = [&](const std::string& what) {
         s.mesh.positions = x_save;
         s.v = v_save;
-        throw RunFailure("simulation blew up at step " + std::to_string(step_no) + " (t = " + num(s.t + s.scene.dt) +
-                         " s): " + what + "; likely cause: " + s.likely_cause(h));
+        const std::string where = s.scene.substeps > 1 && sub < s.scene.substeps
+                                      ? ", substep " + std::to_string(sub + 1) + "/" + std::to_string(s.scene.substeps)
+                                      : std::string();
+        throw RunFailure("simulation blew up at step " + std::to_string(step_no) + where + " (t = " +
+                         num(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) + " s): " + what +
+                         "; likely cause: " + s.likely_cause(h));
     };
-    for (int sub = 0; sub < s.scene.substeps; ++sub) {
+    for (; sub < s.scene.substeps; ++sub) {
         try {
             s.detect_and_respond(st.ms_detect, st.ms_response);
         } catch (const Error& e) {
-            if (!s.state_finite()) fail("non-finite positions");
-            throw;
+            // The input was checked at construction: a detector error now comes from the state (a vertex
+            // flung far away, a tet stretched over millions of cells), i.e. from a diverging run.
+            fail(std::string("collision detection failed (") + e.what() + ")");
         }
         const auto t0 = Clock::now();
         switch (s.scene.integrator) {
@@ -592,7 +724,8 @@ void Simulation::step()
         case Integrator::local_global: s.substep_local_global(h); break;
         }
         st.ms_integrate += ms_since(t0);
-        if (!s.state_finite()) fail("positions or velocities became NaN/Inf");
+        const std::string bad = s.check_state(s.t + (sub + 1) * h);
+        if (!bad.empty()) fail(bad);
     }
     const Energy e = s.model.energy(s.mesh.positions, s.v);
     const double internal = e.internal() + s.contact_energy();
@@ -667,6 +800,15 @@ void Simulation::refresh_contacts()
 {
     double a = 0, b = 0;
     m_impl->detect_and_respond(a, b);
+}
+
+double Simulation::contact_stiffness(int a, int b) const
+{
+    const int n = static_cast<int>(m_impl->scene.objects.size());
+    if (a < 0 || a >= n || b < 0 || b >= n)
+        throw Error("contact_stiffness: object index out of range (" + std::to_string(a) + ", " + std::to_string(b) +
+                    "; " + std::to_string(n) + " objects)");
+    return m_impl->pair_stiffness(a, b);
 }
 
 const StepStats& Simulation::last_stats() const { return m_impl->stats; }

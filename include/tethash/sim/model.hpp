@@ -43,6 +43,11 @@ struct Model {
     std::vector<char> fixed;       ///< n: 1 = pinned or static (never moves)
     Eigen::Vector3d gravity{0, 0, 0};
     Ground ground;
+    /// Per-vertex ground penalty stiffness and damping (n each); empty: ground.stiffness / ground.damping
+    /// for every vertex. Simulation fills them when the scene leaves the ground coefficients automatic.
+    std::vector<double> ground_k, ground_c;
+    double ground_k_at(Index i) const { return ground_k.empty() ? ground.stiffness : ground_k[static_cast<size_t>(i)]; }
+    double ground_c_at(Index i) const { return ground_c.empty() ? ground.damping : ground_c[static_cast<size_t>(i)]; }
 
     /// Springs, volumes and masses of the dynamic objects of `mesh` (rest state = mesh.rest()),
     /// materials per object. Throws Error on a zero-volume tet or a zero-length edge, naming the element.
@@ -68,8 +73,11 @@ struct Model {
     double omega_max_sq(const Positions& x) const;
     /// Explicit (symplectic Euler) stability limit (s) per vertex from the Gershgorin bounds of ω² and of the
     /// damping rate γ: h < (−γ + sqrt(γ² + 4ω²)) / ω² (= 2/ω without damping); minimum over free vertices.
-    /// `extra_k` adds a stiffness per vertex (e.g. contact or ground penalty). +inf when nothing is stiff.
+    /// `extra_k` adds a stiffness per vertex (e.g. contact or ground penalty); `extra_k_per_vertex` (n, or empty)
+    /// adds one per vertex, and `extra_c_per_vertex` a damping. +inf when nothing is stiff.
     double explicit_dt_limit(const Positions& x, double extra_k = 0) const;
+    double explicit_dt_limit(const Positions& x, const std::vector<double>& extra_k_per_vertex,
+                             const std::vector<double>& extra_c_per_vertex) const;
     /// Adds the (positive semi-definite) stiffness −∂f/∂x of springs (+ volume Gauss–Newton part) and the
     /// damping −∂f/∂v of the dashpots as triplets on the 3n × 3n matrix: scale_k · K + scale_c · C.
     void add_matrix_triplets(const Positions& x, double scale_k, double scale_c,

@@ -74,6 +74,11 @@ public:
     /// Runs detection + penetration at the current positions (updates contacts()).
     void refresh_contacts();
 
+    /// Contact penalty stiffness (force / length) used between a vertex of object `a` and a tet of object `b`:
+    /// scene().contact.stiffness when set, else 10 × the harmonic mean of the two objects' stiffest springs
+    /// (a static object counts as stiff as its partner). Damping per contact: sqrt(k · reduced mass).
+    double contact_stiffness(int a, int b) const;
+
     const StepStats& last_stats() const;
     /// Explicit stability limit 2/ω_max of the model (s); a warning is issued when dt/substeps exceeds it
     /// with the symplectic integrator.

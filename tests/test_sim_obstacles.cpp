@@ -1,0 +1,226 @@
+// Static obstacles given as closed surfaces, friction, per-pair contact stiffness, and the per-substep
+// blow-up test of the simulator.
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/io/generate.hpp"
+#include "tethash/io/surface.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <cmath>
+#include <string>
+
+using namespace tethash;
+using namespace tethash::sim;
+using namespace tethash::test;
+
+namespace {
+
+ObjectSpec box_object(const Eigen::Vector3d& size, const Eigen::Vector3d& at, int res = 2)
+{
+    ObjectSpec o;
+    io::GenerateParams g;
+    g.shape = "box";
+    g.resolution = res;
+    g.size = size;
+    o.generate = g;
+    o.translate = at;
+    o.material.density = 100;
+    o.material.young = 1e4;
+    o.material.damping = 0.01;
+    o.self_collision = false;
+    return o;
+}
+
+/// Horizontal speed of object k (mean over its vertices).
+double horizontal_speed(const Simulation& sim, int k)
+{
+    const auto [first, count] = sim.object_vertices(k);
+    const Eigen::Vector3d v = sim.velocities().middleRows(first, count).colwise().mean().transpose();
+    return std::hypot(v.x(), v.y());
+}
+
+} // namespace
+
+TEST(SimObstacle, BodyComesToRestOnAClosedSurfaceObstacle)
+{
+    if (!io::have_assimp()) GTEST_SKIP() << "built without assimp";
+    const auto dir = temp_dir();
+    // The obstacle: the boundary of a generated slab, written as OBJ, read back through assimp and
+    // tetrahedralized on load.
+    io::GenerateParams g;
+    g.shape = "box";
+    g.resolution = 3;
+    g.size = Eigen::Vector3d(1.2, 1.2, 0.4);
+    const std::string obj = (dir / "slab.obj").string();
+    io::write_surface(obj, io::boundary_surface(io::generate(g)));
+
+    Scene s;
+    ObjectSpec slab;
+    slab.name = "slab";
+    slab.mesh = obj;
+    slab.surface_resolution = 6;
+    slab.is_static = true;
+    s.objects.push_back(slab);
+    s.objects.push_back(box_object(Eigen::Vector3d::Constant(0.3), {0.1, -0.1, 0.6}));
+    s.dt = 2e-3;
+    s.output.every = 0;
+    Simulation sim(s);
+    const auto [o0, on] = sim.object_vertices(0);
+    ASSERT_GT(on, 0);
+    ASSERT_GT(sim.object_tets(0).second, 0);   // tetrahedralized
+    const double top = sim.positions().middleRows(o0, on).col(2).maxCoeff();
+    EXPECT_NEAR(top, 0.2, 0.05);               // the slab spans z in [-0.2, 0.2]
+    const auto [b0, bn] = sim.object_vertices(1);
+    double lowest = 1e9;
+    for (int i = 0; i < 400; ++i) {
+        sim.step();
+        lowest = std::min(lowest, sim.positions().middleRows(b0, bn).col(2).minCoeff());
+    }
+    const auto body = sim.positions().middleRows(b0, bn);
+    fprintf(stderr, "DBG top %g lowest %g min %g mean %g v %g\n", top, lowest, body.col(2).minCoeff(), body.col(2).mean(), sim.velocities().middleRows(b0, bn).rowwise().norm().maxCoeff());
+    // Never fell through, and rests on top: bottom at the top face, centre half the box above it, still.
+    EXPECT_GT(lowest, top - 0.1);
+    EXPECT_NEAR(body.col(2).minCoeff(), top, 0.05);
+    EXPECT_NEAR(body.col(2).mean(), top + 0.15, 0.05);
+    EXPECT_LT(sim.velocities().middleRows(b0, bn).rowwise().norm().maxCoeff(), 0.05);
+}
+
+TEST(SimFriction, GroundFrictionDeceleratesAndStopsASlidingBox)
+{
+    auto slide = [](double friction) {
+        Scene s;
+        s.objects.push_back(box_object(Eigen::Vector3d(0.4, 0.4, 0.2), {0, 0, 0.1}));
+        s.objects[0].velocity = Eigen::Vector3d(2.0, 0, 0);
+        s.ground.enabled = true;
+        s.ground.friction = friction;
+        s.dt = 2e-3;
+        s.output.every = 0;
+        Simulation sim(s);
+        for (int i = 0; i < 200; ++i) sim.step();   // 0.4 s
+        EXPECT_TRUE(sim.positions().allFinite());
+        return horizontal_speed(sim, 0);
+    };
+    const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
+    fprintf(stderr, "DBG %g %g %g\n", free, some, high);
+    EXPECT_GT(free, 1.8);                  // without friction it keeps sliding
+    EXPECT_LT(some, free - 0.6);           // μ g t ≈ 1.2 less after 0.4 s
+    EXPECT_GT(some, 0.2);                  // ... but has not stopped yet
+    EXPECT_LT(high, 0.02);                 // μ = 2 stops it within ~0.1 s
+}
+
+TEST(SimFriction, ContactFrictionOnAStaticObstacle)
+{
+    auto slide = [](double friction) {
+        Scene s;
+        ObjectSpec plate = box_object(Eigen::Vector3d(3.0, 1.0, 0.2), {0.5, 0, -0.1}, 3);
+        plate.is_static = true;
+        s.objects.push_back(plate);
+        s.objects.push_back(box_object(Eigen::Vector3d(0.4, 0.4, 0.2), {-0.5, 0, 0.1}));
+        s.objects[1].velocity = Eigen::Vector3d(2.0, 0, 0);
+        s.contact.friction = friction;
+        s.dt = 2e-3;
+        s.output.every = 0;
+        Simulation sim(s);
+        for (int i = 0; i < 200; ++i) sim.step();
+        EXPECT_TRUE(sim.positions().allFinite());
+        const auto [b0, bn] = sim.object_vertices(1);
+        EXPECT_GT(sim.positions().middleRows(b0, bn).col(2).minCoeff(), -0.05);   // stayed on the plate
+        return horizontal_speed(sim, 1);
+    };
+    const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
+    fprintf(stderr, "DBG %g %g %g\n", free, some, high);
+    EXPECT_GT(free, 1.7);
+    EXPECT_LT(some, free - 0.6);
+    EXPECT_LT(high, 0.05);
+}
+
+TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
+{
+    Scene s;
+    ObjectSpec cushion = box_object(Eigen::Vector3d(1.0, 1.0, 0.3), {0, 0, 0.15}, 3);
+    cushion.material.young = 1e6;
+    ObjectSpec steel = box_object(Eigen::Vector3d::Constant(0.4), {0, 0, 0.5}, 2);
+    steel.material.young = 1e9;
+    steel.material.density = 1e5;
+    ObjectSpec table = box_object(Eigen::Vector3d(2.0, 2.0, 0.2), {0, 0, -0.1}, 2);
+    table.is_static = true;
+    s.objects = {cushion, steel, table};
+    s.dt = 5e-3;
+    s.output.every = 0;
+    Simulation sim(s);
+    auto stiffest = [&](int k) {
+        double m = 0;
+        const auto [first, count] = sim.object_vertices(k);
+        const Edges& e = sim.model().springs.edges;
+        for (Index q = 0; q < e.rows(); ++q)
+            if (e(q, 0) >= first && e(q, 0) < first + count) m = std::max(m, sim.model().springs.k[static_cast<size_t>(q)]);
+        return m;
+    };
+    const double k_soft = stiffest(0), k_hard = stiffest(1);
+    ASSERT_GT(k_hard, 100 * k_soft);
+    // Steel on cushion: bounded by twice the soft side, far below the steel's own scale.
+    EXPECT_LE(sim.contact_stiffness(0, 1), 20 * k_soft);
+    EXPECT_GT(sim.contact_stiffness(0, 1), 10 * k_soft);
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 1), sim.contact_stiffness(1, 0));
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 2), 10 * k_soft);   // static partner: as stiff as the cushion
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 1), 10 * k_hard);
+    EXPECT_THROW(sim.contact_stiffness(0, 3), Error);
+
+    // The steel block settles on the cushion (implicit Euler, automatic stiffness): finite, no energy
+    // gain, shallow penetration.
+    const double e0 = sim.energy().total();
+    double emax = e0;
+    for (int i = 0; i < 80; ++i) {
+        sim.step();
+        emax = std::max(emax, sim.energy().total());
+    }
+    EXPECT_TRUE(sim.positions().allFinite());
+    fprintf(stderr, "DBG e0 %g emax %g pen %g k01 %g ks %g\n", e0, emax, sim.max_penetration(), sim.contact_stiffness(0,1), k_soft);
+    EXPECT_LE(emax, e0 + 1e-6 * std::abs(e0));
+    EXPECT_LT(sim.max_penetration(), 0.05);
+
+    s.contact.stiffness = 123.0;   // given: used for every pair
+    Simulation fixed(s);
+    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(0, 1), 123.0);
+    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(1, 1), 123.0);
+}
+
+TEST(SimBlowUp, CaughtWithinTheStepBeforeDetectionFails)
+{
+    // Symplectic Euler far above its limit with substeps: the state diverges within one step. The run must
+    // stop with a RunFailure naming the step and substep (not a detector Error about the grid), and keep
+    // the last good state.
+    Scene s;
+    s.objects.push_back(box_object(Eigen::Vector3d::Constant(0.5), {0, 0, 0.3}));
+    s.objects.push_back(box_object(Eigen::Vector3d::Constant(0.4), {0.1, 0, 0.7}));
+    s.ground.enabled = true;
+    s.integrator = Integrator::symplectic_euler;
+    s.dt = 1e-2;
+    s.substeps = 5;
+    s.output.every = 0;
+    Simulation sim(s);
+    ASSERT_FALSE(sim.warnings().empty());
+    Positions good;
+    std::int64_t last_good = 0;
+    std::string message;
+    try {
+        for (int i = 0; i < 200; ++i) {
+            good = sim.positions();
+            last_good = sim.step_index();
+            sim.step();
+        }
+    } catch (const RunFailure& e) {
+        message = e.what();
+    } catch (const Error& e) {
+        FAIL() << "a blow-up surfaced as a bad-input Error: " << e.what();
+    }
+    ASSERT_FALSE(message.empty()) << "no blow-up detected";
+    fprintf(stderr, "DBG %s\n", message.c_str());
+    EXPECT_NE(message.find("step " + std::to_string(last_good + 1) + ", substep "), std::string::npos) << message;
+    EXPECT_NE(message.find("likely cause"), std::string::npos) << message;
+    EXPECT_EQ(message.find("grid"), std::string::npos) << message;
+    EXPECT_EQ(sim.step_index(), last_good);
+    EXPECT_TRUE(sim.positions().allFinite());
+    EXPECT_TRUE((sim.positions().array() == good.array()).all());
+}
