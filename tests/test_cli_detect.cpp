@@ -135,3 +135,51 @@ TEST(CliDetect, BadOptionsExitTwoNamingTheOption)
     EXPECT_EQ(missing.status, 2);
     EXPECT_NE(missing.err.find("nope.mesh"), std::string::npos) << missing.err;
 }
+
+// Labels as objects: a Gmsh file with two bodies (physical tags 5 and 6); node 5 of body 6 lies in the
+// tet of body 5. As one object that is a self-contact (gone with --no-self); as two objects it stays.
+TEST(CliDetect, ObjectsFromLabels)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "bodies.msh", R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+8
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+5 0.1 0.1 0.1
+6 2 0 0
+7 0 2 0
+8 0 0 2
+$EndNodes
+$Elements
+2
+1 4 2 5 50 1 2 3 4
+2 4 2 6 60 5 6 7 8
+$EndElements
+)");
+    const std::string file = sq(dir / "bodies.msh");
+    auto run = [&](const std::string& options) {
+        const auto r = run_tethash("detect " + file + " " + options + " --contacts " + sq(dir / "c.csv"));
+        EXPECT_EQ(r.status, 0) << options << "\n" << r.err;
+        return std::make_pair(r.out, read_text(dir / "c.csv"));
+    };
+    const std::string header = "vertex,tet,b0,b1,b2,b3\n";
+    auto [out, csv] = run("");
+    EXPECT_NE(out.find("scene: 1 objects"), std::string::npos) << out;
+    EXPECT_EQ(csv.rfind(header + "4,0,", 0), 0u) << csv;
+    std::tie(out, csv) = run("--no-self");
+    EXPECT_EQ(csv, header);
+    std::tie(out, csv) = run("--no-self --objects-from-labels");
+    EXPECT_NE(out.find("scene: 2 objects"), std::string::npos) << out;
+    EXPECT_EQ(csv.rfind(header + "4,0,", 0), 0u) << csv;
+    // Object 1 (label 6) static: its vertex in moving object 0 is still a contact; --static 2 is past the end.
+    std::tie(out, csv) = run("--objects-from-labels --static 1");
+    EXPECT_EQ(csv.rfind(header + "4,0,", 0), 0u) << csv;
+    const auto bad = run_tethash("detect " + file + " --objects-from-labels --static 2");
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_NE(bad.err.find("--static"), std::string::npos) << bad.err;
+}

@@ -103,11 +103,82 @@ TEST(CliInfo, IndexPastTheEndExitsTwoNamingTheFile)
     EXPECT_NE(r.err.find("bad.mesh"), std::string::npos) << r.err;
 }
 
-// Counts and problems of the real meshes, as given in ../shared/meshes/SOURCES.md.
+namespace {
+
+// Two bodies in one Gmsh 2.2 file: a unit tet (physical tag 5) and a tet (physical tag 6) whose first
+// vertex (node 5, 0-based vertex 4) lies inside the unit tet; node 9 belongs to no tet.
+const char* kTwoBodies = R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+9
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+5 0.1 0.1 0.1
+6 2 0 0
+7 0 2 0
+8 0 0 2
+9 7 7 7
+$EndNodes
+$Elements
+2
+1 4 2 6 60 5 6 7 8
+2 4 2 5 50 1 2 3 4
+$EndElements
+)";
+
+} // namespace
+
+TEST(CliInfo, ObjectsFromLabels)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "bodies.msh", kTwoBodies);
+    RunResult r = run_tethash("info --json " + quote(dir / "bodies.msh"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_int(r.out, "objects"), 1);
+    r = run_tethash("info --json --objects-from-labels " + quote(dir / "bodies.msh"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_int(r.out, "objects"), 2);
+    EXPECT_NE(r.out.find("2 objects from tet labels"), std::string::npos) << r.out;
+    // Two files: objects of the second follow those of the first.
+    r = run_tethash("info --json --objects-from-labels " + quote(dir / "bodies.msh") + " " + quote(dir / "bodies.msh"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_int(r.out, "objects"), 4);
+
+    // Tets of two labels that share a face: an error naming the file and a vertex, or one object with =join.
+    write_text(dir / "glued.msh", std::string(kTwoBodies).replace(std::string(kTwoBodies).find("1 4 2 6 60 5 6 7 8"), 18,
+                                                                  "1 4 2 6 60 2 3 4 6"));
+    r = run_tethash("info --objects-from-labels " + quote(dir / "glued.msh"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("glued.msh"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("vertex "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("=join"), std::string::npos) << r.err;
+    r = run_tethash("info --json --objects-from-labels=join " + quote(dir / "glued.msh"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_int(r.out, "objects"), 1);
+    EXPECT_NE(r.out.find("3 shared vertices"), std::string::npos) << r.out;
+    r = run_tethash("info --objects-from-labels=maybe " + quote(dir / "glued.msh"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--objects-from-labels"), std::string::npos) << r.err;
+}
+
+// Counts and problems of the real meshes, as given in ../shared/meshes/SOURCES.md (vertices, tets,
+// inverted tets, unreferenced vertices, unique edges, boundary triangles).
 struct SharedMeshCase {
     const char* file;
     long vertices, tets, inverted, unreferenced;
+    long edges, boundary_faces; ///< "Unique edges" and "Boundary triangles" of SOURCES.md
 };
+
+/// Value of "count" inside the "edges" object of info's JSON, or -1.
+long json_edge_count(const std::string& json)
+{
+    std::smatch m;
+    if (std::regex_search(json, m, std::regex("\"edges\": \\{\"count\": ([0-9]+)"))) return std::stol(m[1]);
+    return -1;
+}
 
 class CliInfoShared : public ::testing::TestWithParam<SharedMeshCase> {};
 
@@ -125,18 +196,38 @@ TEST_P(CliInfoShared, CountsMatchSources)
     EXPECT_EQ(json_int(r.out, "degenerate_tets"), 0);
     EXPECT_EQ(json_int(r.out, "unreferenced_vertices"), c.unreferenced);
     EXPECT_EQ(json_int(r.out, "non_manifold_faces"), 0);
+    EXPECT_EQ(json_edge_count(r.out), c.edges);
+    EXPECT_EQ(json_int(r.out, "boundary_faces"), c.boundary_faces);
+}
+
+// convert keeps what SOURCES.md counts: the same edges and boundary faces after a round through .vtu.
+TEST_P(CliInfoShared, ConvertKeepsEdgesAndBoundary)
+{
+    const SharedMeshCase c = GetParam();
+    const auto path = shared_mesh(c.file);
+    if (!path) GTEST_SKIP() << "../shared/meshes/" << c.file << " not present";
+    const auto dir = temp_dir();
+    const RunResult conv = run_tethash("convert " + quote(*path) + " " + quote(dir / "copy.vtu"));
+    ASSERT_EQ(conv.status, 0) << conv.err;
+    const RunResult r = run_tethash("info --json " + quote(dir / "copy.vtu"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(json_int(r.out, "vertices"), c.vertices);
+    EXPECT_EQ(json_int(r.out, "tets"), c.tets);
+    EXPECT_EQ(json_edge_count(r.out), c.edges);
+    EXPECT_EQ(json_int(r.out, "boundary_faces"), c.boundary_faces);
+    EXPECT_EQ(json_int(r.out, "inverted_tets"), c.inverted);
 }
 
 INSTANTIATE_TEST_SUITE_P(RealMeshes, CliInfoShared,
-                         ::testing::Values(SharedMeshCase{"octopus-low.mesh", 452, 1140, 0, 0},
-                                           SharedMeshCase{"armadillo_4k.node", 1180, 3717, 0, 0},
-                                           SharedMeshCase{"screw.msh", 1732, 6059, 0, 0},
-                                           SharedMeshCase{"P1.msh", 1585, 6414, 8, 0},
-                                           SharedMeshCase{"raptorTetra_8418.vtu", 2996, 8418, 0, 3},
-                                           SharedMeshCase{"32770_octocat.msh", 6133, 21426, 0, 0},
-                                           SharedMeshCase{"hand.mesh", 7234, 29998, 0, 0},
-                                           SharedMeshCase{"mat100x100t40.msh", 20000, 58806, 0, 0},
-                                           SharedMeshCase{"quintupleTorus.veg", 15789, 71427, 0, 0}),
+                         ::testing::Values(SharedMeshCase{"octopus-low.mesh", 452, 1140, 0, 0, 2040, 898},
+                                           SharedMeshCase{"armadillo_4k.node", 1180, 3717, 0, 0, 5947, 2102},
+                                           SharedMeshCase{"screw.msh", 1732, 6059, 0, 0, 9204, 2828},
+                                           SharedMeshCase{"P1.msh", 1585, 6414, 8, 0, 8890, 1762},
+                                           SharedMeshCase{"raptorTetra_8418.vtu", 2996, 8418, 0, 3, 14284, 5750},
+                                           SharedMeshCase{"32770_octocat.msh", 6133, 21426, 0, 0, 31835, 8554},
+                                           SharedMeshCase{"hand.mesh", 7234, 29998, 0, 0, 42009, 9556},
+                                           SharedMeshCase{"mat100x100t40.msh", 20000, 58806, 0, 0, 98803, 39996},
+                                           SharedMeshCase{"quintupleTorus.veg", 15789, 71427, 0, 0, 94675, 14816}),
                          [](const auto& info) {
                              std::string n = info.param.file;
                              for (char& ch : n)

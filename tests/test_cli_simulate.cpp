@@ -70,11 +70,22 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
 
 TEST(CliSimulate, DefaultSceneRuns)
 {
+    // What tools/run shows: progress lines (stderr, not a terminal), the summary, frames meshio reads.
     const auto dir = temp_dir();
-    const auto r = run_tethash("simulate --steps 2 --out " + quote(dir / "out"));
+    const auto r = run_tethash("simulate --steps 10 --out " + quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("<default scene>"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("step 1/10 "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("step 10/10 "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("steps/s"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("max pen"), std::string::npos) << r.err;
+    for (const char* s : {"ms/step: detection ", ", response ", ", integration ", "contacts per step: ",
+                          "penetration depth: max ", ", mean ", "energy: start ", ", end ", "scene.pvd"})
+        EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00000.vtu"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00010.vtu"));
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
+    EXPECT_EQ(check_frames(py, dir / "out"), "OK 3\n");
 }
 
 TEST(CliSimulate, BadSceneKeysAndOptionsExit2)
@@ -98,6 +109,9 @@ TEST(CliSimulate, BadSceneKeysAndOptionsExit2)
     r = run_tethash("simulate --dt -1 --out " + quote(dir / "o"));
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--dt"), std::string::npos) << r.err;
+    r = run_tethash("simulate --threads -1 --steps 1 --out " + quote(dir / "o"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--threads"), std::string::npos) << r.err;
     r = run_tethash("simulate " + quote(dir / "missing.toml"));
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("missing.toml"), std::string::npos) << r.err;
@@ -115,4 +129,51 @@ TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "scene.pvd"));
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
     EXPECT_EQ(check_frames(py, dir / "out").substr(0, 3), "OK ");
+}
+
+TEST(CliSimulate, ExplicitStabilityWarningIsPrintedUpFront)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", kSmall);
+    // dt above the limit: warned before the first step (the run itself survives one step).
+    auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --integrator symplectic_euler --dt 0.002 --steps 1 --out " +
+                         quote(dir / "a"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto warn = r.err.find("warning: time step 0.002 s");
+    ASSERT_NE(warn, std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("exceeds the explicit stability limit"), std::string::npos) << r.err;
+    const auto first_step = r.err.find("step 1/1");
+    ASSERT_NE(first_step, std::string::npos) << r.err;
+    EXPECT_LT(warn, first_step) << r.err;
+    // Below the limit, or with the implicit integrator: no warning.
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --integrator symplectic_euler --dt 1e-5 --steps 1 --out " +
+                    quote(dir / "b"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --integrator implicit_euler --dt 0.002 --steps 1 --out " +
+                    quote(dir / "c"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
+TEST(CliSimulate, BlowUpWithinSubstepsIsARunFailureNamingTheStep)
+{
+    // Diverges within a step of 2 substeps: must exit 1 (run failure) naming step and substep, not 2 (a
+    // detector error about the grid), keep the frames written so far, and never write a NaN frame.
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", kSmall);
+    const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
+                               " --integrator symplectic_euler --dt 0.004 --substeps 2 --steps 100 --out " + quote(dir / "out"));
+    EXPECT_EQ(r.status, 1) << r.out << r.err;
+    EXPECT_NE(r.err.find("blew up at step "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(", substep "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("likely cause"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("grid"), std::string::npos) << r.err;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00000.vtu"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00002.vtu"));
+    const std::string pvd = read_text(dir / "out" / "scene.pvd");
+    EXPECT_NE(pvd.find("frame_00002.vtu"), std::string::npos) << pvd;
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
+    const std::string check = check_frames(py, dir / "out");
+    EXPECT_EQ(check.substr(0, 3), "OK ") << check;
 }

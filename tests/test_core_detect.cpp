@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -389,4 +390,55 @@ TEST(CoreDetect, EmptyInputs)
     det.set_topology(none, 5);
     Positions five = Positions::Random(5, 3);
     EXPECT_TRUE(det.detect(five).empty());
+}
+
+TEST(CoreDetect, LongTetsAndAliasedCellKeys)
+{
+    // A needle tet spanning 2000 cells in z (beyond the 32-bit cell key's exact window: exact cells are compared),
+    // and small tets whose vertices lie on the needle's axis, on its faces, or in cells that share a needle cell's
+    // key (2^10 cells up in z, inside the needle's box at cell size 1; 2^11 cells over in x or y) and, for table
+    // sizes 1 and 1024, its buckets. At cell size 4 the needle spans 501 cells: the key test applies.
+    Scene s;
+    std::vector<Eigen::Vector3d> pts = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {1, 1, 2000}};
+    std::vector<std::array<Index, 4>> tets = {{0, 1, 2, 3}};
+    s.vertex_object = {0, 0, 0, 0};
+    s.tet_object = {0};
+    auto small_tet = [&](const Eigen::Vector3d& p) {
+        const Index b = static_cast<Index>(pts.size());
+        for (const Eigen::Vector3d& d : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.25, 0, 0), Eigen::Vector3d(0, 0.25, 0),
+                                         Eigen::Vector3d(0, 0, 0.25)}) {
+            pts.push_back(p + d);
+            s.vertex_object.push_back(1);
+        }
+        tets.push_back({b, b + 1, b + 2, b + 3});
+        s.tet_object.push_back(1);
+    };
+    for (double z = 0; z <= 2000; z += 24.75) {
+        const double f = 1.0 - z / 2000;   // the needle's cross-section shrinks linearly towards its tip
+        small_tet({z / 2000 + 0.5 * f, z / 2000 + 0.5 * f, z});   // inside
+        small_tet({z / 2000, z / 2000 + 2.0 * f, z});             // on the face x = z/2000 (exactly, when representable)
+        small_tet({0.5, 0.5, z + 1024});                                    // same key as a needle cell, far above
+        small_tet({0.5 + 2048, 0.5, z});
+        small_tet({0.5, 0.5 - 2048, z});
+    }
+    s.positions.resize(static_cast<Eigen::Index>(pts.size()), 3);
+    for (std::size_t i = 0; i < pts.size(); ++i) s.positions.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+    s.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
+    for (std::size_t t = 0; t < tets.size(); ++t)
+        for (int k = 0; k < 4; ++k) s.tets(static_cast<Eigen::Index>(t), k) = tets[t][static_cast<std::size_t>(k)];
+    const std::vector<Contact> want = run_oracle(s);
+    ASSERT_GT(want.size(), 80u);
+    for (double cell : {1.0, 4.0})
+        for (std::int64_t table : {0, 1, 1024, 4096})
+            for (HashFunction hash : {HashFunction::column, HashFunction::teschner})
+                for (int threads : {1, 2}) {
+                    DetectParams p;
+                    p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+                    p.cell_size = cell;
+                    p.table_size = table;
+                    p.hash = hash;
+                    p.threads = threads;
+                    EXPECT_TRUE(same_contacts(run_detector(s, p), want))
+                        << "cell " << cell << " table " << table << " hash " << to_string(hash) << " threads " << threads;
+                }
 }

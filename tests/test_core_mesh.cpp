@@ -204,3 +204,93 @@ TEST(Mesh, ConsistencyCheckNamesTheTet)
         EXPECT_NE(msg.find("42"), std::string::npos) << msg;
     }
 }
+
+// ---- split_objects_by_label -------------------------------------------------------------
+
+namespace {
+
+/// Two disjoint unit tets (vertices 0-3 and 4-7) plus an unreferenced vertex 8.
+TetMesh two_separate_tets()
+{
+    TetMesh m;
+    m.positions.resize(9, 3);
+    m.positions << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 5, 0, 0, 6, 0, 0, 5, 1, 0, 5, 0, 1, 9, 9, 9;
+    m.tets.resize(2, 4);
+    m.tets << 0, 1, 2, 3, 4, 5, 6, 7;
+    return m;
+}
+
+} // namespace
+
+TEST(MeshLabels, EachLabelIsAnObjectInLabelOrder)
+{
+    TetMesh m = two_separate_tets();
+    m.tet_label = {9, 3};
+    const LabelSplit s = split_objects_by_label(m);
+    ASSERT_EQ(s.object_labels.size(), 2u);
+    EXPECT_EQ(s.object_labels[0], std::vector<Index>{3});
+    EXPECT_EQ(s.object_labels[1], std::vector<Index>{9});
+    EXPECT_EQ(s.shared_vertices, 0);
+    EXPECT_EQ(m.tet_object, (std::vector<Index>{1, 0}));
+    EXPECT_EQ(m.vertex_object, (std::vector<Index>{1, 1, 1, 1, 0, 0, 0, 0, 0})); // unreferenced vertex 8: object 0
+    EXPECT_EQ(m.num_objects(), 2);
+    EXPECT_EQ(m.tet_label, (std::vector<Index>{9, 3})); // labels kept
+}
+
+TEST(MeshLabels, WithoutLabelsOneObject)
+{
+    TetMesh m = two_separate_tets();
+    m.vertex_object.assign(9, 4); // stale ids are replaced
+    const LabelSplit s = split_objects_by_label(m);
+    EXPECT_EQ(s.object_labels.size(), 1u);
+    EXPECT_EQ(m.vertex_object, std::vector<Index>(9, 0));
+    EXPECT_EQ(m.tet_object, std::vector<Index>(2, 0));
+}
+
+TEST(MeshLabels, SharedVertexIsAnErrorNamingItOrJoinsTheLabels)
+{
+    TetMesh m = kuhn_cube();
+    m.tet_label = {1, 1, 1, 2, 2, 2}; // tets 0-2 and 3-5 share vertices 0, 6 and one more each side
+    try {
+        TetMesh copy = m;
+        split_objects_by_label(copy, SharedLabelVertices::error, "cube.msh");
+        FAIL() << "no error for a vertex shared by two labels";
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find("cube.msh"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("vertex "), std::string::npos) << msg;
+        EXPECT_NE(msg.find("label 1"), std::string::npos) << msg;
+        EXPECT_NE(msg.find("label 2"), std::string::npos) << msg;
+    }
+    const LabelSplit s = split_objects_by_label(m, SharedLabelVertices::join);
+    ASSERT_EQ(s.object_labels.size(), 1u);
+    EXPECT_EQ(s.object_labels[0], (std::vector<Index>{1, 2}));
+    // Vertices used by both halves, counted independently of the implementation.
+    std::set<Index> first, second;
+    for (Index t = 0; t < 6; ++t)
+        for (int k = 0; k < 4; ++k) (t < 3 ? first : second).insert(m.tets(t, k));
+    std::int64_t both = 0;
+    for (Index v : first) both += second.count(v);
+    EXPECT_EQ(s.shared_vertices, both);
+    EXPECT_EQ(m.num_objects(), 1);
+}
+
+TEST(MeshLabels, JoinMergesOnlyLabelsThatTouch)
+{
+    // Labels 5 and 7 share vertex 3 (via a third tet); label 6 stands apart.
+    TetMesh m = two_separate_tets();
+    Positions p(10, 3);
+    p << m.positions, -1, -1, -1;
+    m.positions = p;
+    m.tets.resize(3, 4);
+    m.tets << 0, 1, 2, 3, 4, 5, 6, 7, 9, 1, 2, 3;
+    m.tet_label = {5, 6, 7};
+    const LabelSplit s = split_objects_by_label(m, SharedLabelVertices::join);
+    ASSERT_EQ(s.object_labels.size(), 2u);
+    EXPECT_EQ(s.object_labels[0], (std::vector<Index>{5, 7}));
+    EXPECT_EQ(s.object_labels[1], (std::vector<Index>{6}));
+    EXPECT_EQ(m.tet_object, (std::vector<Index>{0, 1, 0}));
+    EXPECT_EQ(m.vertex_object[9], 0);
+    EXPECT_EQ(m.vertex_object[4], 1);
+    EXPECT_EQ(s.shared_vertices, 3);
+}

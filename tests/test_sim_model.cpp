@@ -161,6 +161,31 @@ TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
     model.add_matrix_diagonal(x, 0.7, 0.3, diag);
     EXPECT_LT((Eigen::VectorXd(A.diagonal()) - diag).norm(), 1e-9 * diag.norm());
     EXPECT_LT((Eigen::SparseMatrix<double>(A.transpose()) - A).norm(), 1e-9 * A.norm());   // symmetric
+
+    // The linearised (cached) operator used by CG gives the same products and diagonal.
+    const Model::Linearised lin = model.linearise(x, 0.7, 0.3);
+    Eigen::VectorXd out2 = Eigen::VectorXd::Zero(N), diag2 = Eigen::VectorXd::Zero(N);
+    lin.apply(p, out2);
+    lin.add_diagonal(diag2);
+    EXPECT_LT((out2 - out).norm(), 1e-9 * out.norm());
+    EXPECT_LT((diag2 - diag).norm(), 1e-9 * diag.norm());
+
+    // Per-vertex ground coefficients (automatic ground) enter all three the same way.
+    model.ground_k.assign(static_cast<size_t>(x.rows()), 0.0);
+    model.ground_c.assign(static_cast<size_t>(x.rows()), 0.0);
+    for (Index i = 0; i < x.rows(); ++i) {
+        model.ground_k[static_cast<size_t>(i)] = 500.0 + 100.0 * static_cast<double>(i % 7);
+        model.ground_c[static_cast<size_t>(i)] = 1.0 + static_cast<double>(i % 3);
+    }
+    t.clear();
+    model.add_matrix_triplets(x, 0.7, 0.3, t);
+    A.setFromTriplets(t.begin(), t.end());
+    out.setZero();
+    model.apply_matrix(x, 0.7, 0.3, p, out);
+    out2.setZero();
+    model.linearise(x, 0.7, 0.3).apply(p, out2);
+    EXPECT_LT((A * p - out).norm(), 1e-9 * out.norm());
+    EXPECT_LT((out2 - out).norm(), 1e-9 * out.norm());
 }
 
 TEST(SimModel, ZeroVolumeRestTetIsRefused)

@@ -78,7 +78,6 @@ TEST(SimObstacle, BodyComesToRestOnAClosedSurfaceObstacle)
         lowest = std::min(lowest, sim.positions().middleRows(b0, bn).col(2).minCoeff());
     }
     const auto body = sim.positions().middleRows(b0, bn);
-    fprintf(stderr, "DBG top %g lowest %g min %g mean %g v %g\n", top, lowest, body.col(2).minCoeff(), body.col(2).mean(), sim.velocities().middleRows(b0, bn).rowwise().norm().maxCoeff());
     // Never fell through, and rests on top: bottom at the top face, centre half the box above it, still.
     EXPECT_GT(lowest, top - 0.1);
     EXPECT_NEAR(body.col(2).minCoeff(), top, 0.05);
@@ -102,7 +101,6 @@ TEST(SimFriction, GroundFrictionDeceleratesAndStopsASlidingBox)
         return horizontal_speed(sim, 0);
     };
     const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
-    fprintf(stderr, "DBG %g %g %g\n", free, some, high);
     EXPECT_GT(free, 1.8);                  // without friction it keeps sliding
     EXPECT_LT(some, free - 0.6);           // μ g t ≈ 1.2 less after 0.4 s
     EXPECT_GT(some, 0.2);                  // ... but has not stopped yet
@@ -129,7 +127,6 @@ TEST(SimFriction, ContactFrictionOnAStaticObstacle)
         return horizontal_speed(sim, 1);
     };
     const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
-    fprintf(stderr, "DBG %g %g %g\n", free, some, high);
     EXPECT_GT(free, 1.7);
     EXPECT_LT(some, free - 0.6);
     EXPECT_LT(high, 0.05);
@@ -176,7 +173,6 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
         emax = std::max(emax, sim.energy().total());
     }
     EXPECT_TRUE(sim.positions().allFinite());
-    fprintf(stderr, "DBG e0 %g emax %g pen %g k01 %g ks %g\n", e0, emax, sim.max_penetration(), sim.contact_stiffness(0,1), k_soft);
     EXPECT_LE(emax, e0 + 1e-6 * std::abs(e0));
     EXPECT_LT(sim.max_penetration(), 0.05);
 
@@ -216,7 +212,6 @@ TEST(SimBlowUp, CaughtWithinTheStepBeforeDetectionFails)
         FAIL() << "a blow-up surfaced as a bad-input Error: " << e.what();
     }
     ASSERT_FALSE(message.empty()) << "no blow-up detected";
-    fprintf(stderr, "DBG %s\n", message.c_str());
     EXPECT_NE(message.find("step " + std::to_string(last_good + 1) + ", substep "), std::string::npos) << message;
     EXPECT_NE(message.find("likely cause"), std::string::npos) << message;
     EXPECT_EQ(message.find("grid"), std::string::npos) << message;

@@ -378,17 +378,33 @@ def main():
     args = ap.parse_args()
     args.out = args.out or args.dir
     args.formats = [f for f in args.formats.split(",") if f]
-    os.makedirs(args.out, exist_ok=True)
-    rows, meta = load(args.dir)
-    if not rows:
-        print("figures: no rows in %s/study.csv" % args.dir)
-        return 0
-    pts = points(rows)
-    sweep = rows[0].get("sweep", meta.get("sweep", ""))
-    if sweep == "integrator":
-        plot_integrator(pts, meta, args)
-    else:
-        plot_detection(pts, meta, args, sweep)
+    csv_path = os.path.join(args.dir, "study.csv")
+    # Bad input (a missing folder, a file that is not a study) is one line and status 2, not a traceback.
+    try:
+        rows, meta = load(args.dir)
+        if not rows:
+            print("figures: no rows in %s" % csv_path)
+            return 0
+        missing = [c for c in ("point", "sweep") if c not in rows[0]]
+        if missing:
+            raise ValueError("missing column(s) %s: not a tethash study" % ", ".join(missing))
+        pts = points(rows)
+    except FileNotFoundError:
+        print("plot_study.py: error: %s: no such file (give the folder of a tethash study)" % csv_path, file=sys.stderr)
+        return 2
+    except (OSError, csv.Error, ValueError, KeyError, TypeError) as e:  # json.JSONDecodeError is a ValueError
+        print("plot_study.py: error: %s: %s" % (csv_path, e), file=sys.stderr)
+        return 2
+    try:
+        os.makedirs(args.out, exist_ok=True)
+        sweep = rows[0].get("sweep", meta.get("sweep", ""))
+        if sweep == "integrator":
+            plot_integrator(pts, meta, args)
+        else:
+            plot_detection(pts, meta, args, sweep)
+    except OSError as e:
+        print("plot_study.py: error: cannot write figures to %s: %s" % (args.out, e), file=sys.stderr)
+        return 1
     return 0
 
 

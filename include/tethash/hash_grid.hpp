@@ -40,6 +40,23 @@ inline std::uint64_t teschner_hash(std::int32_t x, std::int32_t y, std::int32_t 
                                       static_cast<std::uint32_t>(z) * 83492791u);
 }
 
+/// The 32-bit key stored with every table entry in place of its three cell coordinates:
+/// x mod 2^11 | (y mod 2^11) << 11 | (z mod 2^10) << 22. Not injective on the infinite grid, but a scanned entry
+/// is also inside the tet's float box, hence within 2^8 cells of the tet's cell box (float rounding of coordinates
+/// up to 2^31 cells from the origin); for cell boxes of at most key_exact_xy × key_exact_xy × key_exact_z cells
+/// a key match therefore means the very cell. Bigger cell boxes (tiny cells) compare exact cells instead.
+inline std::uint32_t column_key(std::int32_t x, std::int32_t y)
+{
+    return (static_cast<std::uint32_t>(x) & 0x7ffu) | ((static_cast<std::uint32_t>(y) & 0x7ffu) << 11);
+}
+inline std::uint32_t cell_key(std::int32_t x, std::int32_t y, std::int32_t z)
+{
+    return column_key(x, y) | ((static_cast<std::uint32_t>(z) & 0x3ffu) << 22);
+}
+inline constexpr std::uint32_t key_column_mask = 0x3fffffu;
+inline constexpr std::int64_t key_exact_xy = 2048 - 2 * 257 - 1;   ///< cells per axis in x and y (1533)
+inline constexpr std::int64_t key_exact_z = 1024 - 2 * 257 - 1;    ///< cells in z (509)
+
 /// 64-bit mix of a column (x, y).
 inline std::uint64_t column_mix(std::int32_t x, std::int32_t y)
 {
@@ -71,9 +88,12 @@ struct TableModulus {
 };
 
 /// The default table size for `vertices` hashed vertices: for the column hash the smallest power of two
-/// ≥ 2·vertices (bucket ranges are masks; beyond 2V the collisions saved no longer pay for the table
-/// memory), for Teschner's hash the smallest prime ≥ 2·vertices (the xor-product hash needs an odd modulus).
-/// At least 1.
+/// ≥ 2·vertices (so 2V..4V buckets; bucket ranges are masks), for Teschner's hash the smallest prime ≥ 2·vertices
+/// (the xor-product hash needs an odd modulus). At least 1.
+/// Measured (tethash_bench --table-factor, scenario 5: 19,600 vertices, CPU ms at one thread, ±5 %):
+/// 16,384 buckets (0.84 V) 6.3–7.3, 32,768 (1.7 V) 6.0, 65,536 (3.3 V, the default) 5.7, 131,072 (6.7 V) 5.9:
+/// below 2V the hash collisions scanned cost more than they save in table memory, beyond 4V the bigger offset
+/// array no longer stays in cache.
 std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices);
 /// Smallest prime ≥ n (n ≥ 2).
 std::int64_t next_prime(std::int64_t n);
@@ -92,17 +112,18 @@ public:
     Index size() const { return m_count; }
     std::int64_t memory_bytes() const;
 
-    // Structure of arrays in bucket order, padded by 8 entries at the end (padding never matches).
-    std::vector<float> x, y, z;
-    std::vector<std::int32_t> id, cx, cy, cz;
-    std::vector<std::int32_t> start;   ///< n + 1 offsets
+    // Structure of arrays in bucket order, padded by 8 entries at the end (padding never matches: NaN
+    // coordinates). 20 bytes per entry.
+    std::vector<float> x, y, z;          ///< coordinates relative to the origin, rounded to float
+    std::vector<std::int32_t> id;        ///< vertex id
+    std::vector<std::uint32_t> key;      ///< cell_key() of the entry's cell
+    std::vector<std::int32_t> start;     ///< n + 1 offsets
 
 private:
     TableModulus m_mod;
     Index m_count = 0;
     std::vector<std::uint32_t> m_bucket;   ///< per input vertex
-    std::vector<std::int32_t> m_cell;      ///< per input vertex, 3 ints
-    std::vector<float> m_local;            ///< per input vertex, 3 floats
+    std::vector<std::uint32_t> m_key;      ///< per input vertex
 };
 
 } // namespace tethash

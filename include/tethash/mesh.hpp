@@ -71,6 +71,29 @@ ValidationReport validate(const TetMesh& mesh);
 /// Swaps two vertices of every inverted (negative-volume, non-degenerate) tet; returns how many.
 std::int64_t reorient_inverted(TetMesh& mesh);
 
+/// What to do with a vertex used by tets of different labels in split_objects_by_label.
+enum class SharedLabelVertices {
+    error, ///< throw Error naming the vertex and the two labels (default: the file is not separate bodies)
+    join,  ///< labels that share a vertex become one object (glued regions are one body)
+};
+
+/// Result of split_objects_by_label.
+struct LabelSplit {
+    /// For each object, the labels it holds (sorted; more than one only where SharedLabelVertices::join merged).
+    std::vector<std::vector<Index>> object_labels;
+    /// Vertices used by tets of more than one label (0 unless join merged something).
+    std::int64_t shared_vertices = 0;
+};
+
+/// Makes each tet label (Gmsh physical tag, else entity tag; Medit ref; TetGen region attribute) an
+/// object: object ids 0, 1, ... in increasing label order, set in tet_object and vertex_object; a
+/// vertex takes the object of its tets; a vertex of no tet goes to the object of the smallest label
+/// (object 0). tet_label itself is kept. A mesh without labels (tet_label empty) is one object, 0.
+/// Throws Error (naming `what`, the vertex and both labels) for a vertex shared by tets of different
+/// labels when `shared` is SharedLabelVertices::error.
+LabelSplit split_objects_by_label(TetMesh& mesh, SharedLabelVertices shared = SharedLabelVertices::error,
+                                  const std::string& what = "mesh");
+
 // ---- derived data: each computed when called, nothing cached in the mesh -------------
 
 /// Unique undirected edges (i < j), sorted lexicographically.

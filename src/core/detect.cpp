@@ -12,9 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
-#include <limits>
 #include <sstream>
 
 #ifdef TETHASH_HAVE_OPENMP
@@ -173,7 +171,6 @@ struct alignas(64) ThreadState {
     std::size_t used = 0;
     std::vector<double> values;         // stage 3: 4 plane values per candidate of a run
     std::vector<std::int8_t> codes;     // stage 3: filter outcome per candidate of a run
-    std::vector<detail::BlockHit> hits;      // stage 2, block path: (vertex, lane) hits of one block
     std::vector<CandidateRun> runs;
     std::vector<RawContact> contacts;
     Counters counters;
@@ -224,9 +221,6 @@ public:
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
-    void stage_block(ThreadState& ts, const Index* ids, int count, const double* P);
-    std::vector<Index> tets_sorted;
-    std::vector<Index> tet_order;   // tets in Morton order of their centroid cells at the first detect()
     void stage_inside(ThreadState& ts, const double* P);
     std::int64_t memory_bytes() const;
 };
@@ -257,38 +251,6 @@ void DetectorImpl::prepare(const PositionsRef& positions)
                                     static_cast<std::int64_t>(static_ids.size())};
     for (int k = 0; k < 2; ++k)
         table_sizes[k] = params.table_size > 0 ? params.table_size : auto_table_size(params.hash, counts[k]);
-    // Tet order for the block path: Morton order of the centroid cells at these positions, so that the eight
-    // tets of a block are neighbours (deformation keeps them mostly so). Ties by tet id: deterministic.
-    {
-        const std::size_t m = tets.size() / 4;
-        std::vector<std::pair<std::uint64_t, Index>> keyed(m);
-        auto spread = [](std::uint64_t v) {   // 21 bits → every third bit
-            v &= 0x1fffff;
-            v = (v | v << 32) & 0x1f00000000ffffULL;
-            v = (v | v << 16) & 0x1f0000ff0000ffULL;
-            v = (v | v << 8) & 0x100f00f00f00f00fULL;
-            v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-            v = (v | v << 2) & 0x1249249249249249ULL;
-            return v;
-        };
-        for (std::size_t t = 0; t < m; ++t) {
-            std::uint64_t key = 0;
-            for (int a = 0; a < 3; ++a) {
-                double c = 0;
-                for (int k = 0; k < 4; ++k) c += positions(tets[4 * t + k], a);
-                const double cell = std::floor((0.25 * c - origin[a]) / cell_size) + 1048576.0;
-                const auto u = static_cast<std::uint64_t>(std::clamp(cell, 0.0, 2097151.0));
-                key |= spread(u) << a;
-            }
-            keyed[t] = {key, static_cast<Index>(t)};
-        }
-        std::sort(keyed.begin(), keyed.end());
-        tet_order.resize(m);
-        for (std::size_t t = 0; t < m; ++t) tet_order[t] = keyed[t].second;
-        tets_sorted.resize(4 * m);
-        for (std::size_t t = 0; t < m; ++t)
-            for (int k = 0; k < 4; ++k) tets_sorted[4 * t + k] = tets[4 * static_cast<std::size_t>(tet_order[t]) + k];
-    }
     // Static vertices: hashed once.
     if (!tables[1].build(positions.data(), static_ids.data(), static_cast<Index>(static_ids.size()), cell_size, origin,
                          table_sizes[1], params.hash, resolve_threads(params.threads)))
@@ -314,7 +276,7 @@ void DetectorImpl::diagnose_build_failure(const PositionsRef& positions, const I
 
 std::int64_t DetectorImpl::memory_bytes() const
 {
-    std::int64_t m = static_cast<std::int64_t>(tets.capacity() + tet_order.capacity() + vertex_object.capacity() + tet_object.capacity() +
+    std::int64_t m = static_cast<std::int64_t>(tets.capacity() + vertex_object.capacity() + tet_object.capacity() +
                                                dynamic_ids.capacity() + static_ids.capacity() +
                                                vertex_counts.capacity()) * 4;
     m += tables[0].memory_bytes() + tables[1].memory_bytes();
@@ -361,6 +323,8 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         return;
     }
     if (with_stats) ts.counters.cells += nx * ny * nz;
+    // Tiny cells: the entries' 32-bit cell keys are no longer exact over this tet's cell box (see cell_key).
+    const double* exact = nx > key_exact_xy || ny > key_exact_xy || nz > key_exact_z ? P : nullptr;
 
     const std::int32_t run_begin = static_cast<std::int32_t>(ts.used);
     // Table 0 holds the moving vertices, table 1 the static ones: static tets never look at table 1.
@@ -382,7 +346,7 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
             const std::size_t need = ts.used + total;
             if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
             ts.used += static_cast<std::size_t>(
-                detail::scan_ranges(table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats));
+                detail::scan_ranges(table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats, exact, inv_cell));
             nr = 0;
             total = 0;
         };
@@ -445,110 +409,6 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
     if (run_end > run_begin) ts.runs.push_back({t, run_begin, run_end});
 }
 
-// Stage 2 for up to 8 consecutive tets at once (column hash, power-of-two table, no static objects, no
-// statistics): the columns of the block's cell box are looked up once and each of their entries is tested
-// against the eight tet boxes in one SIMD compare. Consecutive tets of a mesh are mostly neighbours, so the
-// block's box is much smaller than the sum of the eight tets' cell boxes (scenario 5: about half as many
-// entries scanned and a quarter of the column lookups). Falls back to one tet at a time when the block's
-// box is not smaller than the sum of the tets' boxes (tets far apart in the ordering).
-void DetectorImpl::stage_block(ThreadState& ts, const Index* ids, int count, const double* P)
-{
-    alignas(32) detail::BlockQuery q;
-    std::int32_t b0[3] = {std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::max(),
-                          std::numeric_limits<std::int32_t>::max()};
-    std::int32_t b1[3] = {std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::min(),
-                          std::numeric_limits<std::int32_t>::min()};
-    std::int64_t sum_cells = 0;
-    for (int k = 0; k < 8; ++k) {
-        if (k >= count) {
-            for (int a = 0; a < 3; ++a) {
-                q.lo[a][k] = std::numeric_limits<float>::infinity();
-                q.hi[a][k] = -std::numeric_limits<float>::infinity();
-            }
-            for (int j = 0; j < 4; ++j) q.own[j][k] = -1;
-            continue;
-        }
-        const Index* tv = tets_sorted.data() + 4 * static_cast<std::size_t>(ids - tet_order.data() + k);
-        const double* a = P + 3 * static_cast<std::size_t>(tv[0]);
-        const double* b = P + 3 * static_cast<std::size_t>(tv[1]);
-        const double* c = P + 3 * static_cast<std::size_t>(tv[2]);
-        const double* d = P + 3 * static_cast<std::size_t>(tv[3]);
-        std::int64_t cells = 1;
-        for (int ax = 0; ax < 3; ++ax) {
-            const double lo = std::min(std::min(a[ax], b[ax]), std::min(c[ax], d[ax]));
-            const double hi = std::max(std::max(a[ax], b[ax]), std::max(c[ax], d[ax]));
-            const std::int32_t l = floor_to_int(lo * inv_cell), h = floor_to_int(hi * inv_cell);
-            b0[ax] = std::min(b0[ax], l);
-            b1[ax] = std::max(b1[ax], h);
-            cells *= std::int64_t{h} - l + 1;
-            q.lo[ax][k] = static_cast<float>(lo - origin[ax]);
-            q.hi[ax][k] = static_cast<float>(hi - origin[ax]);
-        }
-        sum_cells += cells;
-        for (int j = 0; j < 4; ++j) q.own[j][k] = tv[j];
-    }
-    const std::int64_t nx = std::int64_t{b1[0]} - b0[0] + 1, ny = std::int64_t{b1[1]} - b0[1] + 1,
-                       nz = std::int64_t{b1[2]} - b0[2] + 1;
-    const VertexTable& table = tables[0];
-    const TableModulus& mod = table.modulus();
-    if (nx * ny * nz > sum_cells || static_cast<std::uint64_t>(nz) >= mod.n || table.size() == 0) {
-        for (int k = 0; k < count; ++k) stage_tets(ts, ids[k], P, false);
-        return;
-    }
-    const std::int32_t* start = table.start.data();
-    constexpr int max_ranges = 64;
-    detail::ScanRange ranges[max_ranges];
-    int nr = 0;
-    std::size_t total = 0, nhits = 0;
-    auto flush = [&]() {
-        if (nr == 0) return;
-        const std::size_t need = nhits + total + 1;
-        if (ts.hits.size() < need) ts.hits.resize(need + need / 4 + 64);
-        nhits += static_cast<std::size_t>(detail::scan_block(table, ranges, nr, q, ts.hits.data() + nhits));
-        nr = 0;
-        total = 0;
-    };
-    auto add = [&](std::int32_t begin, std::int32_t end, std::int32_t x, std::int32_t y) {
-        if (begin >= end) return;
-        ranges[nr++] = {begin, end, x, y, b0[2], b1[2]};
-        total += static_cast<std::size_t>(end - begin);
-        if (nr == max_ranges) flush();
-    };
-    const std::uint64_t mask = mod.mask;
-    const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(b0[2]));
-    for (std::int32_t x = b0[0]; x <= b1[0]; ++x)
-        for (std::int32_t y = b0[1]; y <= b1[1]; ++y) {
-            const std::uint64_t s0 = (column_mix(x, y) + zoff) & mask;
-            const std::uint64_t e = s0 + static_cast<std::uint64_t>(nz);
-            if (e <= mod.n) {
-                add(start[s0], start[e], x, y);
-            } else {
-                add(start[s0], start[mod.n], x, y);
-                add(start[0], start[e - mod.n], x, y);
-            }
-        }
-    flush();
-    if (nhits == 0) return;
-    // Hits (entry-major, a lane mask each) → one candidate run per tet, in tet order.
-    std::int32_t offset[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const detail::BlockHit* hits = ts.hits.data();
-    for (std::size_t h = 0; h < nhits; ++h)
-        for (int lanes = hits[h].lanes; lanes; lanes &= lanes - 1) ++offset[__builtin_ctz(static_cast<unsigned>(lanes)) + 1];
-    for (int k = 0; k < 8; ++k) offset[k + 1] += offset[k];
-    const std::size_t need = ts.used + static_cast<std::size_t>(offset[8]);
-    if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
-    Index* cand = ts.candidates.data() + ts.used;
-    std::int32_t fill[8];
-    for (int k = 0; k < 8; ++k) fill[k] = offset[k];
-    for (std::size_t h = 0; h < nhits; ++h)
-        for (int lanes = hits[h].lanes; lanes; lanes &= lanes - 1)
-            cand[fill[__builtin_ctz(static_cast<unsigned>(lanes))]++] = hits[h].vertex;
-    const auto base = static_cast<std::int32_t>(ts.used);
-    for (int k = 0; k < count; ++k)
-        if (offset[k + 1] > offset[k]) ts.runs.push_back({ids[k], base + offset[k], base + offset[k + 1]});
-    ts.used = need;
-}
-
 // Stage 3 over a thread's candidate runs: face planes per tet (only tets with candidates), filtered
 // plane tests for all candidates of the tet at once (AVX2 where available), exact orientation only where
 // the filter cannot decide.
@@ -571,30 +431,14 @@ void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
             count = kept;
             if (count == 0) continue;
         }
-        const predicates::Orientation o = predicates::orient3d(A, B, C, D);
-        ts.counters.exact += o.exact;
-        if (o.sign == 0) continue;
-        const double s = o.sign;
-        // Face i: p replaces vertex i; value = n_i · (p − r_i) (the orient3d evaluation order, so Shewchuk's
-        // bound holds); m_i are the permanent weights of the bound. The sign of the tet is folded into n_i.
+        // Face planes with the tet's orientation folded in (AVX2: four faces in four lanes); the orientation's
+        // exact sign comes from face 3's plane at D.
         detail::FacePlanes f;
-        auto face = [&](int i, const double* ref, const double* u, const double* w) {
-            const double ux = u[0] - ref[0], uy = u[1] - ref[1], uz = u[2] - ref[2];
-            const double wx = w[0] - ref[0], wy = w[1] - ref[1], wz = w[2] - ref[2];
-            f.nx[i] = s * (uy * wz - uz * wy);
-            f.ny[i] = s * (uz * wx - ux * wz);
-            f.nz[i] = s * (ux * wy - uy * wx);
-            f.mx[i] = std::fabs(uy * wz) + std::fabs(uz * wy);
-            f.my[i] = std::fabs(uz * wx) + std::fabs(ux * wz);
-            f.mz[i] = std::fabs(ux * wy) + std::fabs(uy * wx);
-            f.rx[i] = ref[0];
-            f.ry[i] = ref[1];
-            f.rz[i] = ref[2];
-        };
-        face(0, D, C, B);   // orient(p,b,c,d) = (p−d)·((c−d)×(b−d))
-        face(1, D, A, C);   // orient(a,p,c,d) = (p−d)·((a−d)×(c−d))
-        face(2, D, B, A);   // orient(a,b,p,d) = (p−d)·((b−d)×(a−d))
-        face(3, A, B, C);   // orient(a,b,c,p) = (p−a)·((b−a)×(c−a))
+        bool tet_exact = false;
+        const int tet_sign = detail::face_planes(A, B, C, D, f, tet_exact);
+        ts.counters.exact += tet_exact;
+        if (tet_sign == 0) continue;
+        const double s = tet_sign;
         if (ts.codes.size() < static_cast<std::size_t>(count)) {
             ts.codes.resize(std::max<std::size_t>(static_cast<std::size_t>(count), 2 * ts.codes.size()));
             ts.values.resize(4 * ts.codes.size());
@@ -619,7 +463,7 @@ void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
                     default: e = predicates::orient3d_exact(A, B, C, p); break;
                     }
                     ++ts.counters.exact;
-                    if (e.sign * o.sign < 0) outside = true;
+                    if (e.sign * tet_sign < 0) outside = true;
                     val[i] = e.value * s;
                 }
                 if (outside) continue;
@@ -641,7 +485,9 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         throw Error("positions has " + std::to_string(positions.rows()) + " rows, expected " +
                     std::to_string(num_vertices) + " (the number of vertices given to set_topology)");
     if (!prepared) prepare(positions);
-    const int T = resolve_threads(params.threads);
+    // Automatic thread count: one thread for small scenes, where waking the others costs more than it saves
+    // (fewer than 2,000 tets: well under 0.2 ms of work at one thread). An explicit count is always honoured.
+    const int T = params.threads == 0 && tets.size() / 4 < 2000 ? 1 : resolve_threads(params.threads);
     if (static_cast<int>(threads.size()) != T) threads.resize(static_cast<std::size_t>(T));
     const double* P = positions.data();
 
@@ -655,14 +501,6 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     // Stages 2 and 3, parallel over tets; each thread then tests its own candidates.
     const Index m = static_cast<Index>(tets.size() / 4);
     const bool with_stats = stats != nullptr;
-    // The block path (eight tets per scan) where it applies; statistics count per tet, so they use the other.
-    // Environment TETHASH_BLOCKS=0 turns it off (for measuring one path against the other).
-    static const bool blocks_allowed = [] {
-        const char* e = std::getenv("TETHASH_BLOCKS");
-        return !(e && std::strcmp(e, "0") == 0);
-    }();
-    const bool use_blocks = blocks_allowed && !with_stats && !any_static && params.hash == HashFunction::column &&
-                            tables[0].modulus().pow2;
     for (ThreadState& ts : threads) {
         ts.used = 0;
         ts.runs.clear();
@@ -678,15 +516,8 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         ThreadState& ts = threads[0];
 #endif
         const auto t0 = Clock::now();
-        if (use_blocks) {
-            const Index blocks = (m + 7) / 8;
-#pragma omp for schedule(dynamic, 32) nowait
-            for (Index bi = 0; bi < blocks; ++bi)
-                stage_block(ts, tet_order.data() + 8 * bi, static_cast<int>(std::min<Index>(8, m - 8 * bi)), P);
-        } else {
 #pragma omp for schedule(dynamic, 256) nowait
-            for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
-        }
+        for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
         ts.ms_tets = ms_since(t0);
         const auto t1 = Clock::now();
         stage_inside(ts, P);

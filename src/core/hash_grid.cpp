@@ -36,9 +36,9 @@ std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices)
 
 std::int64_t VertexTable::memory_bytes() const
 {
-    return static_cast<std::int64_t>(x.capacity() * 3 * sizeof(float) + id.capacity() * 4 * sizeof(std::int32_t) +
-                                     start.capacity() * sizeof(std::int32_t) + m_bucket.capacity() * 4 +
-                                     m_cell.capacity() * 4 + m_local.capacity() * 4);
+    return static_cast<std::int64_t>(x.capacity() * 3 * sizeof(float) + id.capacity() * sizeof(std::int32_t) +
+                                     key.capacity() * sizeof(std::uint32_t) + start.capacity() * sizeof(std::int32_t) +
+                                     m_bucket.capacity() * 4 + m_key.capacity() * 4);
 }
 
 bool VertexTable::build(const double* positions, const Index* ids, Index count, double cell_size,
@@ -49,11 +49,11 @@ bool VertexTable::build(const double* positions, const Index* ids, Index count, 
     const std::size_t padded = static_cast<std::size_t>(count) + 8;
     if (x.size() != padded) {
         for (auto* v : {&x, &y, &z}) v->assign(padded, std::numeric_limits<float>::quiet_NaN());
-        for (auto* v : {&id, &cx, &cy, &cz}) v->assign(padded, std::numeric_limits<std::int32_t>::min());
+        id.assign(padded, std::numeric_limits<std::int32_t>::min());
+        key.assign(padded, 0);
     }
     m_bucket.resize(count);
-    m_cell.resize(3 * static_cast<std::size_t>(count));
-    m_local.resize(3 * static_cast<std::size_t>(count));
+    m_key.resize(count);
     start.assign(static_cast<std::size_t>(table_size) + 1, 0);
 
     const double inv = 1.0 / cell_size;
@@ -73,12 +73,7 @@ bool VertexTable::build(const double* positions, const Index* ids, Index count, 
             continue;
         }
         const std::int32_t ix = floor_to_int(sx), iy = floor_to_int(sy), iz = floor_to_int(sz);
-        m_cell[3 * i] = ix;
-        m_cell[3 * i + 1] = iy;
-        m_cell[3 * i + 2] = iz;
-        m_local[3 * i] = static_cast<float>(p[0] - ox);
-        m_local[3 * i + 1] = static_cast<float>(p[1] - oy);
-        m_local[3 * i + 2] = static_cast<float>(p[2] - oz);
+        m_key[i] = cell_key(ix, iy, iz);
         m_bucket[i] = static_cast<std::uint32_t>(hash == HashFunction::column
                                                      ? mod.column_bucket(column_mix(ix, iy), iz)
                                                      : mod.reduce(teschner_hash(ix, iy, iz)));
@@ -91,13 +86,13 @@ bool VertexTable::build(const double* positions, const Index* ids, Index count, 
     for (std::int64_t b = 0; b < table_size; ++b) s[b + 1] += s[b];
     for (Index i = 0; i < count; ++i) {
         const std::int32_t k = s[m_bucket[i]]++;
-        x[k] = m_local[3 * i];
-        y[k] = m_local[3 * i + 1];
-        z[k] = m_local[3 * i + 2];
-        id[k] = ids ? ids[i] : i;
-        cx[k] = m_cell[3 * i];
-        cy[k] = m_cell[3 * i + 1];
-        cz[k] = m_cell[3 * i + 2];
+        const Index v = ids ? ids[i] : i;
+        const double* p = positions + 3 * static_cast<std::size_t>(v);
+        x[k] = static_cast<float>(p[0] - ox);
+        y[k] = static_cast<float>(p[1] - oy);
+        z[k] = static_cast<float>(p[2] - oz);
+        id[k] = v;
+        key[k] = m_key[i];
     }
     // start[b] now holds the end of bucket b: shift right by one.
     std::memmove(s + 1, s, static_cast<std::size_t>(table_size) * sizeof(std::int32_t));

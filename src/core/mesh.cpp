@@ -101,6 +101,74 @@ void TetMesh::append(const TetMesh& other)
     }
 }
 
+LabelSplit split_objects_by_label(TetMesh& mesh, SharedLabelVertices shared, const std::string& what)
+{
+    mesh.check_consistency(what);
+    const Index n = mesh.num_vertices(), m = mesh.num_tets();
+    LabelSplit out;
+    if (mesh.tet_label.empty()) {
+        mesh.vertex_object.assign(static_cast<std::size_t>(n), 0);
+        mesh.tet_object.assign(static_cast<std::size_t>(m), 0);
+        if (n > 0 || m > 0) out.object_labels.push_back({});
+        return out;
+    }
+    // Distinct labels in increasing order; each tet's label as an index into them.
+    std::vector<Index> labels(mesh.tet_label);
+    std::sort(labels.begin(), labels.end());
+    labels.erase(std::unique(labels.begin(), labels.end()), labels.end());
+    const auto k = labels.size();
+    auto label_index = [&](Index label) {
+        return static_cast<std::size_t>(std::lower_bound(labels.begin(), labels.end(), label) - labels.begin());
+    };
+    // Union-find over label indices (used by join only); a vertex records the first label seen.
+    std::vector<std::size_t> parent(k);
+    for (std::size_t i = 0; i < k; ++i) parent[i] = i;
+    auto find = [&](std::size_t i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    constexpr std::size_t none = static_cast<std::size_t>(-1);
+    std::vector<std::size_t> vertex_label(static_cast<std::size_t>(n), none);
+    std::vector<char> vertex_shared(static_cast<std::size_t>(n), 0);
+    for (Index t = 0; t < m; ++t) {
+        const std::size_t li = label_index(mesh.tet_label[static_cast<std::size_t>(t)]);
+        for (int c = 0; c < 4; ++c) {
+            const auto v = static_cast<std::size_t>(mesh.tets(t, c));
+            if (vertex_label[v] == none) {
+                vertex_label[v] = li;
+            } else if (vertex_label[v] != li) {
+                if (shared == SharedLabelVertices::error)
+                    throw Error(what + ": vertex " + std::to_string(v) + " is in tets of label " +
+                                std::to_string(labels[vertex_label[v]]) + " and of label " + std::to_string(labels[li]) +
+                                " (tet " + std::to_string(t) + "): these labels are not separate bodies");
+                vertex_shared[v] = 1;
+                const std::size_t a = find(vertex_label[v]), b = find(li);
+                if (a != b) parent[std::max(a, b)] = std::min(a, b);
+            }
+        }
+    }
+    for (char c : vertex_shared) out.shared_vertices += c;
+    // Objects numbered by their smallest label (roots are the smallest index of their set).
+    std::vector<Index> object_of_root(k, -1);
+    for (std::size_t i = 0; i < k; ++i) {
+        const std::size_t r = find(i);
+        if (object_of_root[r] < 0) {
+            object_of_root[r] = static_cast<Index>(out.object_labels.size());
+            out.object_labels.emplace_back();
+        }
+        out.object_labels[static_cast<std::size_t>(object_of_root[r])].push_back(labels[i]);
+    }
+    mesh.tet_object.resize(static_cast<std::size_t>(m));
+    for (Index t = 0; t < m; ++t)
+        mesh.tet_object[static_cast<std::size_t>(t)] = object_of_root[find(label_index(mesh.tet_label[static_cast<std::size_t>(t)]))];
+    mesh.vertex_object.resize(static_cast<std::size_t>(n));
+    for (Index v = 0; v < n; ++v) {
+        const std::size_t li = vertex_label[static_cast<std::size_t>(v)];
+        mesh.vertex_object[static_cast<std::size_t>(v)] = li == none ? 0 : object_of_root[find(li)];
+    }
+    return out;
+}
+
 void TetMesh::check_consistency(const std::string& what) const
 {
     const auto n = positions.rows();

@@ -22,8 +22,11 @@ std::int32_t scan_scalar(const VertexTable& t, std::int32_t begin, std::int32_t 
 {
     std::int32_t n = 0;
     c.scanned += end - begin;
+    const std::uint32_t ckey = column_key(q.cx, q.cy);
+    const auto zspan = static_cast<std::uint32_t>(q.z1 - q.z0);
     for (std::int32_t i = begin; i < end; ++i) {
-        if (t.cx[i] != q.cx || t.cy[i] != q.cy || t.cz[i] < q.z0 || t.cz[i] > q.z1) {
+        const std::uint32_t k = t.key[i];
+        if ((k & key_column_mask) != ckey || (((k >> 22) - static_cast<std::uint32_t>(q.z0)) & 0x3ffu) > zspan) {
             ++c.collisions;
             continue;
         }
@@ -56,23 +59,22 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const Verte
     const float* Y = t.y.data();
     const float* Z = t.z.data();
     const std::int32_t* ID = t.id.data();
-    const std::int32_t* CX = t.cx.data();
-    const std::int32_t* CY = t.cy.data();
-    const std::int32_t* CZ = t.cz.data();
+    const std::uint32_t* KEY = t.key.data();
+    const __m256i colmask = _mm256_set1_epi32(static_cast<int>(key_column_mask));
+    const __m256i zmask = _mm256_set1_epi32(0x3ff);
     std::int32_t n = 0;
     std::int64_t coll = 0, boxr = 0, own = 0;
     for (std::int32_t r = 0; r < count; ++r) {
     const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
-    const __m256i qx = _mm256_set1_epi32(ranges[r].cx), qy = _mm256_set1_epi32(ranges[r].cy);
-    const __m256i z0 = _mm256_set1_epi32(ranges[r].z0 - 1), z1 = _mm256_set1_epi32(ranges[r].z1 + 1);
+    const __m256i qk = _mm256_set1_epi32(static_cast<int>(column_key(ranges[r].cx, ranges[r].cy)));
+    const __m256i z0 = _mm256_set1_epi32(ranges[r].z0), zs = _mm256_set1_epi32(ranges[r].z1 - ranges[r].z0 + 1);
     c.scanned += end - begin;
     for (std::int32_t i = begin; i < end; i += 8) {
         const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
-        const __m256i cx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CX + i));
-        const __m256i cy = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CY + i));
-        const __m256i cz = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(CZ + i));
-        const __m256i cell = _mm256_and_si256(_mm256_and_si256(_mm256_cmpeq_epi32(cx, qx), _mm256_cmpeq_epi32(cy, qy)),
-                                              _mm256_and_si256(_mm256_cmpgt_epi32(cz, z0), _mm256_cmpgt_epi32(z1, cz)));
+        const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
+        const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
+        const __m256i cell = _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk),
+                                              _mm256_cmpgt_epi32(zs, dz));
         const int mv = _mm256_movemask_ps(_mm256_castsi256_ps(valid));
         const int mc = _mm256_movemask_ps(_mm256_castsi256_ps(cell)) & mv;
         coll += __builtin_popcount(mv & ~mc);
@@ -118,13 +120,20 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
     const float* Y = t.y.data();
     const float* Z = t.z.data();
     const std::int32_t* ID = t.id.data();
-    const std::int32_t* CX = t.cx.data();
-    const std::int32_t* CY = t.cy.data();
-    const std::int32_t* CZ = t.cz.data();
+    const std::uint32_t* KEY = t.key.data();
+    // Start the loads of every range first (the ranges lie scattered over the table).
+    for (std::int32_t r = 0; r < count; ++r) {
+        const std::int32_t b = ranges[r].begin;
+        _mm_prefetch(reinterpret_cast<const char*>(X + b), _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(Y + b), _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(Z + b), _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(ID + b), _MM_HINT_T0);
+    }
     std::int32_t n = 0;
     for (std::int32_t r = 0; r < count; ++r) {
         const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
-        const std::int32_t rx = ranges[r].cx, ry = ranges[r].cy, z0 = ranges[r].z0;
+        const std::uint32_t ckey = column_key(ranges[r].cx, ranges[r].cy);
+        const auto z0 = static_cast<std::uint32_t>(ranges[r].z0);
         const auto zspan = static_cast<std::uint32_t>(ranges[r].z1 - ranges[r].z0);
         for (std::int32_t i = begin; i < end; i += 8) {
             // Lanes past `end` read the next entries or the padding (NaN coordinates): masked off.
@@ -143,78 +152,9 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
                 const std::int32_t j = i + __builtin_ctz(static_cast<unsigned>(keep));
                 keep &= keep - 1;
                 // Entry from this range's cells (not a foreign cell sharing the bucket: a duplicate or a miss).
-                if (CX[j] == rx && CY[j] == ry && static_cast<std::uint32_t>(CZ[j] - z0) <= zspan) out[n++] = ID[j];
+                const std::uint32_t k = KEY[j];
+                if ((k & key_column_mask) == ckey && (((k >> 22) - z0) & 0x3ffu) <= zspan) out[n++] = ID[j];
             }
-        }
-    }
-    return n;
-}
-#endif
-
-std::int32_t scan_block_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count,
-                               const BlockQuery& q, BlockHit* out)
-{
-    std::int32_t n = 0;
-    for (std::int32_t r = 0; r < count; ++r) {
-        const ScanRange& R = ranges[r];
-        const auto zspan = static_cast<std::uint32_t>(R.z1 - R.z0);
-        for (std::int32_t i = R.begin; i < R.end; ++i) {
-            if (t.cx[i] != R.cx || t.cy[i] != R.cy || static_cast<std::uint32_t>(t.cz[i] - R.z0) > zspan) continue;
-            const float x = t.x[i], y = t.y[i], z = t.z[i];
-            const Index v = t.id[i];
-            int m = 0;
-            for (int k = 0; k < 8; ++k)
-                if (x >= q.lo[0][k] && x <= q.hi[0][k] && y >= q.lo[1][k] && y <= q.hi[1][k] && z >= q.lo[2][k] &&
-                    z <= q.hi[2][k] && v != q.own[0][k] && v != q.own[1][k] && v != q.own[2][k] && v != q.own[3][k])
-                    m |= 1 << k;
-            if (m) out[n++] = {v, m};
-        }
-    }
-    return n;
-}
-
-#ifdef TETHASH_X86
-// Each entry broadcast against the eight boxes: 6 compares give the lanes whose box holds it, 4 more the lanes
-// it is an own vertex of, and the cell test masks foreign cells. Branch-free per entry (about a third of the
-// entries are inside some box, in no predictable pattern): every entry writes a record, only records with
-// lanes left advance the output.
-__attribute__((target("avx2,popcnt"))) std::int32_t scan_block_avx2(const VertexTable& t, const ScanRange* ranges,
-                                                                     std::int32_t count, const BlockQuery& q,
-                                                                     BlockHit* out)
-{
-    const __m256 lx = _mm256_load_ps(q.lo[0]), ly = _mm256_load_ps(q.lo[1]), lz = _mm256_load_ps(q.lo[2]);
-    const __m256 hx = _mm256_load_ps(q.hi[0]), hy = _mm256_load_ps(q.hi[1]), hz = _mm256_load_ps(q.hi[2]);
-    const __m256i o0 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[0]));
-    const __m256i o1 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[1]));
-    const __m256i o2 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[2]));
-    const __m256i o3 = _mm256_load_si256(reinterpret_cast<const __m256i*>(q.own[3]));
-    const float* X = t.x.data();
-    const float* Y = t.y.data();
-    const float* Z = t.z.data();
-    const std::int32_t* ID = t.id.data();
-    const std::int32_t* CX = t.cx.data();
-    const std::int32_t* CY = t.cy.data();
-    const std::int32_t* CZ = t.cz.data();
-    std::int32_t n = 0;
-    for (std::int32_t r = 0; r < count; ++r) {
-        const ScanRange& R = ranges[r];
-        const std::int32_t rx = R.cx, ry = R.cy, z0 = R.z0;
-        const auto zspan = static_cast<std::uint32_t>(R.z1 - R.z0);
-        for (std::int32_t i = R.begin; i < R.end; ++i) {
-            const __m256 x = _mm256_broadcast_ss(X + i), y = _mm256_broadcast_ss(Y + i), z = _mm256_broadcast_ss(Z + i);
-            const __m256 in = _mm256_and_ps(
-                _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ)),
-                              _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ))),
-                _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ)));
-            const Index v = ID[i];
-            const __m256i vv = _mm256_set1_epi32(v);
-            const __m256i own = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(vv, o0), _mm256_cmpeq_epi32(vv, o1)),
-                                                _mm256_or_si256(_mm256_cmpeq_epi32(vv, o2), _mm256_cmpeq_epi32(vv, o3)));
-            // Only entries of this range's cells (a foreign cell sharing the bucket would be a duplicate or a miss).
-            const int cell = (CX[i] == rx) & (CY[i] == ry) & (static_cast<std::uint32_t>(CZ[i] - z0) <= zspan);
-            const int m = _mm256_movemask_ps(_mm256_andnot_ps(_mm256_castsi256_ps(own), in)) & -cell;
-            out[n] = {v, m};
-            n += m != 0;
         }
     }
     return n;
@@ -268,6 +208,57 @@ __attribute__((target("avx2"))) void filter_avx2(const FacePlanes& f, const doub
 }
 #endif
 
+// Face i: p replaces vertex i; value = n_i · (p − r_i) (the orient3d evaluation order, so Shewchuk's bound
+// holds); m_i are the permanent weights of the bound. Lanes: (ref, u, w) = (D, C, B), (D, A, C), (D, B, A), (A, B, C):
+//   orient(p,b,c,d) = (p−d)·((c−d)×(b−d)),  orient(a,p,c,d) = (p−d)·((a−d)×(c−d)),
+//   orient(a,b,p,d) = (p−d)·((b−d)×(a−d)),  orient(a,b,c,p) = (p−a)·((b−a)×(c−a)).
+void faces_scalar(const double* A, const double* B, const double* C, const double* D, FacePlanes& f)
+{
+    const double* ref[4] = {D, D, D, A};
+    const double* u[4] = {C, A, B, B};
+    const double* w[4] = {B, C, A, C};
+    for (int i = 0; i < 4; ++i) {
+        const double ux = u[i][0] - ref[i][0], uy = u[i][1] - ref[i][1], uz = u[i][2] - ref[i][2];
+        const double wx = w[i][0] - ref[i][0], wy = w[i][1] - ref[i][1], wz = w[i][2] - ref[i][2];
+        f.nx[i] = uy * wz - uz * wy;
+        f.ny[i] = uz * wx - ux * wz;
+        f.nz[i] = ux * wy - uy * wx;
+        f.mx[i] = std::fabs(uy * wz) + std::fabs(uz * wy);
+        f.my[i] = std::fabs(uz * wx) + std::fabs(ux * wz);
+        f.mz[i] = std::fabs(ux * wy) + std::fabs(uy * wx);
+        f.rx[i] = ref[i][0];
+        f.ry[i] = ref[i][1];
+        f.rz[i] = ref[i][2];
+    }
+}
+
+#ifdef TETHASH_X86
+// The same operations as faces_scalar, four faces in the four lanes (same results bit for bit).
+__attribute__((target("avx2"))) void faces_avx2(const double* A, const double* B, const double* C, const double* D,
+                                                FacePlanes& f)
+{
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    __m256d r[3], u[3], w[3];
+    for (int k = 0; k < 3; ++k) {
+        r[k] = _mm256_setr_pd(D[k], D[k], D[k], A[k]);
+        u[k] = _mm256_sub_pd(_mm256_setr_pd(C[k], A[k], B[k], B[k]), r[k]);
+        w[k] = _mm256_sub_pd(_mm256_setr_pd(B[k], C[k], A[k], C[k]), r[k]);
+    }
+    const __m256d yz = _mm256_mul_pd(u[1], w[2]), zy = _mm256_mul_pd(u[2], w[1]);
+    const __m256d zx = _mm256_mul_pd(u[2], w[0]), xz = _mm256_mul_pd(u[0], w[2]);
+    const __m256d xy = _mm256_mul_pd(u[0], w[1]), yx = _mm256_mul_pd(u[1], w[0]);
+    _mm256_store_pd(f.nx, _mm256_sub_pd(yz, zy));
+    _mm256_store_pd(f.ny, _mm256_sub_pd(zx, xz));
+    _mm256_store_pd(f.nz, _mm256_sub_pd(xy, yx));
+    _mm256_store_pd(f.mx, _mm256_add_pd(_mm256_andnot_pd(sign, yz), _mm256_andnot_pd(sign, zy)));
+    _mm256_store_pd(f.my, _mm256_add_pd(_mm256_andnot_pd(sign, zx), _mm256_andnot_pd(sign, xz)));
+    _mm256_store_pd(f.mz, _mm256_add_pd(_mm256_andnot_pd(sign, xy), _mm256_andnot_pd(sign, yx)));
+    _mm256_store_pd(f.rx, r[0]);
+    _mm256_store_pd(f.ry, r[1]);
+    _mm256_store_pd(f.rz, r[2]);
+}
+#endif
+
 using FilterFn = void (*)(const FacePlanes&, const double*, const Index*, std::int32_t, double*, std::int8_t*);
 
 std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count,
@@ -281,6 +272,38 @@ std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, s
         qq.z0 = ranges[r].z0;
         qq.z1 = ranges[r].z1;
         n += scan_scalar(t, ranges[r].begin, ranges[r].end, qq, out + n, c);
+    }
+    return n;
+}
+
+// Cell boxes too big for the key test (see cell_key): every entry's cell recomputed from its double position,
+// with the same expression as the vertex table. Scalar; only tets spanning hundreds of cells get here.
+std::int32_t scan_ranges_exact(const VertexTable& t, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
+                               Index* out, ScanCounters& c, const double* P, double inv_cell)
+{
+    std::int32_t n = 0;
+    for (std::int32_t r = 0; r < count; ++r) {
+        const ScanRange& R = ranges[r];
+        c.scanned += R.end - R.begin;
+        for (std::int32_t i = R.begin; i < R.end; ++i) {
+            const Index v = t.id[i];
+            const double* p = P + 3 * static_cast<std::size_t>(v);
+            const std::int32_t cz = floor_to_int(p[2] * inv_cell);
+            if (floor_to_int(p[0] * inv_cell) != R.cx || floor_to_int(p[1] * inv_cell) != R.cy || cz < R.z0 || cz > R.z1) {
+                ++c.collisions;
+                continue;
+            }
+            if (!(t.x[i] >= q.lo[0] && t.x[i] <= q.hi[0] && t.y[i] >= q.lo[1] && t.y[i] <= q.hi[1] &&
+                  t.z[i] >= q.lo[2] && t.z[i] <= q.hi[2])) {
+                ++c.box_rejections;
+                continue;
+            }
+            if (v == q.own[0] || v == q.own[1] || v == q.own[2] || v == q.own[3]) {
+                ++c.own;
+                continue;
+            }
+            out[n++] = v;
+        }
     }
     return n;
 }
@@ -315,8 +338,10 @@ const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 } // namespace
 
 std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
-                         Index* out, ScanCounters& counters, bool full_counts)
+                         Index* out, ScanCounters& counters, bool full_counts, const double* exact_positions,
+                         double inv_cell)
 {
+    if (exact_positions) return scan_ranges_exact(table, ranges, count, q, out, counters, exact_positions, inv_cell);
     return (full_counts ? chosen : chosen_lean)(table, ranges, count, q, out, counters);
 }
 
@@ -333,13 +358,34 @@ void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, 
     chosen_filter(f, P, cand, count, val, code);
 }
 
-std::int32_t scan_block(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const BlockQuery& q,
-                        BlockHit* out)
+int face_planes(const double* A, const double* B, const double* C, const double* D, FacePlanes& f, bool& exact)
 {
 #ifdef TETHASH_X86
-    if (chosen == scan_ranges_avx2) return scan_block_avx2(table, ranges, count, q, out);
+    if (chosen_filter == filter_avx2) faces_avx2(A, B, C, D, f);
+    else faces_scalar(A, B, C, D, f);
+#else
+    faces_scalar(A, B, C, D, f);
 #endif
-    return scan_block_scalar(table, ranges, count, q, out);
+    // orient(A, B, C, D) = face 3 at D, with the candidate filter's bound.
+    const double dx = D[0] - f.rx[3], dy = D[1] - f.ry[3], dz = D[2] - f.rz[3];
+    const double det = f.nx[3] * dx + f.ny[3] * dy + f.nz[3] * dz;
+    const double bound = predicates::orient3d_error_bound *
+                         (std::fabs(dx) * f.mx[3] + std::fabs(dy) * f.my[3] + std::fabs(dz) * f.mz[3]);
+    int s;
+    exact = false;
+    if (det > bound) s = 1;
+    else if (det < -bound) s = -1;
+    else {
+        s = predicates::orient3d_exact(A, B, C, D).sign;
+        exact = true;
+    }
+    if (s < 0)
+        for (int i = 0; i < 4; ++i) {
+            f.nx[i] = -f.nx[i];
+            f.ny[i] = -f.ny[i];
+            f.nz[i] = -f.nz[i];
+        }
+    return s;
 }
 
 const char* scan_kernel_name() { return chosen == scan_ranges_scalar ? "scalar" : "avx2"; }

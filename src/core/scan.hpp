@@ -27,33 +27,16 @@ struct ScanRange {
 /// to `out` (room for the sum of the range lengths); returns how many. With `full_counts` every entry is
 /// classified for `counters` (cell, box, own); without, a leaner kernel tests the box first and the cell only
 /// for box survivors, and leaves `counters` alone. Both append the same ids in the same order.
+/// With `exact_positions` (the n × 3 positions the table was built from, and 1 / cell size): cells are recomputed
+/// from the double positions instead of the key test, for cell boxes beyond key_exact_xy / key_exact_z.
 std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
-                         Index* out, ScanCounters& counters, bool full_counts = true);
+                         Index* out, ScanCounters& counters, bool full_counts = true,
+                         const double* exact_positions = nullptr, double inv_cell = 0);
 
 /// Appends to `out` the ids of the entries [begin, end) of `table` that match `q`; returns how many.
 /// `out` must have room for end − begin ids.
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
                                Index* out, ScanCounters& counters);
-
-/// Eight tets scanned together (stage 2, block path): lane k is one tet (float box relative to the table origin,
-/// own vertex ids); lanes without a tet have an empty box (lo = +inf, hi = −inf).
-struct alignas(32) BlockQuery {
-    float lo[3][8], hi[3][8];
-    Index own[4][8];
-};
-
-/// One hit of the block scan: vertex `vertex` lies in the boxes of the lanes set in `lanes` (bit k: lane k) and is
-/// not one of their own vertices.
-struct BlockHit {
-    Index vertex;
-    std::int32_t lanes;
-};
-
-/// Scans every range of `ranges` (each: the bucket range of one column and the block's z-range) once for all
-/// eight lanes of `q`: an entry of the range's column and z-range is tested against the eight boxes at once.
-/// Appends to `out` (room for the sum of the range lengths + 1) and returns how many hits.
-std::int32_t scan_block(const VertexTable& table, const ScanRange* ranges, std::int32_t count, const BlockQuery& q,
-                        BlockHit* out);
 
 /// "avx2" or "scalar": the version scan_bucket_range uses (environment TETHASH_SIMD=scalar forces scalar).
 const char* scan_kernel_name();
@@ -69,6 +52,11 @@ struct alignas(32) FacePlanes {
     double nx[4], ny[4], nz[4];
     double mx[4], my[4], mz[4];
 };
+
+/// Builds the face planes of tet (A, B, C, D) (each point 3 doubles) with the tet's orientation folded in, and
+/// returns that orientation's exact sign (0: flat tet, `f` unusable). The sign comes from face 3's plane at D with
+/// the same error bound as the candidate filter; `exact` is set when it needed exact arithmetic.
+int face_planes(const double* A, const double* B, const double* C, const double* D, FacePlanes& f, bool& exact);
 
 /// Filtered plane tests of `count` candidates (vertex ids `cand`, positions `P` n × 3): for candidate j writes the
 /// four values to val[4j..4j+3] and returns in code[j] −1 if p is certainly outside, else the bit mask of faces

@@ -9,6 +9,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <unistd.h>
 
@@ -62,27 +66,121 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
                     "' (expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
 }
 
-void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write)
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Folder that will hold `target` ("." for a bare file name).
+fs::path folder_of(const fs::path& target) { return target.has_parent_path() ? target.parent_path() : fs::path("."); }
+
+/// A unique hidden temporary name next to `target`.
+fs::path temporary_for(const fs::path& target)
 {
-    namespace fs = std::filesystem;
     static std::atomic<int> counter{0};
-    const fs::path target(path);
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(dir)) throw Error(path + ": folder '" + dir.string() + "' does not exist");
     std::string name = target.filename().string(); // appended piecewise: g++ 12 warns falsely on "." + string
     name.insert(name.begin(), '.');
     name.append(".tmp").append(std::to_string(::getpid())).append("_").append(std::to_string(counter++));
-    const fs::path tmp = dir / name;
+    return folder_of(target) / name;
+}
+
+/// `text` with every occurrence of `from` replaced by `to`.
+std::string replace_all(std::string text, const std::string& from, const std::string& to)
+{
+    if (from.empty()) return text;
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    return text;
+}
+
+void check_target(const std::string& path)
+{
+    const fs::path target(path);
+    if (path.empty()) throw Error("empty output file name");
+    if (fs::is_directory(target)) throw Error(path + ": is a directory, expected a file name");
+    const fs::path dir = folder_of(target);
+    if (!fs::exists(dir)) throw Error(path + ": folder '" + dir.string() + "' does not exist");
+    if (!fs::is_directory(dir)) throw Error(path + ": '" + dir.string() + "' is not a folder");
+}
+
+} // namespace
+
+void write_atomically(const std::vector<std::string>& paths,
+                      const std::function<void(const std::vector<std::string>&)>& write)
+{
+    for (const std::string& p : paths) check_target(p);
+    std::vector<std::string> tmps;
+    for (const std::string& p : paths) tmps.push_back(temporary_for(p).string());
+    auto remove_temporaries = [&] {
+        for (const std::string& t : tmps) {
+            std::error_code ec;
+            fs::remove(t, ec);
+        }
+    };
     try {
-        write(tmp.string());
-        std::error_code ec;
-        fs::rename(tmp, target, ec);
-        if (ec) throw Error(path + ": cannot rename temporary file into place: " + ec.message());
+        write(tmps);
+        for (std::size_t i = 0; i < paths.size(); ++i) {
+            std::error_code ec;
+            fs::rename(tmps[i], paths[i], ec);
+            if (ec) throw Error(paths[i] + ": cannot move the temporary file into place: " + ec.message());
+        }
+    } catch (const Error& e) {
+        remove_temporaries();
+        std::string msg = e.what();
+        for (std::size_t i = 0; i < paths.size(); ++i) msg = replace_all(msg, tmps[i], paths[i]);
+        throw Error(msg);
     } catch (...) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
+        remove_temporaries();
         throw;
     }
+}
+
+void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write)
+{
+    write_atomically(std::vector<std::string>{path}, [&](const std::vector<std::string>& tmps) { write(tmps[0]); });
+}
+
+void write_text_file(const std::string& path, const std::string& text)
+{
+    write_atomically(path, [&](const std::string& tmp) {
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) throw Error(path + ": cannot create file: " + std::strerror(errno));
+        errno = 0;
+        const bool wrote = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+        const bool flushed = std::fflush(f) == 0;
+        const int err = errno;
+        const bool closed = std::fclose(f) == 0;
+        if (!wrote || !flushed || !closed) throw Error(path + ": write failed: " + std::strerror(err ? err : EIO));
+    });
+}
+
+void check_output_file(const std::string& path, const std::string& what)
+{
+    try {
+        check_target(path);
+    } catch (const Error& e) {
+        throw Error(what + ": " + e.what());
+    }
+    // Probe the folder: permissions, read-only file systems and special folders all show up here.
+    const fs::path probe = temporary_for(fs::path(path));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+        throw Error(what + ": " + path + ": cannot create files in folder '" + folder_of(fs::path(path)).string() +
+                    "': " + std::strerror(errno));
+    ::close(fd);
+    ::unlink(probe.c_str());
+}
+
+void check_mesh_output_file(const std::string& path, const std::string& what)
+{
+    const std::string e = extension_of(path);
+    const bool tet = e == ".vtu" || e == ".vtk" || e == ".msh" || e == ".mesh" || e == ".node" || e == ".ele";
+    const bool surface = e == ".obj" || e == ".ply" || e == ".stl" || e == ".gltf" || e == ".glb";
+    if (!fs::is_directory(path) && !tet && !surface)
+        throw Error(what + ": " + path + ": unknown output format '" + e +
+                    "' (expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
+    if (surface && !have_assimp())
+        throw Error(what + ": " + path + ": cannot write surfaces: tethash was built without assimp");
+    check_output_file(path, what);
 }
 
 } // namespace tethash::io

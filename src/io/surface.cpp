@@ -7,11 +7,16 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <unistd.h>
 
 #ifdef TETHASH_HAVE_ASSIMP
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Exporter.hpp>
+#include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -114,6 +119,74 @@ SurfaceMesh read_surface(const std::string& path)
     return s;
 }
 
+namespace {
+
+/// assimp's own file streams ignore write errors (a full disk gives a truncated file and success);
+/// these streams record the first error so that the export can be refused.
+class CheckedWriteStream : public Assimp::IOStream {
+public:
+    CheckedWriteStream(std::FILE* f, std::string* error) : m_file(f), m_error(error) {}
+    ~CheckedWriteStream() override
+    {
+        if (std::fflush(m_file) != 0) fail();
+        if (std::fclose(m_file) != 0) fail();
+    }
+    size_t Read(void* buffer, size_t size, size_t count) override { return std::fread(buffer, size, count, m_file); }
+    size_t Write(const void* buffer, size_t size, size_t count) override
+    {
+        const size_t n = std::fwrite(buffer, size, count, m_file);
+        if (n != count) fail();
+        return n;
+    }
+    aiReturn Seek(size_t offset, aiOrigin origin) override
+    {
+        const int whence = origin == aiOrigin_SET ? SEEK_SET : origin == aiOrigin_CUR ? SEEK_CUR : SEEK_END;
+        return std::fseek(m_file, static_cast<long>(offset), whence) == 0 ? aiReturn_SUCCESS : aiReturn_FAILURE;
+    }
+    size_t Tell() const override { return static_cast<size_t>(std::ftell(m_file)); }
+    size_t FileSize() const override
+    {
+        const long here = std::ftell(m_file);
+        std::fseek(m_file, 0, SEEK_END);
+        const long size = std::ftell(m_file);
+        std::fseek(m_file, here, SEEK_SET);
+        return static_cast<size_t>(size);
+    }
+    void Flush() override
+    {
+        if (std::fflush(m_file) != 0) fail();
+    }
+
+private:
+    void fail()
+    {
+        if (m_error->empty()) m_error->assign(std::strerror(errno ? errno : EIO));
+    }
+    std::FILE* m_file;
+    std::string* m_error;
+};
+
+class CheckedIOSystem : public Assimp::DefaultIOSystem {
+public:
+    explicit CheckedIOSystem(std::string* error) : m_error(error) {}
+    Assimp::IOStream* Open(const char* file, const char* mode) override
+    {
+        if (std::strchr(mode, 'w') == nullptr && std::strchr(mode, 'a') == nullptr)
+            return Assimp::DefaultIOSystem::Open(file, mode);
+        std::FILE* f = std::fopen(file, mode);
+        if (!f) {
+            if (m_error->empty()) m_error->assign(std::string("cannot create ") + file + ": " + std::strerror(errno));
+            return nullptr;
+        }
+        return new CheckedWriteStream(f, m_error);
+    }
+
+private:
+    std::string* m_error;
+};
+
+} // namespace
+
 void write_surface(const std::string& path, const SurfaceMesh& surface)
 {
     namespace fs = std::filesystem;
@@ -177,9 +250,14 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
             }
         } cleanup{work};
         const fs::path main_file = work / target.filename();
-        Assimp::Exporter exporter;
-        if (exporter.Export(&scene, format, main_file.string()) != aiReturn_SUCCESS)
-            throw Error(path + ": cannot write surface: " + exporter.GetErrorString());
+        std::string io_error;
+        {
+            Assimp::Exporter exporter;
+            exporter.SetIOHandler(new CheckedIOSystem(&io_error)); // the exporter owns it
+            if (exporter.Export(&scene, format, main_file.string()) != aiReturn_SUCCESS)
+                throw Error(path + ": cannot write surface: " + exporter.GetErrorString());
+        }
+        if (!io_error.empty()) throw Error(path + ": write failed: " + io_error);
         if (!fs::exists(main_file)) throw Error(path + ": assimp wrote no file");
         for (const auto& entry : fs::directory_iterator(work)) {
             if (entry.path() == main_file) continue;

@@ -197,8 +197,12 @@ void write_tetgen(const std::string& path, const TetMesh& mesh)
         }
         e += '\n';
     }
-    write_atomically(node_path, [&](const std::string& tmp) { detail::write_file_bytes(tmp, s); });
-    write_atomically(ele_path, [&](const std::string& tmp) { detail::write_file_bytes(tmp, e); });
+    // Both files are complete before either replaces an existing one: a failed write never leaves a
+    // new .node beside an old .ele.
+    write_atomically(std::vector<std::string>{node_path, ele_path}, [&](const std::vector<std::string>& tmp) {
+        detail::write_file_bytes(tmp[0], s);
+        detail::write_file_bytes(tmp[1], e);
+    });
 }
 
 } // namespace tethash::io

@@ -87,6 +87,9 @@ std::vector<std::array<std::int64_t, 4>> lattice_tets(const Lattice& lat)
         for (int b = 0; b < 3; ++b) c *= (b == a ? lat.nc[b] - 1 : lat.nc[b]);
         count += c;
     }
+    if (count > std::numeric_limits<Index>::max())
+        throw Error("resolution too high: the lattice has " + std::to_string(count) +
+                    " tets, more than tet indices (int32) can count");
     tets.reserve(static_cast<std::size_t>(count));
     for (int a = 0; a < 3; ++a) {
         const int b = (a + 1) % 3, d = (a + 2) % 3;

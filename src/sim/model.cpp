@@ -301,7 +301,7 @@ void Model::add_matrix_triplets(const Positions& x, double scale_k, double scale
 
 namespace {
 /// Spring block scale_k·K_e + scale_c·C_e of edge e at x (zero for a zero-length edge).
-Mat3 spring_block(const Model& m, const Positions& x, Index e, double scale_k, double scale_c)
+Mat3 spring_block_at(const Model& m, const Positions& x, Index e, double scale_k, double scale_c)
 {
     const Vec3 d = row(x, m.springs.edges(e, 0)) - row(x, m.springs.edges(e, 1));
     const double len = d.norm();
@@ -322,7 +322,7 @@ void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, con
     for (Index e = 0; e < springs.edges.rows(); ++e) {
         const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
         if (!free(i) && !free(j)) continue;
-        const Vec3 y = spring_block(*this, x, e, scale_k, scale_c) * (pv(i) - pv(j));
+        const Vec3 y = spring_block_at(*this, x, e, scale_k, scale_c) * (pv(i) - pv(j));
         if (free(i)) out.segment<3>(3 * i) += y;
         if (free(j)) out.segment<3>(3 * j) -= y;
     }
@@ -345,11 +345,122 @@ void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, con
     }
 }
 
+Model::Linearised Model::linearise(const Positions& x, double scale_k, double scale_c) const
+{
+    Linearised lin;
+    lin.update(*this, x, scale_k, scale_c);
+    return lin;
+}
+
+void Model::Linearised::update(const Model& m, const Positions& x, double scale_k, double scale_c)
+{
+    const Index n = m.num_vertices();
+    const Index ne = static_cast<Index>(m.springs.edges.rows());
+    const Index nt = static_cast<Index>(m.volumes.tets.rows());
+    if (model != &m || static_cast<Index>(spring_start.size()) != n + 1 || static_cast<Index>(spring_id.size()) != 2 * ne ||
+        static_cast<Index>(tet_slot.size()) != 4 * nt) {
+        // CSR adjacency by counting.
+        spring_start.assign(static_cast<size_t>(n + 1), 0);
+        tet_start.assign(static_cast<size_t>(n + 1), 0);
+        for (Index e = 0; e < ne; ++e)
+            for (int s = 0; s < 2; ++s) ++spring_start[static_cast<size_t>(m.springs.edges(e, s) + 1)];
+        for (Index t = 0; t < nt; ++t)
+            for (int a = 0; a < 4; ++a) ++tet_start[static_cast<size_t>(m.volumes.tets(t, a) + 1)];
+        for (Index i = 0; i < n; ++i) {
+            spring_start[static_cast<size_t>(i + 1)] += spring_start[static_cast<size_t>(i)];
+            tet_start[static_cast<size_t>(i + 1)] += tet_start[static_cast<size_t>(i)];
+        }
+        spring_other.assign(static_cast<size_t>(2 * ne), 0);
+        spring_id.assign(static_cast<size_t>(2 * ne), 0);
+        tet_slot.assign(static_cast<size_t>(4 * nt), 0);
+        std::vector<Index> fill(spring_start.begin(), spring_start.end() - 1);
+        for (Index e = 0; e < ne; ++e)
+            for (int s = 0; s < 2; ++s) {
+                const size_t k = static_cast<size_t>(fill[static_cast<size_t>(m.springs.edges(e, s))]++);
+                spring_other[k] = m.springs.edges(e, 1 - s);
+                spring_id[k] = e;
+            }
+        fill.assign(tet_start.begin(), tet_start.end() - 1);
+        for (Index t = 0; t < nt; ++t)
+            for (int a = 0; a < 4; ++a)
+                tet_slot[static_cast<size_t>(fill[static_cast<size_t>(m.volumes.tets(t, a))]++)] = 4 * t + a;
+    }
+    model = &m;
+    spring_block.resize(static_cast<size_t>(ne));
+    for (Index e = 0; e < ne; ++e) spring_block[static_cast<size_t>(e)] = spring_block_at(m, x, e, scale_k, scale_c);
+    grad.resize(scale_k != 0 ? static_cast<size_t>(nt) : 0);
+    tet_dot.resize(grad.size());
+    for (Index t = 0; t < static_cast<Index>(grad.size()); ++t) {
+        Eigen::Matrix<double, 4, 3>& g = grad[static_cast<size_t>(t)];
+        volume_and_gradient(x, &m.volumes.tets(t, 0), g);
+        // The Gauss–Newton block s ∇V ∇Vᵀ with s ≥ 0 (scale_k ≥ 0 in every use) as (√s ∇V)(√s ∇V)ᵀ.
+        g *= std::sqrt(std::max(0.0, scale_k * m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)]));
+    }
+    ground.assign(m.ground.enabled ? static_cast<size_t>(n) : 0, 0.0);
+    if (m.ground.enabled)
+        for (Index i = 0; i < n; ++i)
+            if (!m.fixed[static_cast<size_t>(i)] && m.ground.height - m.ground.normal.dot(row(x, i)) > 0)
+                ground[static_cast<size_t>(i)] = scale_k * m.ground_k_at(i) + scale_c * m.ground_c_at(i);
+}
+
+void Model::Linearised::apply(const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    const Model& m = *model;
+    const std::vector<char>& fixed = m.fixed;
+    const Index n = m.num_vertices();
+    auto pv = [&](Index i) -> Vec3 { return fixed[static_cast<size_t>(i)] ? Vec3::Zero() : Vec3(p.segment<3>(3 * i)); };
+    const Index nt = static_cast<Index>(grad.size());
+    const Vec3& nrm = m.ground.normal;
+    {
+        for (Index t = 0; t < nt; ++t) {
+            const Eigen::Matrix<double, 4, 3>& g = grad[static_cast<size_t>(t)];
+            const Index* v = &m.volumes.tets(t, 0);
+            double gp = 0;
+            for (int a = 0; a < 4; ++a) gp += g.row(a).dot(pv(v[a]));
+            tet_dot[static_cast<size_t>(t)] = gp;
+        }
+        for (Index i = 0; i < n; ++i) {
+            if (fixed[static_cast<size_t>(i)]) continue;
+            const Vec3 pi = p.segment<3>(3 * i);
+            Vec3 acc = Vec3::Zero();
+            for (Index k = spring_start[static_cast<size_t>(i)]; k < spring_start[static_cast<size_t>(i + 1)]; ++k)
+                acc += spring_block[static_cast<size_t>(spring_id[static_cast<size_t>(k)])] *
+                       (pi - pv(spring_other[static_cast<size_t>(k)]));
+            if (nt)
+                for (Index k = tet_start[static_cast<size_t>(i)]; k < tet_start[static_cast<size_t>(i + 1)]; ++k) {
+                    const Index slot = tet_slot[static_cast<size_t>(k)];
+                    acc += tet_dot[static_cast<size_t>(slot / 4)] * grad[static_cast<size_t>(slot / 4)].row(slot % 4).transpose();
+                }
+            if (!ground.empty() && ground[static_cast<size_t>(i)] != 0) acc += ground[static_cast<size_t>(i)] * nrm * nrm.dot(pi);
+            out.segment<3>(3 * i) += acc;
+        }
+    }
+}
+
+void Model::Linearised::add_diagonal(Eigen::VectorXd& diag) const
+{
+    const Model& m = *model;
+    for (size_t e = 0; e < spring_block.size(); ++e) {
+        const Vec3 dg = spring_block[e].diagonal();
+        for (int s = 0; s < 2; ++s) {
+            const Index v = m.springs.edges(static_cast<Index>(e), s);
+            if (!m.fixed[static_cast<size_t>(v)]) diag.segment<3>(3 * v) += dg;
+        }
+    }
+    for (size_t t = 0; t < grad.size(); ++t)
+        for (int a = 0; a < 4; ++a) {
+            const Index v = m.volumes.tets(static_cast<Index>(t), a);
+            if (!m.fixed[static_cast<size_t>(v)]) diag.segment<3>(3 * v) += grad[t].row(a).transpose().cwiseAbs2();
+        }
+    for (size_t i = 0; i < ground.size(); ++i)
+        if (ground[i] != 0) diag.segment<3>(3 * static_cast<Index>(i)) += ground[i] * m.ground.normal.cwiseAbs2();
+}
+
 void Model::add_matrix_diagonal(const Positions& x, double scale_k, double scale_c, Eigen::VectorXd& diag) const
 {
     auto free = [&](Index i) { return !fixed[static_cast<size_t>(i)]; };
     for (Index e = 0; e < springs.edges.rows(); ++e) {
-        const Vec3 dg = spring_block(*this, x, e, scale_k, scale_c).diagonal();
+        const Vec3 dg = spring_block_at(*this, x, e, scale_k, scale_c).diagonal();
         for (int s = 0; s < 2; ++s)
             if (free(springs.edges(e, s))) diag.segment<3>(3 * springs.edges(e, s)) += dg;
     }

@@ -106,6 +106,7 @@ public:
     double energy_ref = 0;
     double dt_limit = std::numeric_limits<double>::infinity();
     double min_free_mass = 0, mean_free_mass = 0;
+    Model::Linearised lin;               // implicit Euler (CG): operator cache, adjacency kept between steps
     // local/global
     double lg_h = -1;
     std::vector<Index> lg_free;          // vertex → free index or −1
@@ -535,13 +536,14 @@ int SimulationImpl::substep_implicit(double h)
         vnew = solver.solve(rhs);
     } else {
         // Matrix-free preconditioned CG (Jacobi): no assembly, a few sweeps over springs and tets per iteration.
+        lin.update(model, mesh.positions, h * h, h);
         auto apply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& out) {
             out = mdiag.cwiseProduct(p);
-            model.apply_matrix(mesh.positions, h * h, h, p, out);
+            lin.apply(p, out);
             if (cin) contact_apply(h * h, h, p, out);
         };
         Eigen::VectorXd diag = mdiag;
-        model.add_matrix_diagonal(mesh.positions, h * h, h, diag);
+        lin.add_diagonal(diag);
         if (cin) contact_diagonal(h * h, h, diag);
         const Eigen::VectorXd inv = diag.cwiseInverse();
         vnew = vflat;

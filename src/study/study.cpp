@@ -295,6 +295,7 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
         for (const auto& file : split(entry, '+')) {
             if (file.empty()) throw Error("--mesh: empty file name in '" + entry + "'");
             if (!fs::exists(file)) throw Error("--mesh: file not found: " + file);
+            if (fs::is_directory(file)) throw Error("--mesh: " + file + ": is a directory, expected a mesh file");
             if (!io::is_tet_mesh_path(file)) throw Error("--mesh: not a tet mesh format: " + file);
         }
     for (const auto& entry : o.meshes) {
@@ -613,12 +614,31 @@ std::string json_value(const std::string& v)
 
 void write_json(const std::string& path, const std::string& text)
 {
-    io::write_atomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw Error(tmp + ": cannot create file");
-        out << text;
-        if (!out) throw Error(tmp + ": write failed");
-    });
+    io::write_text_file(path, text);
+}
+
+} // namespace
+
+namespace {
+
+/// Checks, without creating anything, that the folder `dir` exists or can be made (run_study makes it)
+/// and accepts files: the nearest existing ancestor must be a folder where files can be created.
+void check_out_dir(const std::string& dir)
+{
+    fs::path p(dir);
+    while (!p.empty() && !fs::exists(p) && p.has_parent_path() && p.parent_path() != p) p = p.parent_path();
+    if (p.empty() || !fs::exists(p)) p = ".";
+    if (!fs::is_directory(p))
+        throw Error("--out: " + dir + ": '" + p.string() + "' exists and is not a folder");
+    io::check_output_file((p / "study.csv").string(), "--out " + dir);
+}
+
+/// Makes the output folder (and its parents).
+void make_out_dir(const std::string& dir)
+{
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw Error("--out: cannot create folder '" + dir + "': " + ec.message());
 }
 
 } // namespace
@@ -634,6 +654,7 @@ std::shared_ptr<StudyPlan> plan_study(const StudyOptions& options)
         throw Error("--shard: expected I/N (0 <= I < N), found " + std::to_string(o.shard_index) + "/" +
                     std::to_string(o.shard_count));
     if (o.out_dir.empty()) throw Error("--out: empty folder name");
+    check_out_dir(o.out_dir);
     if (o.sweep == Sweep::integrator) {
         if (!o.meshes.empty() || o.teschner || !o.scenarios.empty())
             throw Error("integrator sweep: takes --scene FILE (or the default scene), not --mesh / --teschner-scenarios");
@@ -735,7 +756,7 @@ StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)
 {
     const StudyOptions& o = plan.options;
     StudyResult res;
-    fs::create_directories(o.out_dir);
+    make_out_dir(o.out_dir);
     res.csv_path = (fs::path(o.out_dir) / "study.csv").string();
     res.json_path = (fs::path(o.out_dir) / "study.json").string();
     res.points_planned = points_in_shard(plan);
@@ -847,7 +868,8 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
         for (long long p = 0; p < total; ++p)
             if (!seen[static_cast<std::size_t>(p)]) missing.push_back(p);
     }
-    fs::create_directories(out_dir);
+    check_out_dir(out_dir);
+    make_out_dir(out_dir);
     merged.write_csv((fs::path(out_dir) / "study.csv").string());
     std::ostringstream j;
     j << "{\n  \"tethash_study\": 1,\n  \"sweep\": " << sweep << ",\n  \"command\": " << json_escape(command_line)

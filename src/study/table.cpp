@@ -4,7 +4,11 @@
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -97,13 +101,9 @@ Table Table::read_csv(const std::string& path)
 
 void Table::write_csv(const std::string& path) const
 {
-    io::write_atomically(path, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw Error(tmp + ": cannot create file");
-        out << csv_line(columns) << '\n';
-        for (const Row& r : rows) out << csv_line(r) << '\n';
-        if (!out) throw Error(tmp + ": write failed");
-    });
+    std::string text = csv_line(columns) + "\n";
+    for (const Row& r : rows) text += csv_line(r) + "\n";
+    io::write_text_file(path, text);
 }
 
 bool is_timing_column(const std::string& name)
@@ -139,18 +139,29 @@ std::string fmt_double(double v)
     return buf;
 }
 
-CsvWriter::~CsvWriter() { close(); }
+CsvWriter::~CsvWriter() { abandon(); }
 
 void CsvWriter::open(const std::string& path, const std::vector<std::string>& columns)
 {
-    close();
-    m_file = std::fopen(path.c_str(), "wb");
-    if (!m_file) throw Error(path + ": cannot create file");
+    abandon();
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::string name = target.filename().string();
+    name.append(".partial"); // visible: `tail -f study.csv.partial` follows a running study
+    m_tmp_path = (dir / name).string();
+    m_file = std::fopen(m_tmp_path.c_str(), "wb");
+    if (!m_file) {
+        m_tmp_path.clear();
+        throw Error(path + ": cannot create file: " + std::strerror(errno));
+    }
     m_path = path;
     m_columns = columns.size();
     const std::string line = csv_line(columns) + "\n";
-    std::fwrite(line.data(), 1, line.size(), m_file);
-    std::fflush(m_file);
+    if (std::fwrite(line.data(), 1, line.size(), m_file) != line.size() || std::fflush(m_file) != 0) {
+        abandon();
+        throw Error(path + ": write failed: " + std::strerror(errno));
+    }
 }
 
 void CsvWriter::write(const Row& row)
@@ -161,13 +172,36 @@ void CsvWriter::write(const Row& row)
                     std::to_string(m_columns));
     const std::string line = csv_line(row) + "\n";
     if (std::fwrite(line.data(), 1, line.size(), m_file) != line.size() || std::fflush(m_file) != 0)
-        throw RunFailure(m_path + ": write failed");
+        throw Error(m_path + ": write failed: " + std::strerror(errno));
 }
 
 void CsvWriter::close()
 {
+    if (!m_file) return;
+    const bool ok = std::fclose(m_file) == 0;
+    m_file = nullptr;
+    if (!ok) {
+        abandon();
+        throw Error(m_path + ": write failed: " + std::strerror(errno));
+    }
+    std::error_code ec;
+    std::filesystem::rename(m_tmp_path, m_path, ec);
+    if (ec) {
+        abandon();
+        throw Error(m_path + ": cannot move the temporary file into place: " + ec.message());
+    }
+    m_tmp_path.clear();
+}
+
+void CsvWriter::abandon()
+{
     if (m_file) std::fclose(m_file);
     m_file = nullptr;
+    if (!m_tmp_path.empty()) {
+        std::error_code ec;
+        std::filesystem::remove(m_tmp_path, ec);
+        m_tmp_path.clear();
+    }
 }
 
 } // namespace tethash::study

@@ -52,96 +52,41 @@ double median(std::vector<double> v)
 
 // ---- scenes ------------------------------------------------------------------------------------
 
-/// Own fallback: cube lattice, 6 tets per cube (used if io::generate fails).
-TetMesh lattice_box(int k)
+/// The flatness sweep's scenes: `objects` copies of the scenario-5 object (io::generate "blob", resolution 6, as
+/// study/scenarios.hpp chooses it) on a k × k × k lattice with centre spacing 0.6 × the object size, randomly
+/// rotated: every object overlaps its lattice neighbours as in scenario 5, whatever the count.
+TetMesh lattice_scene(int objects, std::uint32_t seed)
 {
-    TetMesh m;
-    auto vid = [&](int i, int j, int l) { return static_cast<Index>((l * (k + 1) + j) * (k + 1) + i); };
-    m.positions.resize((k + 1) * (k + 1) * (k + 1), 3);
-    for (int l = 0; l <= k; ++l)
-        for (int j = 0; j <= k; ++j)
-            for (int i = 0; i <= k; ++i) m.positions.row(vid(i, j, l)) << i / double(k) - 0.5, j / double(k) - 0.5, l / double(k) - 0.5;
-    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    m.tets.resize(6 * k * k * k, 4);
-    int t = 0;
-    for (int l = 0; l < k; ++l)
-        for (int j = 0; j < k; ++j)
-            for (int i = 0; i < k; ++i)
-                for (const auto& p : perms) {
-                    int c[3] = {i, j, l};
-                    m.tets(t, 0) = vid(c[0], c[1], c[2]);
-                    for (int s = 0; s < 3; ++s) {
-                        ++c[p[s]];
-                        m.tets(t, s + 1) = vid(c[0], c[1], c[2]);
-                    }
-                    ++t;
-                }
-    return m;
-}
-
-/// One object of about `tets` tets: io::generate's sphere at the resolution that comes closest.
-TetMesh make_object(int tets, std::string& how)
-{
-    TetMesh best;
-    try {
-        for (int r = 2; r < 80; ++r) {
-            io::GenerateParams g;
-            g.shape = "sphere";
-            g.resolution = r;
-            TetMesh m = io::generate(g);
-            if (best.num_tets() == 0 || std::abs(m.num_tets() - tets) < std::abs(best.num_tets() - tets)) best = m;
-            if (m.num_tets() > tets) break;
-        }
-        how = "io::generate sphere";
-        // Normalise to unit size.
-        const Eigen::RowVector3d lo = best.positions.colwise().minCoeff(), hi = best.positions.colwise().maxCoeff();
-        const double ext = (hi - lo).maxCoeff();
-        for (Eigen::Index v = 0; v < best.positions.rows(); ++v)
-            best.positions.row(v) = (best.positions.row(v) - 0.5 * (lo + hi)) / ext;
-        best.rest_positions.resize(0, 3);
-        best.vertex_object.clear();
-        best.tet_object.clear();
-        return best;
-    } catch (const std::exception&) {
-        how = "own cube lattice";
-        int k = 1;
-        while (6 * (k + 1) * (k + 1) * (k + 1) <= tets) ++k;
-        return lattice_box(k);
-    }
-}
-
-/// `objects` copies of an object of ~tets/objects tets, randomly rotated and placed so that they overlap
-/// heavily (centres in a cube of side 0.5·objects^(1/3) object sizes).
-TetMesh make_scene(int objects, int tets, std::uint32_t seed, std::string& how)
-{
-    const TetMesh obj = make_object(tets / objects, how);
+    io::GenerateParams g;
+    g.shape = "blob";
+    g.resolution = 6;
+    TetMesh obj = io::generate(g);
+    obj.vertex_object.clear();
+    obj.tet_object.clear();
+    obj.rest_positions.resize(0, 3);
+    const Eigen::RowVector3d lo = obj.positions.colwise().minCoeff(), hi = obj.positions.colwise().maxCoeff();
+    const double size = (hi - lo).maxCoeff();
+    for (Eigen::Index v = 0; v < obj.positions.rows(); ++v) obj.positions.row(v) -= 0.5 * (lo + hi);
+    int k = 1;
+    while (k * k * k < objects) ++k;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
-    const double side = 0.5 * std::cbrt(static_cast<double>(objects));
+    Positions p(static_cast<Eigen::Index>(objects) * obj.positions.rows(), 3);
+    Tets t(static_cast<Eigen::Index>(objects) * obj.tets.rows(), 4);
     TetMesh scene;
     for (int o = 0; o < objects; ++o) {
-        TetMesh m = obj;
         const Eigen::Matrix3d rot =
             Eigen::AngleAxisd(3.14159 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
-        const Eigen::RowVector3d shift(side * u(rng) / 2, side * u(rng) / 2, side * u(rng) / 2);
-        for (Eigen::Index v = 0; v < m.positions.rows(); ++v)
-            m.positions.row(v) = (rot * m.positions.row(v).transpose()).transpose() + shift;
-        if (o == 0) {
-            scene = m;
-            scene.ensure_object_ids();
-        } else {
-            // append as a new object (own code: independent of mesh.cpp's append)
-            const Index base = scene.num_vertices();
-            Positions p(scene.positions.rows() + m.positions.rows(), 3);
-            p << scene.positions, m.positions;
-            Tets t(scene.tets.rows() + m.tets.rows(), 4);
-            t << scene.tets, (m.tets.array() + base).matrix();
-            scene.positions = p;
-            scene.tets = t;
-            scene.vertex_object.insert(scene.vertex_object.end(), m.positions.rows(), o);
-            scene.tet_object.insert(scene.tet_object.end(), m.tets.rows(), o);
-        }
+        const Eigen::RowVector3d c(0.6 * size * (o % k), 0.6 * size * ((o / k) % k), 0.6 * size * (o / (k * k)));
+        const Eigen::Index vb = o * obj.positions.rows(), tb = o * obj.tets.rows();
+        for (Eigen::Index v = 0; v < obj.positions.rows(); ++v)
+            p.row(vb + v) = (rot * obj.positions.row(v).transpose()).transpose() + c;
+        t.middleRows(tb, obj.tets.rows()) = (obj.tets.array() + static_cast<Index>(vb)).matrix();
+        scene.vertex_object.insert(scene.vertex_object.end(), obj.positions.rows(), o);
+        scene.tet_object.insert(scene.tet_object.end(), obj.tets.rows(), o);
     }
+    scene.positions = std::move(p);
+    scene.tets = std::move(t);
     return scene;
 }
 
@@ -388,16 +333,17 @@ int main(int argc, char** argv)
     std::printf("scan kernel: %s\n\n", simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
 
     if (sweep) {
-        std::printf("flatness sweep: objects of ~500 tets, same overlap density\n");
+        std::printf("flatness sweep: copies of the scenario-5 object (551 tets) packed as in scenario 5, 1 thread\n");
         for (int tets : {1000, 3000, 10000, 30000, 100000, 300000, 1000000}) {
-            std::string how;
-            const TetMesh m = make_scene(std::max(2, tets / 500), tets, 7, how);
+            const TetMesh m = lattice_scene(std::max(2, (tets + 275) / 551), 7);
             DetectParams p = base;
             p.threads = 1;
             const Measured r = measure(m, p, std::max(3, repeat / (tets >= 300000 ? 4 : 1)));
-            std::printf("  tets %8d  vertices %8d  %9.3f ms (cpu %.3f)  %6.1f ns/tet  %6.1f B/tet  contacts %lld\n", m.num_tets(),
-                        m.num_vertices(), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / m.num_tets(), double(r.stats.memory_bytes) / m.num_tets(),
-                        static_cast<long long>(r.stats.contacts));
+            std::printf("  tets %8d  vertices %8d  %9.3f ms (cpu %.3f)  %6.1f ns/tet (cpu)  %6.1f B/tet  contacts %lld "
+                        "(%.2f per tet)\n",
+                        m.num_tets(), m.num_vertices(), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / m.num_tets(),
+                        double(r.stats.memory_bytes) / m.num_tets(), static_cast<long long>(r.stats.contacts),
+                        double(r.stats.contacts) / m.num_tets());
             std::fflush(stdout);
         }
         return 0;

@@ -1,6 +1,8 @@
 #pragma once
 // Subcommands of the tethash program: each tools/tethash/<name>.cpp registers itself with a static
 // Registrar, so adding a command touches no other file.
+#include "tethash/mesh.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <functional>
@@ -21,6 +23,14 @@ std::vector<Command>& registry();
 struct Registrar {
     explicit Registrar(Command c) { registry().push_back(std::move(c)); }
 };
+
+/// Adds `--objects-from-labels[=separate|join]` (info, detect): each tet label of a file is an object.
+void add_objects_from_labels_option(CLI::App& sub, std::string& value);
+/// Throws Error unless `value` is "", "separate" or "join".
+void check_objects_from_labels_value(const std::string& value);
+/// Splits `mesh` (read from `path`) into objects by its tet labels (split_objects_by_label); `value`
+/// is "separate" (a vertex shared by two labels is an error) or "join". Returns a one-line note.
+std::string objects_from_labels(TetMesh& mesh, const std::string& path, const std::string& value);
 
 /// Sets the OpenMP thread count when n > 0; returns the count in effect.
 int set_threads(int n);

@@ -3,6 +3,7 @@
 
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/io/surface.hpp"
 
 #include <fmt/core.h>
 
@@ -20,6 +21,7 @@ struct ConvertOptions {
 
 void run_convert(const ConvertOptions& o)
 {
+    io::check_mesh_output_file(o.out, "OUT"); // before reading: a bad output name costs no work
     io::ReadNotes notes;
     TetMesh mesh = io::read_mesh(o.in, &notes);
     fmt::print("read {}: {} vertices, {} tets", o.in, mesh.num_vertices(), mesh.num_tets());
@@ -34,7 +36,10 @@ void run_convert(const ConvertOptions& o)
         fmt::print("  note: {} inverted tets kept as they are (--reorient flips them)\n", report.inverted_tets);
     }
     io::write_mesh(o.out, mesh);
-    fmt::print("wrote {}: {} vertices, {} tets\n", o.out, mesh.num_vertices(), mesh.num_tets());
+    if (io::is_surface_path(o.out))
+        fmt::print("wrote {}: the boundary surface ({} triangles)\n", o.out, boundary_faces(mesh.tets).rows());
+    else
+        fmt::print("wrote {}: {} vertices, {} tets\n", o.out, mesh.num_vertices(), mesh.num_tets());
 }
 
 const Registrar reg{{"convert", "Convert a tet mesh between formats (chosen by file extension)", [](CLI::App& sub) {

@@ -51,7 +51,9 @@ void run_generate(const GenerateOptions& o)
     }
     if (o.shape.empty()) throw Error("generate: missing SHAPE (see 'tethash generate --list')");
     if (o.out.empty()) throw Error("generate: missing output file (-o OUT)");
-    if (o.resolution < 1) throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1");
+    if (o.resolution < 1 || o.resolution > 1000)
+        throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1 and at most 1000");
+    io::check_mesh_output_file(o.out, "--output");
     io::GenerateParams p;
     p.shape = o.shape;
     p.resolution = o.resolution;
@@ -74,7 +76,7 @@ const Registrar reg{{"generate", "Make a tet mesh of a built-in shape (BCC latti
                          auto o = std::make_shared<GenerateOptions>();
                          sub.add_option("shape", o->shape, "Shape name (see --list)");
                          sub.add_option("-o,--output", o->out, "Output mesh (.vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
-                         sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent")
+                         sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent (1..1000)")
                              ->capture_default_str();
                          auto* size = sub.add_option("--size", o->size, "Bounding-box extents X Y Z (default: the shape's natural size)")
                                           ->expected(3);

@@ -19,6 +19,7 @@ struct InfoOptions {
     std::vector<std::string> meshes;
     bool json = false;
     bool per_file = false;
+    std::string objects_from_labels; ///< "" (each file one object), "separate" or "join"
 };
 
 /// Bins of the minimum dihedral angle, in degrees (a regular tet has 70.5°).
@@ -161,6 +162,7 @@ void print_text(const Summary& s)
 
 void run(const InfoOptions& opt)
 {
+    check_objects_from_labels_value(opt.objects_from_labels);
     // Read everything first, so that a bad file fails before any output.
     std::vector<Summary> summaries;
     TetMesh scene;
@@ -168,6 +170,7 @@ void run(const InfoOptions& opt)
     for (const auto& path : opt.meshes) {
         io::ReadNotes notes;
         TetMesh mesh = io::read_mesh(path, &notes);
+        if (!opt.objects_from_labels.empty()) notes.messages.push_back(objects_from_labels(mesh, path, opt.objects_from_labels));
         summaries.push_back(summarize(path, mesh, notes));
         scene.append(mesh);
         all_notes.skipped_cells += notes.skipped_cells;
@@ -198,6 +201,7 @@ Registrar reg{{"info", "Print counts, bounding box, edge lengths, volume, qualit
                        ->required();
                    sub.add_flag("--json", opt->json, "Print JSON for scripts");
                    sub.add_flag("--per-file", opt->per_file, "With several files, also print each file");
+                   add_objects_from_labels_option(sub, opt->objects_from_labels);
                    sub.callback([opt] { run(*opt); });
                }}};
 

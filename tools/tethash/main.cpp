@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <string>
 #include <unistd.h>
 
 #ifdef _OPENMP
@@ -33,13 +34,59 @@ int set_threads(int n)
 
 bool stderr_is_terminal() { return isatty(fileno(stderr)) != 0; }
 
+void add_objects_from_labels_option(CLI::App& sub, std::string& value)
+{
+    sub.add_flag("--objects-from-labels{separate}", value,
+                 "[=separate|join] Each tet label of a file (Gmsh physical tag, else entity tag; Medit ref; "
+                 "TetGen region attribute) is an object, numbered in label order; a vertex in tets of two labels "
+                 "is an error, or with =join makes those labels one object. Without it each file is one object");
+}
+
+void check_objects_from_labels_value(const std::string& value)
+{
+    if (!value.empty() && value != "separate" && value != "join")
+        throw Error("--objects-from-labels: expected 'separate' or 'join', got '" + value + "'");
+}
+
+std::string objects_from_labels(TetMesh& mesh, const std::string& path, const std::string& value)
+{
+    const bool join = value == "join";
+    if (mesh.tet_label.empty()) {
+        split_objects_by_label(mesh);
+        return "no tet labels: the file is one object";
+    }
+    LabelSplit split;
+    try {
+        split = split_objects_by_label(mesh, join ? SharedLabelVertices::join : SharedLabelVertices::error, path);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (--objects-from-labels=join makes such labels one object)");
+    }
+    std::string note = std::to_string(split.object_labels.size()) + " objects from tet labels";
+    std::size_t joined = 0;
+    for (const auto& labels : split.object_labels) joined += labels.size() > 1;
+    if (joined)
+        note += " (" + std::to_string(split.shared_vertices) + " shared vertices joined labels into " +
+                std::to_string(joined) + " objects)";
+    return note;
+}
+
 } // namespace tethash::cli
 
 int main(int argc, char** argv)
 {
     using namespace tethash;
     CLI::App app{"tethash: collision detection for deformable tetrahedral meshes by spatial hashing,\n"
-                 "and a mass-spring simulator that uses it."};
+                 "and a mass-spring simulator that uses it.",
+                 "tethash"}; // named: usage lines say "tethash", not the path it was started by
+    // Usage errors: one line, like every other error, naming the subcommand whose help explains it.
+    app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+        std::string help = "tethash";
+        for (const CLI::App* sub = a; sub && !sub->get_subcommands().empty();) {
+            sub = sub->get_subcommands().front();
+            help += " " + sub->get_name();
+        }
+        return std::string("tethash: error: ") + e.what() + " (see '" + help + " --help')\n";
+    });
     app.set_version_flag("--version", std::string("tethash ") + TETHASH_VERSION);
     app.require_subcommand(1);
     auto& commands = cli::registry();
@@ -49,6 +96,12 @@ int main(int argc, char** argv)
         c.setup(*sub);
     }
     try {
+        if (argc > 1 && argv[1][0] != '-' &&
+            std::none_of(commands.begin(), commands.end(), [&](const auto& c) { return c.name == argv[1]; })) {
+            std::string names;
+            for (const auto& c : commands) names += (names.empty() ? "" : ", ") + c.name;
+            throw Error(std::string("unknown command '") + argv[1] + "' (commands: " + names + "; see 'tethash --help')");
+        }
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // --help and --version exit 0; every usage error exits 2.

@@ -24,7 +24,7 @@ struct SimulateOptions {
     double dt = std::numeric_limits<double>::quiet_NaN();
     int substeps = unset;
     std::string integrator;
-    int threads = 0;
+    int threads = unset;
     std::string out = "out";
 };
 
@@ -50,9 +50,13 @@ void run_simulate(const SimulateOptions& o)
             throw Error(std::string("--integrator: ") + e.what());
         }
     }
-    if (o.threads < 0) throw Error(fmt::format("--threads must be ≥ 0, found {}", o.threads));
-    const int threads = set_threads(o.threads);
-    if (o.threads > 0) scene.detect.threads = o.threads;
+    if (o.threads != SimulateOptions::unset) {
+        if (o.threads < 0) throw Error(fmt::format("--threads must be ≥ 0, found {}", o.threads));
+        scene.detect.threads = o.threads;
+    }
+    // Detector threads: the scene's (1 unless [detector] threads says otherwise), --threads overrides; 0 = all.
+    const int all = set_threads(scene.detect.threads);
+    const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
 
     sim::Simulation sim(scene);
     for (const std::string& w : sim.warnings()) std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
@@ -142,7 +146,7 @@ Registrar reg{{"simulate", "Simulate a scene of deformable tet meshes (mass-spri
                    sub.add_option("--dt", o->dt, "Time step in s (overrides the scene)");
                    sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
                    sub.add_option("--integrator", o->integrator, "symplectic_euler, implicit_euler or local_global");
-                   sub.add_option("--threads", o->threads, "Threads (0: OpenMP default)");
+                   sub.add_option("--threads", o->threads, "Detector threads (default: the scene's [detector] threads, 1 if absent; 0: all cores)");
                    sub.add_option("--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
                    sub.callback([o] { run_simulate(*o); });
                }}};

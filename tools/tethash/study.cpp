@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -90,7 +91,8 @@ struct Args {
     double from = 0, to = 0;
     int points = 0;
     bool no_plot = false, no_oracle = false, no_penetration = false, quiet = false;
-    int repeat = -1, warmup = -1;
+    static constexpr int kUnset = std::numeric_limits<int>::min(); ///< option not given
+    int repeat = kUnset, warmup = kUnset;
 };
 
 void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool quiet)
@@ -133,9 +135,10 @@ void run(Args& a)
     o.sweep = study::parse_sweep(what);
     if (!a.out.empty()) o.out_dir = a.out;
     if (!a.shard.empty()) study::parse_shard(a.shard, o.shard_index, o.shard_count);
-    o.repeat = a.repeat >= 0 ? a.repeat : (o.sweep == study::Sweep::integrator ? 1 : 3);
-    o.warmup = a.warmup >= 0 ? a.warmup : (o.sweep == study::Sweep::integrator ? 0 : 1);
-    if (a.repeat == 0) throw Error("--repeat: must be >= 1, found 0");
+    o.repeat = a.repeat != Args::kUnset ? a.repeat : (o.sweep == study::Sweep::integrator ? 1 : 3);
+    o.warmup = a.warmup != Args::kUnset ? a.warmup : (o.sweep == study::Sweep::integrator ? 0 : 1);
+    if (o.repeat < 1) throw Error("--repeat: must be >= 1, found " + std::to_string(o.repeat));
+    if (o.warmup < 0) throw Error("--warmup: must be >= 0, found " + std::to_string(o.warmup));
     o.oracle = !a.no_oracle;
     o.penetration = !a.no_penetration;
     if (a.points != 0 || a.from != 0 || a.to != 0) {
@@ -210,28 +213,30 @@ Registrar reg{{"study", "Parameter studies: sweeps of cell size, table size, has
                    sub.add_option("--scenarios", a->o.scenarios, "with or instead of --teschner-scenarios: which (1..5), e.g. 1,5")
                        ->delimiter(',');
                    sub.add_option("--cell-size", a->o.cell_size,
-                                  "cell sizes as factors of the mean edge: list '0.5,1,2' or log range FROM:TO:POINTS");
+                                  "cell sizes as factors of the mean edge: list '0.5,1,2' or log range FROM:TO:POINTS "
+                                  "(default: 0.125:8:13 when swept, 0.25:4:9 in a grid, else 1)");
                    sub.add_option("--table-size", a->o.table_size,
-                                  "table sizes: N, auto, xF (F x vertices), or range xFROM:xTO:POINTS (primes and powers of two)");
-                   sub.add_option("--hash", a->o.hash, "hash functions: teschner, column, all");
+                                  "table sizes: N, auto, xF (F x vertices), or range xFROM:xTO:POINTS (primes and powers of two; "
+                                  "default: x0.01:x100:9 when swept, x0.03:x30:4 in a grid, else auto)");
+                   sub.add_option("--hash", a->o.hash, "hash functions: teschner, column, all (default: all when swept, else column)");
                    sub.add_option("--threads", a->o.threads, "thread counts: list or FROM:TO (default 1; threads sweep: 1..cores)");
                    sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
                        ->delimiter(',');
                    sub.add_option("--from", a->from, "range start of the swept parameter (cell factor, table factor of vertices, dt in s)");
                    sub.add_option("--to", a->to, "range end");
                    sub.add_option("--points", a->points, "number of log-spaced points");
-                   sub.add_option("--integrator", a->o.integrator, "integrators: symplectic_euler, implicit_euler, local_global, all");
-                   sub.add_option("--dt", a->o.dt, "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt)");
-                   sub.add_option("--substeps", a->o.substeps, "substep counts");
+                   sub.add_option("--integrator", a->o.integrator, "integrators: symplectic_euler, implicit_euler, local_global, all (default: all)");
+                   sub.add_option("--dt", a->o.dt, "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5)");
+                   sub.add_option("--substeps", a->o.substeps, "substep counts (default: 1)");
                    sub.add_option("--duration", a->o.duration, "simulated seconds (default: the scene's, at most 0.5)");
-                   sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken");
-                   sub.add_option("--reference-factor", a->o.reference_factor, "reference dt = smallest dt / this");
+                   sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken")->capture_default_str();
+                   sub.add_option("--reference-factor", a->o.reference_factor, "reference dt = smallest dt / this")->capture_default_str();
                    sub.add_option("--repeat", a->repeat, "measured repeats per point (default 3; integrator: 1)");
                    sub.add_option("--warmup", a->warmup, "unmeasured runs before the repeats (default 1; integrator: 0)");
                    sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
                    sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
                    sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
-                   sub.add_option("--out", a->out, "output folder (default: study)");
+                   sub.add_option("--out", a->out, "output folder, made if missing (default: study)");
                    sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
                    sub.add_flag("--quiet", a->quiet, "no progress output");
                    sub.callback([a]() { run(*a); });

@@ -44,7 +44,21 @@ bool is_tet_mesh_path(const std::string& path);
 std::string extension_of(const std::string& path);
 
 /// Writes a file through a temporary name next to it; `write` gets the temporary path.
-/// On success renames over `path`; on any exception removes the temporary and rethrows.
+/// On success renames over `path`; on any exception removes the temporary and rethrows (an Error
+/// that names the temporary is rethrown naming `path` instead). Throws Error before calling
+/// `write` when `path` is a directory or its folder is missing.
 void write_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
+/// The same for files that belong together (TetGen .node + .ele): every file is written to its
+/// temporary first; only when all are complete are they renamed into place.
+void write_atomically(const std::vector<std::string>& paths,
+                      const std::function<void(const std::vector<std::string>& tmp_paths)>& write);
+/// Writes `text` to `path` through write_atomically, checking every write (Error naming `path`).
+void write_text_file(const std::string& path, const std::string& text);
+
+/// Checks, before any work, that a file can be created at `path`: not a directory, its folder
+/// exists and accepts new files. Throws Error naming `what` (e.g. "--contacts") and the path.
+void check_output_file(const std::string& path, const std::string& what = "output");
+/// check_output_file plus: the extension is one write_mesh knows.
+void check_mesh_output_file(const std::string& path, const std::string& what = "output");
 
 } // namespace tethash::io

@@ -45,9 +45,11 @@ public:
     Simulation(Simulation&&) noexcept;
     Simulation& operator=(Simulation&&) noexcept;
 
-    /// Advances one time step (scene().dt, in scene().substeps substeps). On NaN/Inf or energy growing by
-    /// orders of magnitude throws RunFailure naming the step and the likely cause; the state stays at the
-    /// last good step.
+    /// Advances one time step (scene().dt, in scene().substeps substeps). Throws RunFailure naming the step
+    /// (and substep) and the likely cause when, after any substep, a vertex is NaN/Inf, farther from the scene
+    /// than the energy at start can carry it, or the kinetic energy exploded; when the energy after the step
+    /// grew by orders of magnitude; or when collision detection fails on the diverged state. The state then
+    /// stays at the last good step.
     void step();
 
     const Scene& scene() const;

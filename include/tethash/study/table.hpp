@@ -33,18 +33,24 @@ bool is_timing_column(const std::string& name);
 class CsvWriter {
 public:
     CsvWriter() = default;
+    /// Without close(): removes the temporary file; an existing file at the path stays as it was.
     ~CsvWriter();
     CsvWriter(const CsvWriter&) = delete;
     CsvWriter& operator=(const CsvWriter&) = delete;
-    /// Creates (truncates) `path` and writes the header. Throws Error if the file cannot be created.
+    /// Starts `path`: writes the header to `path`.partial (rows are flushed one by one, so a killed run
+    /// leaves them there; close() renames it to `path`). Throws Error if the file cannot be created.
     void open(const std::string& path, const std::vector<std::string>& columns);
     /// Writes one row (size must equal the column count) and flushes.
     void write(const Row& row);
+    /// Completes the file: renames the temporary over `path`. Throws Error if that fails.
     void close();
+    /// Drops the temporary file (what the destructor does when close() was not called).
+    void abandon();
 
 private:
     std::FILE* m_file = nullptr;
     std::string m_path;
+    std::string m_tmp_path;
     std::size_t m_columns = 0;
 };
 

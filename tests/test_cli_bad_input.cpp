@@ -1,0 +1,242 @@
+// Bad input to every command that reads or writes files (info, convert, generate, tetrahedralize,
+// detect, study): one line on standard error naming the thing, exit status 2, no work done first,
+// no half-written or temporary file left, an existing good file never destroyed.
+#include "support.hpp"
+
+#include "tethash/io/surface.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+using namespace tethash::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Shell-quoted path (own helper: GCC 12 warns falsely on "'" + string inlined from support.hpp's quote()).
+std::string sq(const fs::path& p)
+{
+    std::string s(1, '\'');
+    s.append(p.string());
+    s.push_back('\'');
+    return s;
+}
+
+const fs::path kBox = fs::path(TETHASH_SOURCE_DIR) / "meshes" / "box.vtu";
+
+/// Lines of `text` (a trailing newline does not start another line).
+std::size_t line_count(const std::string& text)
+{
+    std::size_t n = 0;
+    for (char c : text) n += c == '\n';
+    return n + (!text.empty() && text.back() != '\n');
+}
+
+/// The error contract: status 2, exactly one line "tethash: error: ..." holding every fragment.
+void expect_one_line_error(const RunResult& r, const std::string& args, const std::vector<std::string>& fragments)
+{
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("tethash: error: ", 0), 0u) << args << "\n" << r.err;
+    for (const auto& f : fragments) EXPECT_NE(r.err.find(f), std::string::npos) << args << ": no '" << f << "' in\n" << r.err;
+}
+
+/// Names in `dir` that look like temporary files (hidden, .tmp, .partial).
+std::vector<std::string> temporaries(const fs::path& dir)
+{
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string n = e.path().filename().string();
+        if (n[0] == '.' || n.find(".tmp") != std::string::npos || n.find(".partial") != std::string::npos)
+            out.push_back(n);
+    }
+    return out;
+}
+
+} // namespace
+
+TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
+{
+    const auto dir = temp_dir();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"generate box -o " + sq(dir / "g.vtu") + " --resolution abc", "--resolution"},
+        {"generate box -o " + sq(dir / "g.vtu") + " --size 1 2", "--size"},
+        {"tetrahedralize x.obj -o " + sq(dir / "t.vtu") + " -r abc", "--resolution"},
+        {"detect " + sq(kBox) + " --threads abc", "--threads"},
+        {"study cell-size --mesh " + sq(kBox) + " --repeat abc", "--repeat"},
+        {"info --no-such-option " + sq(kBox), "--no-such-option"},
+        {"convert " + sq(kBox), "OUT"},
+        {"no-such-command", "no-such-command"},
+    };
+    for (const auto& [args, fragment] : cases) {
+        const RunResult r = run_tethash(args);
+        expect_one_line_error(r, args, {fragment, "--help"});
+        EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
+    }
+    const std::string too_fine = "generate box -o " + sq(dir / "g.vtu") + " --resolution 5000";
+    expect_one_line_error(run_tethash(too_fine), too_fine, {"--resolution 5000", "at most 1000"});
+    // Help still goes to standard output with status 0, names the program (not its path) and shows defaults.
+    const RunResult help = run_tethash("detect --help");
+    EXPECT_EQ(help.status, 0);
+    EXPECT_NE(help.out.find("Usage: tethash detect"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("--cell-size TEXT=auto"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("--repeat INT=1"), std::string::npos) << help.out;
+}
+
+TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
+{
+    const auto dir = temp_dir();
+    fs::create_directories(dir / "folder.vtu");
+    for (const char* ext : {".vtu", ".vtk", ".msh", ".mesh", ".veg", ".node"}) write_text(dir / (std::string("empty") + ext), "");
+    struct Case {
+        std::string args;
+        std::vector<std::string> fragments;
+    };
+    const std::vector<Case> cases = {
+        {"info " + sq(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
+        {"info " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"detect " + sq(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
+        {"detect " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"convert " + sq(dir / "folder.vtu") + " " + sq(dir / "o.vtu"), {"folder.vtu", "directory"}},
+        {"study cell-size --no-plot --out " + sq(dir / "s") + " --mesh " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"tetrahedralize " + sq(dir / "missing.obj") + " -o " + sq(dir / "t.vtu"), {"missing.obj", "no such file"}},
+        {"tetrahedralize " + sq(kBox) + " -o " + sq(dir / "t.vtu"), {"box.vtu", "tet mesh", "surface"}},
+        {"info " + sq(dir / "empty.vtu"), {"empty.vtu", "end of file"}},
+        {"info " + sq(dir / "empty.vtk"), {"empty.vtk"}},
+        {"info " + sq(dir / "empty.msh"), {"empty.msh", "end of file"}},
+        {"info " + sq(dir / "empty.mesh"), {"empty.mesh", "end of file"}},
+        {"info " + sq(dir / "empty.veg"), {"empty.veg"}},
+        {"info " + sq(dir / "empty.node"), {"empty"}},
+        {"info " + sq(dir / "mesh.xyz"), {"mesh.xyz"}},
+    };
+    for (const Case& c : cases) expect_one_line_error(run_tethash(c.args), c.args, c.fragments);
+}
+
+TEST(CliBadInput, UnreadableFileNamesIt)
+{
+    if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop reading";
+    const auto dir = temp_dir();
+    fs::copy_file(kBox, dir / "locked.vtu");
+    fs::permissions(dir / "locked.vtu", fs::perms::none);
+    expect_one_line_error(run_tethash("info " + sq(dir / "locked.vtu")), "info locked.vtu", {"locked.vtu", "cannot open"});
+}
+
+TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
+{
+    const auto dir = temp_dir();
+    fs::create_directories(dir / "folder");
+    struct Case {
+        std::string args;
+        std::vector<std::string> fragments;
+    };
+    std::vector<Case> cases;
+    const std::vector<std::pair<std::string, std::string>> commands = {
+        {"convert " + sq(kBox) + " ", ""},
+        {"generate box -r 2 -o ", ""},
+        {"detect " + sq(kBox) + " --contacts ", "--contacts"},
+        {"detect " + sq(kBox) + " --stats ", "--stats"},
+    };
+    for (const auto& [prefix, option] : commands) {
+        cases.push_back({prefix + sq(dir / "missing" / "out.vtu"), {"out.vtu", "folder", "does not exist"}});
+        cases.push_back({prefix + sq(dir / "folder"), {"folder", "is a directory"}});
+        cases.push_back({prefix + sq("/proc/out.vtu"), {"/proc", "cannot create"}});
+        if (!option.empty())
+            for (auto& c : std::vector<Case*>{&cases[cases.size() - 3], &cases[cases.size() - 2], &cases.back()})
+                c->fragments.push_back(option);
+    }
+    cases.push_back({"convert " + sq(kBox) + " " + sq(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
+    cases.push_back({"generate box -o " + sq(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
+    cases.push_back({"generate box -o " + sq(dir / "folder"), {"folder", "is a directory"}});
+    if (tethash::io::have_assimp())
+        cases.push_back({"tetrahedralize " + sq(fs::path(TETHASH_SOURCE_DIR) / "meshes" / "surfaces" / "blob.obj") + " -o " +
+                             sq(dir / "missing" / "t.vtu"),
+                         {"t.vtu", "does not exist"}});
+    for (const Case& c : cases) {
+        const RunResult r = run_tethash(c.args);
+        expect_one_line_error(r, c.args, c.fragments);
+        EXPECT_TRUE(r.out.empty()) << "work was done before the output was checked: " << c.args << "\n" << r.out;
+    }
+    EXPECT_TRUE(temporaries(dir).empty());
+    EXPECT_TRUE(fs::is_empty(dir / "folder"));
+}
+
+// A write that fails part way (file size limit: the same errors as a full disk) exits 2 naming the
+// file, leaves no temporary and keeps the file that was there.
+TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
+{
+    const auto dir = temp_dir();
+    std::vector<std::string> names = {"out.vtu", "out.vtk", "out.msh", "out.mesh", "out.node"};
+    if (tethash::io::have_assimp()) names.insert(names.end(), {"out.obj", "out.ply", "out.stl", "out.gltf", "out.glb"});
+    const std::string good = "a good file that must survive\n";
+    for (const auto& name : names) {
+        const fs::path out = dir / name;
+        write_text(out, good);
+        if (name == "out.node") write_text(dir / "out.ele", good);
+        if (name == "out.gltf") write_text(dir / "out.bin", good);
+        // dash counts ulimit -f in 512-byte blocks: 4 KiB, far less than any of these files.
+        const RunResult r =
+            run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " convert " + sq(kBox) + " " + sq(out));
+        expect_one_line_error(r, name, {name});
+        EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << "the message names the temporary: " << r.err;
+        EXPECT_EQ(read_text(out), good) << name;
+        if (name == "out.node") {
+            EXPECT_EQ(read_text(dir / "out.ele"), good);
+        }
+        EXPECT_TRUE(temporaries(dir).empty()) << name << ": " << temporaries(dir).front();
+    }
+    // The same for detect's outputs (the contacts of two overlapping boxes fill more than 4 KiB).
+    write_text(dir / "c.csv", good);
+    ASSERT_EQ(run_tethash("generate box -r 6 -o " + sq(dir / "b.vtu")).status, 0);
+    const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " detect " + sq(dir / "b.vtu") + " " +
+                                  sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"));
+    expect_one_line_error(r, "detect --contacts", {"c.csv"});
+    EXPECT_EQ(read_text(dir / "c.csv"), good);
+    EXPECT_TRUE(temporaries(dir).empty());
+    fs::remove(dir / "c.csv");
+    // Without the limit the same command writes the file: the failure above was the write.
+    ASSERT_EQ(run_tethash("detect " + sq(dir / "b.vtu") + " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv")).status, 0);
+    EXPECT_GT(fs::file_size(dir / "c.csv"), 4096u);
+}
+
+TEST(CliBadInput, StudyRejectsBadCountsAndOutputFolders)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "file", "not a folder\n");
+    const std::string base = "study cell-size --no-plot --quiet --cell-size 1 --mesh " + sq(kBox);
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {base + " --repeat -2 --out " + sq(dir / "s"), "--repeat"},
+        {base + " --warmup -1 --out " + sq(dir / "s"), "--warmup"},
+        {base + " --out " + sq(dir / "file"), "not a folder"},
+        {base + " --out " + sq(dir / "file" / "sub"), "--out"},
+        {base + " --out /proc/tethash_study", "--out"},
+    };
+    for (const auto& [args, fragment] : cases) {
+        const RunResult r = run_tethash(args);
+        expect_one_line_error(r, args, {fragment});
+        EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
+    }
+    EXPECT_FALSE(fs::exists(dir / "s" / "study.csv"));
+    EXPECT_EQ(read_text(dir / "file"), "not a folder\n");
+}
+
+TEST(CliBadInput, PlotScriptRejectsWhatIsNotAStudyInOneLine)
+{
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "matplotlib");
+    const auto dir = temp_dir();
+    const std::string script = sq(fs::path(TETHASH_SOURCE_DIR) / "tools" / "plot_study.py");
+    fs::create_directories(dir / "other");
+    write_text(dir / "other" / "study.csv", "a,b\n1,2\n");
+    const std::vector<std::pair<std::string, std::string>> cases = {{sq(dir / "none"), "no such file"},
+                                                                    {sq(dir / "other"), "not a tethash study"}};
+    for (const auto& [arg, fragment] : cases) {
+        const RunResult r = run_shell(py + " " + script + " " + arg);
+        EXPECT_EQ(r.status, 2) << arg << "\n" << r.err;
+        EXPECT_EQ(line_count(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
+    }
+}
