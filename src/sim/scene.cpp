@@ -194,6 +194,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
             const toml::table& g = r.table(v, full);
             r.check_keys(g, full + ".", {"shape", "resolution", "size", "snap"});
             io::GenerateParams gp;
+            double longest = 0; // > 0 when 'size' is one number
             for (auto&& [gk, gv] : g) {
                 const std::string gkey(gk.str()), gfull = full + "." + gkey;
                 if (gkey == "shape") {
@@ -208,11 +209,16 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
                     }
                 } else if (gkey == "resolution") gp.resolution = static_cast<int>(r.integer_at_least(gv, gfull, 1));
                 else if (gkey == "size") {
-                    if (gv.is_number()) gp.size.setConstant(r.positive(gv, gfull));
-                    else gp.size = r.vec3(gv, gfull);
-                    if (!(gp.size.minCoeff() > 0)) r.fail(&gv, gfull, "must be positive");
+                    // A single number is the longest extent (the shape keeps its proportions);
+                    // three numbers are the bounding-box extents (the shape is stretched to them).
+                    if (gv.is_number()) longest = r.positive(gv, gfull);
+                    else {
+                        gp.size = r.vec3(gv, gfull);
+                        if (!(gp.size.minCoeff() > 0)) r.fail(&gv, gfull, "must be positive");
+                    }
                 } else if (gkey == "snap") gp.snap = r.boolean(gv, gfull);
             }
+            if (longest > 0) gp.scale = longest / io::shape_natural_size(gp.shape).maxCoeff();
             o.generate = gp;
         }
     }
