@@ -106,6 +106,12 @@ public:
     /// coordinate is non-finite or a cell coordinate is out of range (the caller diagnoses and throws).
     bool build(const double* positions, const Index* ids, Index count, double cell_size, const double origin[3],
                std::int64_t table_size, HashFunction hash, int threads);
+    /// The same, called by every thread of the current OpenMP team (inside a parallel region; outside one it runs
+    /// on the calling thread alone): cells, buckets and the counting sort are split over the team (per-thread
+    /// histograms, a parallel prefix sum, a parallel stable scatter). The table is the same for any team size.
+    /// Returns the same value on every thread; ends with a barrier.
+    bool build_team(const double* positions, const Index* ids, Index count, double cell_size, const double origin[3],
+                    std::int64_t table_size, HashFunction hash);
 
     std::int64_t table_size() const { return static_cast<std::int64_t>(m_mod.n); }
     const TableModulus& modulus() const { return m_mod; }
@@ -124,6 +130,11 @@ private:
     Index m_count = 0;
     std::vector<std::uint32_t> m_bucket;   ///< per input vertex
     std::vector<std::uint32_t> m_key;      ///< per input vertex
+    std::vector<std::vector<std::int32_t>> m_hist;   ///< per thread: histogram, then scatter cursors (team build)
+    std::vector<std::int32_t*> m_hist_ptr;
+    std::vector<std::int64_t> m_partial;
+    int m_parts = 1;
+    int m_bad = 0;
 };
 
 } // namespace tethash

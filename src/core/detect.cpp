@@ -5,6 +5,7 @@
 
 #include "detect_checks.hpp"
 #include "scan.hpp"
+#include "team.hpp"
 #include "tethash/error.hpp"
 #include "tethash/hash_grid.hpp"
 #include "tethash/predicates.hpp"
@@ -171,8 +172,10 @@ struct alignas(64) ThreadState {
     std::size_t used = 0;
     std::vector<double> values;         // stage 3: 4 plane values per candidate of a run
     std::vector<std::int8_t> codes;     // stage 3: filter outcome per candidate of a run
-    std::vector<CandidateRun> runs;
+    std::vector<CandidateRun> runs;     // grown only; `num_runs` entries valid
+    std::size_t num_runs = 0;
     std::vector<RawContact> contacts;
+    std::vector<std::int32_t> vertex_hist;   // merge: contacts per vertex, then scatter cursors
     Counters counters;
     double ms_tets = 0, ms_inside = 0;
     bool too_many_cells = false;
@@ -214,7 +217,9 @@ public:
     VertexTable tables[2];   // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
     // buffers
     std::vector<ThreadState> threads;
-    std::vector<std::int32_t> vertex_counts;
+    std::vector<std::int32_t> vertex_counts;     // merge: first contact of each vertex (n + 1)
+    std::vector<std::int32_t*> merge_hist;       // merge: each thread's vertex_hist
+    std::vector<std::int64_t> merge_partial;
     std::vector<Contact> contacts;
 
     void prepare(const PositionsRef& positions);
@@ -222,6 +227,7 @@ public:
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const double* P);
+    void merge_team();
     std::int64_t memory_bytes() const;
 };
 
@@ -284,7 +290,8 @@ std::int64_t DetectorImpl::memory_bytes() const
         m += static_cast<std::int64_t>(ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() +
                                        ts.values.capacity() * sizeof(double) +
                                        ts.runs.capacity() * sizeof(CandidateRun) +
-                                       ts.contacts.capacity() * sizeof(RawContact) + sizeof(ThreadState));
+                                       ts.contacts.capacity() * sizeof(RawContact) +
+                                       ts.vertex_hist.capacity() * sizeof(std::int32_t) + sizeof(ThreadState));
     return m;
 }
 
@@ -331,11 +338,14 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
     const int num_tables =
         any_static && !flags.is_static[static_cast<std::size_t>(tet_object[static_cast<std::size_t>(t)])] ? 2 : 1;
     detail::ScanCounters sc;
+    const std::int32_t x0 = c0[0], x1 = c1[0], y0 = c0[1], y1 = c1[1];
     for (int ti = 0; ti < num_tables; ++ti) {
         const VertexTable& table = tables[ti];
         if (table.size() == 0) continue;
         const TableModulus& mod = table.modulus();
         const std::int32_t* start = table.start.data();
+        q.z0 = c0[2];
+        q.z1 = c1[2];
         // Bucket ranges collected in a fixed local array and scanned in batches (no per-range call).
         constexpr int max_ranges = 64;
         detail::ScanRange ranges[max_ranges];
@@ -343,59 +353,71 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         std::size_t total = 0;
         auto flush = [&]() {
             if (nr == 0) return;
-            const std::size_t need = ts.used + total;
+            const std::size_t need = ts.used + total + 8;   // the AVX2 scan stores 8 ids at a time
             if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
             ts.used += static_cast<std::size_t>(
                 detail::scan_ranges(table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats, exact, inv_cell));
             nr = 0;
             total = 0;
         };
-        auto add = [&](std::int32_t begin, std::int32_t end, std::int32_t x, std::int32_t y, std::int32_t z0,
-                       std::int32_t z1) {
-            if (begin >= end) return;
-            ranges[nr++] = {begin, end, x, y, z0, z1};
-            total += static_cast<std::size_t>(end - begin);
+        // Appends a range, dropping it (branch-free) when empty; room for one more range must be left by the caller.
+        auto push = [&](std::int32_t begin, std::int32_t end, std::int32_t x, std::int32_t y) {
+            ranges[nr] = {begin, end, x, y};
+            nr += begin < end;
+            total += static_cast<std::size_t>(std::max(end - begin, 0));
+        };
+        auto add = [&](std::int32_t begin, std::int32_t end, std::int32_t x, std::int32_t y) {
+            push(begin, end, x, y);
             if (nr == max_ranges) flush();
         };
-        if (column && mod.pow2 && static_cast<std::uint64_t>(nz) < mod.n) {
-            // The common case: one contiguous range per column unless it wraps around the table's end.
-            const std::uint64_t mask = mod.mask;
+        if (column && mod.pow2 && static_cast<std::uint64_t>(nz) < mod.n && 2 * nx * ny <= max_ranges) {
+            // The common case: one contiguous range per column unless it wraps around the table's end (then two),
+            // all of a tet's columns in one batch.
+            const std::uint64_t mask = mod.mask, n = mod.n;
             const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(c0[2]));
-            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
-                for (std::int32_t y = c0[1]; y <= c1[1]; ++y) {
-                    const std::uint64_t b0 = (column_mix(x, y) + zoff) & mask;
-                    const std::uint64_t e = b0 + static_cast<std::uint64_t>(nz);
-                    if (e <= mod.n) {
-                        add(start[b0], start[e], x, y, c0[2], c1[2]);
+            // One flat loop over the nx × ny columns (one loop exit to predict instead of nx + 1).
+            std::int32_t x = x0, y = y0;
+            for (std::int64_t j = nx * ny; j > 0; --j) {
+                const std::uint64_t b0 = (column_mix(x, y) + zoff) & mask;
+                const std::uint64_t e = b0 + static_cast<std::uint64_t>(nz);
+                if (e <= n) [[likely]] {
+                    push(start[b0], start[e], x, y);
+                } else {
+                    push(start[b0], start[n], x, y);
+                    push(start[0], start[e - n], x, y);
+                }
+                const bool wrap = y == y1;
+                x += wrap;
+                y = wrap ? y0 : y + 1;
+            }
+        } else if (column) {
+            for (std::int32_t x = x0; x <= x1; ++x)
+                for (std::int32_t y = y0; y <= y1; ++y) {
+                    const std::uint64_t h = column_mix(x, y);
+                    if (static_cast<std::uint64_t>(nz) >= mod.n) {
+                        add(0, table.size(), x, y);
                     } else {
-                        add(start[b0], start[mod.n], x, y, c0[2], c1[2]);
-                        add(start[0], start[e - mod.n], x, y, c0[2], c1[2]);
+                        const std::uint64_t b0 = mod.column_bucket(h, c0[2]);
+                        const std::uint64_t b1 = b0 + static_cast<std::uint64_t>(nz) - 1;
+                        if (b1 < mod.n) {
+                            add(start[b0], start[b1 + 1], x, y);
+                        } else {
+                            add(start[b0], start[mod.n], x, y);
+                            add(start[0], start[b1 - mod.n + 1], x, y);
+                        }
                     }
                 }
         } else {
-            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
-                for (std::int32_t y = c0[1]; y <= c1[1]; ++y) {
-                    if (column) {
-                        const std::uint64_t h = column_mix(x, y);
-                        if (static_cast<std::uint64_t>(nz) >= mod.n) {
-                            add(0, table.size(), x, y, c0[2], c1[2]);
-                        } else {
-                            const std::uint64_t b0 = mod.column_bucket(h, c0[2]);
-                            const std::uint64_t b1 = b0 + static_cast<std::uint64_t>(nz) - 1;
-                            if (b1 < mod.n) {
-                                add(start[b0], start[b1 + 1], x, y, c0[2], c1[2]);
-                            } else {
-                                add(start[b0], start[mod.n], x, y, c0[2], c1[2]);
-                                add(start[0], start[b1 - mod.n + 1], x, y, c0[2], c1[2]);
-                            }
-                        }
-                    } else {
-                        for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
-                            const std::uint64_t bk = mod.reduce(teschner_hash(x, y, z));
-                            add(start[bk], start[bk + 1], x, y, z, z);
-                        }
+            // Teschner's hash: one range per cell, one batch per z-layer (the query's z-run is that layer).
+            for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
+                q.z0 = q.z1 = z;
+                for (std::int32_t x = x0; x <= x1; ++x)
+                    for (std::int32_t y = y0; y <= y1; ++y) {
+                        const std::uint64_t bk = mod.reduce(teschner_hash(x, y, z));
+                        add(start[bk], start[bk + 1], x, y);
                     }
-                }
+                flush();
+            }
         }
         flush();
     }
@@ -406,7 +428,10 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         ts.counters.own += sc.own;
     }
     const std::int32_t run_end = static_cast<std::int32_t>(ts.used);
-    if (run_end > run_begin) ts.runs.push_back({t, run_begin, run_end});
+    // Branch-free append (most tets have candidates, but not predictably which).
+    if (ts.num_runs == ts.runs.size()) ts.runs.resize(std::max<std::size_t>(64, 2 * ts.runs.size()));
+    ts.runs[ts.num_runs] = {t, run_begin, run_end};
+    ts.num_runs += run_end > run_begin;
 }
 
 // Stage 3 over a thread's candidate runs: face planes per tet (only tets with candidates), filtered
@@ -414,7 +439,8 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
 // the filter cannot decide.
 void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
 {
-    for (const CandidateRun& run : ts.runs) {
+    for (std::size_t r = 0; r < ts.num_runs; ++r) {
+        const CandidateRun& run = ts.runs[r];
         const Index t = run.tet;
         const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
         const double* A = P + 3 * static_cast<std::size_t>(tv[0]);
@@ -478,6 +504,56 @@ void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
     }
 }
 
+// The merge, called by every thread of the team after stage 3 (threads[rank] holds that thread's contacts, in
+// increasing tet order): a counting sort by vertex (per-thread counts, parallel prefix sum, each thread scattering
+// its own contacts), then a sort by tet within each vertex, split over the team. Sorted by (vertex, tet): the same
+// for any thread count.
+void DetectorImpl::merge_team()
+{
+    const int rank = detail::team_rank(), size = detail::team_size();
+    const std::size_t V = static_cast<std::size_t>(num_vertices);
+#pragma omp single
+    {
+        std::size_t total = 0;
+        for (const ThreadState& ts : threads) total += ts.contacts.size();
+        contacts.resize(total);
+        vertex_counts.resize(V + 1);
+        merge_partial.resize(static_cast<std::size_t>(size) + 1);
+        merge_hist.resize(static_cast<std::size_t>(size));
+    } // implicit barrier
+    ThreadState& own = threads[static_cast<std::size_t>(rank)];
+    if (own.vertex_hist.size() != V) own.vertex_hist.resize(V);
+    std::memset(own.vertex_hist.data(), 0, V * sizeof(std::int32_t));
+    for (const RawContact& rc : own.contacts) ++own.vertex_hist[static_cast<std::size_t>(rc.vertex)];
+    merge_hist[static_cast<std::size_t>(rank)] = own.vertex_hist.data();
+    detail::team_barrier();
+    detail::team_counting_offsets(merge_hist.data(), size, static_cast<std::int64_t>(V), vertex_counts.data(),
+                                  merge_partial.data());
+    std::int32_t* cursor = own.vertex_hist.data();
+    for (const RawContact& rc : own.contacts) {
+        Contact& c = contacts[static_cast<std::size_t>(cursor[rc.vertex]++)];
+        c.vertex = rc.vertex;
+        c.tet = rc.tet;
+        c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
+        c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
+        for (int k = 0; k < 4; ++k) c.bary[k] = rc.bary[k];
+        c.depth = std::numeric_limits<double>::quiet_NaN();
+        c.direction[0] = c.direction[1] = c.direction[2] = 0;
+    }
+    detail::team_barrier();
+    // Within a vertex: one run per thread, each increasing in tet; one thread → already sorted.
+    if (size > 1) {
+        std::int64_t v0, v1;
+        detail::team_split(static_cast<std::int64_t>(V), rank, size, v0, v1);
+        const std::int32_t* s = vertex_counts.data();
+        for (std::int64_t v = v0; v < v1; ++v)
+            if (s[v + 1] - s[v] > 1)
+                std::sort(contacts.begin() + s[v], contacts.begin() + s[v + 1],
+                          [](const Contact& x, const Contact& y) { return x.tet < y.tet; });
+        detail::team_barrier();
+    }
+}
+
 const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, DetectStats* stats)
 {
     const auto t_start = Clock::now();
@@ -491,75 +567,51 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     if (static_cast<int>(threads.size()) != T) threads.resize(static_cast<std::size_t>(T));
     const double* P = positions.data();
 
-    // Stage 1: moving vertices.
+    // One parallel region for everything: stage 1 (split over the team), stages 2 and 3 (dynamic chunks of tets;
+    // each thread then tests its own candidates), the merge (split over the team). Waking the team once.
     const Index* ids = any_static ? dynamic_ids.data() : nullptr;
     const Index count = static_cast<Index>(dynamic_ids.size());
-    if (!tables[0].build(P, ids, count, cell_size, origin, table_sizes[0], params.hash, T))
-        diagnose_build_failure(positions, ids, count);
-    const double ms_vertices = ms_since(t_start);
-
-    // Stages 2 and 3, parallel over tets; each thread then tests its own candidates.
     const Index m = static_cast<Index>(tets.size() / 4);
     const bool with_stats = stats != nullptr;
     for (ThreadState& ts : threads) {
         ts.used = 0;
-        ts.runs.clear();
+        ts.num_runs = 0;
         ts.contacts.clear();
         ts.counters = Counters{};
         ts.too_many_cells = false;
     }
+    bool built = true;
+    double ms_vertices = 0, ms_sort = 0;
 #pragma omp parallel num_threads(T)
     {
-#ifdef TETHASH_HAVE_OPENMP
-        ThreadState& ts = threads[static_cast<std::size_t>(omp_get_thread_num())];
-#else
-        ThreadState& ts = threads[0];
-#endif
-        const auto t0 = Clock::now();
+        const int rank = detail::team_rank();
+        ThreadState& ts = threads[static_cast<std::size_t>(rank)];
+        // Stage 1: moving vertices (every thread gets the same answer).
+        const bool ok =
+            tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+        if (rank == 0) {
+            built = ok;
+            ms_vertices = ms_since(t_start);
+        }
+        if (ok) {
+            const auto t0 = Clock::now();
 #pragma omp for schedule(dynamic, 256) nowait
-        for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
-        ts.ms_tets = ms_since(t0);
-        const auto t1 = Clock::now();
-        stage_inside(ts, P);
-        ts.ms_inside = ms_since(t1);
+            for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
+            ts.ms_tets = ms_since(t0);
+            const auto t1 = Clock::now();
+            stage_inside(ts, P);
+            ts.ms_inside = ms_since(t1);
+            detail::team_barrier();
+            const auto t2 = Clock::now();
+            merge_team();
+            if (rank == 0) ms_sort = ms_since(t2);
+        }
     }
+    if (!built) diagnose_build_failure(positions, ids, count);
     for (const ThreadState& ts : threads)
         if (ts.too_many_cells)
             throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
                         std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells; use a larger cell size");
-
-    // Merge: counting sort by vertex (stable), then by tet within each vertex.
-    const auto t_sort = Clock::now();
-    vertex_counts.assign(static_cast<std::size_t>(num_vertices) + 1, 0);
-    std::size_t total = 0;
-    for (const ThreadState& ts : threads) {
-        total += ts.contacts.size();
-        for (const RawContact& rc : ts.contacts) ++vertex_counts[static_cast<std::size_t>(rc.vertex) + 1];
-    }
-    for (Index v = 0; v < num_vertices; ++v) vertex_counts[v + 1] += vertex_counts[v];
-    contacts.resize(total);
-    for (const ThreadState& ts : threads)
-        for (const RawContact& rc : ts.contacts) {
-            Contact& c = contacts[static_cast<std::size_t>(vertex_counts[rc.vertex]++)];
-            c.vertex = rc.vertex;
-            c.tet = rc.tet;
-            c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
-            c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
-            for (int k = 0; k < 4; ++k) c.bary[k] = rc.bary[k];
-            c.depth = std::numeric_limits<double>::quiet_NaN();
-            c.direction[0] = c.direction[1] = c.direction[2] = 0;
-        }
-    {
-        std::int32_t begin = 0;
-        for (Index v = 0; v < num_vertices; ++v) {
-            const std::int32_t end = vertex_counts[v];
-            if (end - begin > 1)
-                std::sort(contacts.begin() + begin, contacts.begin() + end,
-                          [](const Contact& x, const Contact& y) { return x.tet < y.tet; });
-            begin = end;
-        }
-    }
-    const double ms_sort = ms_since(t_sort);
 
     if (stats) {
         Counters sum;

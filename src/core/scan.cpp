@@ -67,7 +67,7 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const Verte
     for (std::int32_t r = 0; r < count; ++r) {
     const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
     const __m256i qk = _mm256_set1_epi32(static_cast<int>(column_key(ranges[r].cx, ranges[r].cy)));
-    const __m256i z0 = _mm256_set1_epi32(ranges[r].z0), zs = _mm256_set1_epi32(ranges[r].z1 - ranges[r].z0 + 1);
+    const __m256i z0 = _mm256_set1_epi32(q.z0), zs = _mm256_set1_epi32(q.z1 - q.z0 + 1);
     c.scanned += end - begin;
     for (std::int32_t i = begin; i < end; i += 8) {
         const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
@@ -105,8 +105,26 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const Verte
     return n;
 }
 
-// The lean kernel: box test 8 at a time (the tet's own box, the same for every range), own-vertex test, and the
-// cell test (column and z-range of the range) only for the few box survivors. No statistics.
+// Left-packing indices for the lean kernel: for a lane mask m, the lanes of m in ascending order (3-bit lane
+// numbers, one per byte, widened with vpmovzxbd). 2 KB.
+struct PackTable {
+    std::uint64_t idx[256];
+    constexpr PackTable() : idx()
+    {
+        for (int m = 0; m < 256; ++m) {
+            std::uint64_t v = 0;
+            int k = 0;
+            for (int lane = 0; lane < 8; ++lane)
+                if (m & (1 << lane)) v |= static_cast<std::uint64_t>(lane) << (8 * k++);
+            idx[m] = v;
+        }
+    }
+};
+constexpr PackTable pack_table;
+
+// The lean kernel, branch-free per 8 entries: box, cell (column of the range, z-run of the query) and own-vertex
+// tests as lane masks, one movemask, survivors left-packed by a permutation from pack_table and stored 8 at a time
+// (`out` has 8 ids of slack). No statistics.
 __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const VertexTable& t,
                                                                            const ScanRange* ranges,
                                                                            std::int32_t count, const ScanQuery& q,
@@ -116,6 +134,10 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
     const __m256 hx = _mm256_set1_ps(q.hi[0]), hy = _mm256_set1_ps(q.hi[1]), hz = _mm256_set1_ps(q.hi[2]);
     const __m256i o0 = _mm256_set1_epi32(q.own[0]), o1 = _mm256_set1_epi32(q.own[1]);
     const __m256i o2 = _mm256_set1_epi32(q.own[2]), o3 = _mm256_set1_epi32(q.own[3]);
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i colmask = _mm256_set1_epi32(static_cast<int>(key_column_mask));
+    const __m256i zmask = _mm256_set1_epi32(0x3ff);
+    const __m256i z0 = _mm256_set1_epi32(q.z0), zs = _mm256_set1_epi32(q.z1 - q.z0 + 1);
     const float* X = t.x.data();
     const float* Y = t.y.data();
     const float* Z = t.z.data();
@@ -127,35 +149,37 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
         _mm_prefetch(reinterpret_cast<const char*>(X + b), _MM_HINT_T0);
         _mm_prefetch(reinterpret_cast<const char*>(Y + b), _MM_HINT_T0);
         _mm_prefetch(reinterpret_cast<const char*>(Z + b), _MM_HINT_T0);
-        _mm_prefetch(reinterpret_cast<const char*>(ID + b), _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(KEY + b), _MM_HINT_T0);
     }
     std::int32_t n = 0;
     for (std::int32_t r = 0; r < count; ++r) {
         const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
-        const std::uint32_t ckey = column_key(ranges[r].cx, ranges[r].cy);
-        const auto z0 = static_cast<std::uint32_t>(ranges[r].z0);
-        const auto zspan = static_cast<std::uint32_t>(ranges[r].z1 - ranges[r].z0);
-        for (std::int32_t i = begin; i < end; i += 8) {
+        const __m256i qk = _mm256_set1_epi32(static_cast<int>(column_key(ranges[r].cx, ranges[r].cy)));
+        std::int32_t i = begin;
+        do {
             // Lanes past `end` read the next entries or the padding (NaN coordinates): masked off.
-            const int mv = end - i >= 8 ? 0xff : (1 << (end - i)) - 1;
+            const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
             const __m256 x = _mm256_loadu_ps(X + i), y = _mm256_loadu_ps(Y + i), z = _mm256_loadu_ps(Z + i);
             const __m256 inx = _mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ));
             const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
             const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
-            const int mb = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(inx, iny), inz)) & mv;
-            if (!mb) continue;
+            const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
+            const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
+            const __m256i cell = _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk),
+                                                  _mm256_cmpgt_epi32(zs, dz));
             const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
-            const __m256i isown = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
-                                                  _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
-            int keep = mb & ~_mm256_movemask_ps(_mm256_castsi256_ps(isown));
-            while (keep) {
-                const std::int32_t j = i + __builtin_ctz(static_cast<unsigned>(keep));
-                keep &= keep - 1;
-                // Entry from this range's cells (not a foreign cell sharing the bucket: a duplicate or a miss).
-                const std::uint32_t k = KEY[j];
-                if ((k & key_column_mask) == ckey && (((k >> 22) - z0) & 0x3ffu) <= zspan) out[n++] = ID[j];
-            }
-        }
+            const __m256i isown =
+                _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
+                                _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
+            const __m256i keep = _mm256_andnot_si256(
+                isown, _mm256_and_si256(_mm256_and_si256(valid, cell),
+                                        _mm256_castps_si256(_mm256_and_ps(_mm256_and_ps(inx, iny), inz))));
+            const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(keep)));
+            const __m256i perm = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(pack_table.idx + m)));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + n), _mm256_permutevar8x32_epi32(ids, perm));
+            n += __builtin_popcount(m);
+            i += 8;
+        } while (i < end);
     }
     return n;
 }
@@ -269,8 +293,6 @@ std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, s
     for (std::int32_t r = 0; r < count; ++r) {
         qq.cx = ranges[r].cx;
         qq.cy = ranges[r].cy;
-        qq.z0 = ranges[r].z0;
-        qq.z1 = ranges[r].z1;
         n += scan_scalar(t, ranges[r].begin, ranges[r].end, qq, out + n, c);
     }
     return n;
@@ -289,7 +311,7 @@ std::int32_t scan_ranges_exact(const VertexTable& t, const ScanRange* ranges, st
             const Index v = t.id[i];
             const double* p = P + 3 * static_cast<std::size_t>(v);
             const std::int32_t cz = floor_to_int(p[2] * inv_cell);
-            if (floor_to_int(p[0] * inv_cell) != R.cx || floor_to_int(p[1] * inv_cell) != R.cy || cz < R.z0 || cz > R.z1) {
+            if (floor_to_int(p[0] * inv_cell) != R.cx || floor_to_int(p[1] * inv_cell) != R.cy || cz < q.z0 || cz > q.z1) {
                 ++c.collisions;
                 continue;
             }
@@ -348,7 +370,7 @@ std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std:
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
                                Index* out, ScanCounters& counters)
 {
-    const ScanRange r{begin, end, q.cx, q.cy, q.z0, q.z1};
+    const ScanRange r{begin, end, q.cx, q.cy};
     return chosen(table, &r, 1, q, out, counters);
 }
 

@@ -7,7 +7,8 @@
 namespace tethash::detail {
 
 /// What one tet looks for in a bucket range: entries in column/cell (cx, cy, z0..z1), inside the float box
-/// (lo, hi, relative to the table origin), and not one of the tet's own vertices.
+/// (lo, hi, relative to the table origin), and not one of the tet's own vertices. In scan_ranges the column comes
+/// from each range and the z-range [z0, z1] from the query (the same for all ranges of one call).
 struct ScanQuery {
     float lo[3], hi[3];
     std::int32_t cx = 0, cy = 0, z0 = 0, z1 = 0;
@@ -18,13 +19,14 @@ struct ScanCounters {
     std::int64_t scanned = 0, collisions = 0, box_rejections = 0, own = 0;
 };
 
-/// One bucket range to scan, with the column (cx, cy) and cell z-range its entries must have.
+/// One bucket range to scan, with the column (cx, cy) its entries must have (their z-range: the query's). 16 bytes.
 struct ScanRange {
-    std::int32_t begin, end, cx, cy, z0, z1;
+    std::int32_t begin, end, cx, cy;
 };
 
-/// Scans every range of `ranges` for the box and own vertices of `q` (q.cx/cy/z0/z1 ignored); appends the ids
-/// to `out` (room for the sum of the range lengths); returns how many. With `full_counts` every entry is
+/// Scans every range of `ranges` for the box and own vertices of `q` and cells in the range's column and
+/// q.z0..q.z1 (q.cx/cy ignored); appends the ids to `out` (room for the sum of the range lengths plus 8: the AVX2
+/// kernel stores 8 ids at a time); returns how many. With `full_counts` every entry is
 /// classified for `counters` (cell, box, own); without, a leaner kernel tests the box first and the cell only
 /// for box survivors, and leaves `counters` alone. Both append the same ids in the same order.
 /// With `exact_positions` (the n × 3 positions the table was built from, and 1 / cell size): cells are recomputed
