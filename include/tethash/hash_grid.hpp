@@ -107,11 +107,16 @@ public:
     bool build(const double* positions, const Index* ids, Index count, double cell_size, const double origin[3],
                std::int64_t table_size, HashFunction hash, int threads);
     /// The same, called by every thread of the current OpenMP team (inside a parallel region; outside one it runs
-    /// on the calling thread alone): cells, buckets and the counting sort are split over the team (per-thread
-    /// histograms, a parallel prefix sum, a parallel stable scatter). The table is the same for any team size.
-    /// Returns the same value on every thread; ends with a barrier.
+    /// on the calling thread alone) after reserve(count, table_size) on one thread: cells and buckets are split over
+    /// the team by vertex, the counting sort by bucket (each thread sorts the vertices of its block of buckets, in
+    /// input order). Two barriers; the table is the same for any team size. Returns the same value on every thread.
     bool build_team(const double* positions, const Index* ids, Index count, double cell_size, const double origin[3],
                     std::int64_t table_size, HashFunction hash);
+    /// Sizes the buffers for build_team (no allocation when the sizes did not change).
+    void reserve(Index count, std::int64_t table_size, int threads);
+    /// How many threads of a team of `threads` build_team splits `count` vertices over (1: thread 0 builds the
+    /// table alone; then build_team is better called before the parallel region, saving the team a barrier).
+    static int team_parts(Index count, int threads);
 
     std::int64_t table_size() const { return static_cast<std::int64_t>(m_mod.n); }
     const TableModulus& modulus() const { return m_mod; }
@@ -119,7 +124,7 @@ public:
     std::int64_t memory_bytes() const;
 
     // Structure of arrays in bucket order, padded by 8 entries at the end (padding never matches: NaN
-    // coordinates). 20 bytes per entry.
+    // coordinates; never read beyond) and then one spare entry per thread of a team build. 20 bytes per entry.
     std::vector<float> x, y, z;          ///< coordinates relative to the origin, rounded to float
     std::vector<std::int32_t> id;        ///< vertex id
     std::vector<std::uint32_t> key;      ///< cell_key() of the entry's cell
@@ -130,10 +135,7 @@ private:
     Index m_count = 0;
     std::vector<std::uint32_t> m_bucket;   ///< per input vertex
     std::vector<std::uint32_t> m_key;      ///< per input vertex
-    std::vector<std::vector<std::int32_t>> m_hist;   ///< per thread: histogram, then scatter cursors (team build)
-    std::vector<std::int32_t*> m_hist_ptr;
-    std::vector<std::int64_t> m_partial;
-    int m_parts = 1;
+    std::vector<std::int32_t> m_cursor;    ///< team build: scatter cursor per bucket, then one spare slot per thread
     int m_bad = 0;
 };
 

@@ -175,9 +175,9 @@ struct alignas(64) ThreadState {
     std::vector<CandidateRun> runs;     // grown only; `num_runs` entries valid
     std::size_t num_runs = 0;
     std::vector<RawContact> contacts;
-    std::vector<std::int32_t> vertex_hist;   // merge: contacts per vertex, then scatter cursors
+    std::vector<RawContact> sorted;         // radix sort buffer
     Counters counters;
-    double ms_tets = 0, ms_inside = 0;
+    double ms_tets = 0, ms_inside = 0, ms_sort = 0;
     bool too_many_cells = false;
     Index too_many_cells_tet = -1;
 };
@@ -217,17 +217,14 @@ public:
     VertexTable tables[2];   // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
     // buffers
     std::vector<ThreadState> threads;
-    std::vector<std::int32_t> vertex_counts;     // merge: first contact of each vertex (n + 1)
-    std::vector<std::int32_t*> merge_hist;       // merge: each thread's vertex_hist
-    std::vector<std::int64_t> merge_partial;
     std::vector<Contact> contacts;
+    std::vector<std::size_t> merge_pos;   // merge: next contact of each thread's run
 
     void prepare(const PositionsRef& positions);
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const double* P);
-    void merge_team();
     std::int64_t memory_bytes() const;
 };
 
@@ -283,15 +280,14 @@ void DetectorImpl::diagnose_build_failure(const PositionsRef& positions, const I
 std::int64_t DetectorImpl::memory_bytes() const
 {
     std::int64_t m = static_cast<std::int64_t>(tets.capacity() + vertex_object.capacity() + tet_object.capacity() +
-                                               dynamic_ids.capacity() + static_ids.capacity() +
-                                               vertex_counts.capacity()) * 4;
+                                               dynamic_ids.capacity() + static_ids.capacity()) * 4;
     m += tables[0].memory_bytes() + tables[1].memory_bytes();
     for (const ThreadState& ts : threads)
         m += static_cast<std::int64_t>(ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() +
                                        ts.values.capacity() * sizeof(double) +
                                        ts.runs.capacity() * sizeof(CandidateRun) +
                                        ts.contacts.capacity() * sizeof(RawContact) +
-                                       ts.vertex_hist.capacity() * sizeof(std::int32_t) + sizeof(ThreadState));
+                                       ts.sorted.capacity() * sizeof(RawContact) + sizeof(ThreadState));
     return m;
 }
 
@@ -504,54 +500,29 @@ void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
     }
 }
 
-// The merge, called by every thread of the team after stage 3 (threads[rank] holds that thread's contacts, in
-// increasing tet order): a counting sort by vertex (per-thread counts, parallel prefix sum, each thread scattering
-// its own contacts), then a sort by tet within each vertex, split over the team. Sorted by (vertex, tet): the same
-// for any thread count.
-void DetectorImpl::merge_team()
+// Sorts a thread's contacts by (vertex, tet) without any synchronisation: they come out of stage 3 in increasing
+// tet order (monotonic dynamic schedule, runs in order), so a stable LSD radix sort by vertex (11-bit digits) does
+// it. The result is in ts.contacts.
+static void sort_own_contacts(ThreadState& ts, Index num_vertices)
 {
-    const int rank = detail::team_rank(), size = detail::team_size();
-    const std::size_t V = static_cast<std::size_t>(num_vertices);
-#pragma omp single
-    {
-        std::size_t total = 0;
-        for (const ThreadState& ts : threads) total += ts.contacts.size();
-        contacts.resize(total);
-        vertex_counts.resize(V + 1);
-        merge_partial.resize(static_cast<std::size_t>(size) + 1);
-        merge_hist.resize(static_cast<std::size_t>(size));
-    } // implicit barrier
-    ThreadState& own = threads[static_cast<std::size_t>(rank)];
-    if (own.vertex_hist.size() != V) own.vertex_hist.resize(V);
-    std::memset(own.vertex_hist.data(), 0, V * sizeof(std::int32_t));
-    for (const RawContact& rc : own.contacts) ++own.vertex_hist[static_cast<std::size_t>(rc.vertex)];
-    merge_hist[static_cast<std::size_t>(rank)] = own.vertex_hist.data();
-    detail::team_barrier();
-    detail::team_counting_offsets(merge_hist.data(), size, static_cast<std::int64_t>(V), vertex_counts.data(),
-                                  merge_partial.data());
-    std::int32_t* cursor = own.vertex_hist.data();
-    for (const RawContact& rc : own.contacts) {
-        Contact& c = contacts[static_cast<std::size_t>(cursor[rc.vertex]++)];
-        c.vertex = rc.vertex;
-        c.tet = rc.tet;
-        c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
-        c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
-        for (int k = 0; k < 4; ++k) c.bary[k] = rc.bary[k];
-        c.depth = std::numeric_limits<double>::quiet_NaN();
-        c.direction[0] = c.direction[1] = c.direction[2] = 0;
+    const std::size_t n = ts.contacts.size();
+    if (n < 2) return;
+    if (ts.sorted.size() < n) ts.sorted.resize(n + n / 2);
+    RawContact* src = ts.contacts.data();
+    RawContact* dst = ts.sorted.data();
+    for (int shift = 0; shift < 31 && (num_vertices - 1) >> shift; shift += 11) {
+        std::int32_t count[2048] = {};
+        for (std::size_t i = 0; i < n; ++i) ++count[(src[i].vertex >> shift) & 2047];
+        std::int32_t sum = 0;
+        for (std::int32_t& c : count) {
+            const std::int32_t k = c;
+            c = sum;
+            sum += k;
+        }
+        for (std::size_t i = 0; i < n; ++i) dst[count[(src[i].vertex >> shift) & 2047]++] = src[i];
+        std::swap(src, dst);
     }
-    detail::team_barrier();
-    // Within a vertex: one run per thread, each increasing in tet; one thread → already sorted.
-    if (size > 1) {
-        std::int64_t v0, v1;
-        detail::team_split(static_cast<std::int64_t>(V), rank, size, v0, v1);
-        const std::int32_t* s = vertex_counts.data();
-        for (std::int64_t v = v0; v < v1; ++v)
-            if (s[v + 1] - s[v] > 1)
-                std::sort(contacts.begin() + s[v], contacts.begin() + s[v + 1],
-                          [](const Contact& x, const Contact& y) { return x.tet < y.tet; });
-        detail::team_barrier();
-    }
+    if (src != ts.contacts.data()) std::copy(src, src + n, ts.contacts.data());
 }
 
 const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, DetectStats* stats)
@@ -567,8 +538,9 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     if (static_cast<int>(threads.size()) != T) threads.resize(static_cast<std::size_t>(T));
     const double* P = positions.data();
 
-    // One parallel region for everything: stage 1 (split over the team), stages 2 and 3 (dynamic chunks of tets;
-    // each thread then tests its own candidates), the merge (split over the team). Waking the team once.
+    // One parallel region: stage 1 (big scenes: split over the team), stages 2 and 3 (dynamic chunks of tets; each
+    // thread then tests its own candidates and sorts its own contacts), no barrier in between; then the merge of the
+    // threads' sorted runs.
     const Index* ids = any_static ? dynamic_ids.data() : nullptr;
     const Index count = static_cast<Index>(dynamic_ids.size());
     const Index m = static_cast<Index>(tets.size() / 4);
@@ -580,31 +552,39 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         ts.counters = Counters{};
         ts.too_many_cells = false;
     }
+    tables[0].reserve(count, table_sizes[0], T);
+    // Stage 1: moving vertices. Split over the team only for big scenes (VertexTable::team_parts); else built here,
+    // before the region: each barrier can cost the team a scheduler time slice on a busy machine.
+    const bool team_build = VertexTable::team_parts(count, T) > 1;
     bool built = true;
-    double ms_vertices = 0, ms_sort = 0;
-#pragma omp parallel num_threads(T)
+    double ms_vertices = 0, ms_sort_own = 0;
+    if (!team_build) {
+        built = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+        ms_vertices = ms_since(t_start);
+    }
+#pragma omp parallel num_threads(T) if (T > 1 && built)
     {
         const int rank = detail::team_rank();
         ThreadState& ts = threads[static_cast<std::size_t>(rank)];
-        // Stage 1: moving vertices (every thread gets the same answer).
-        const bool ok =
-            tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
-        if (rank == 0) {
-            built = ok;
-            ms_vertices = ms_since(t_start);
+        bool ok = built;
+        if (team_build) {   // every thread gets the same answer
+            ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+            if (rank == 0) {
+                built = ok;
+                ms_vertices = ms_since(t_start);
+            }
         }
         if (ok) {
             const auto t0 = Clock::now();
-#pragma omp for schedule(dynamic, 256) nowait
+#pragma omp for schedule(monotonic : dynamic, 256) nowait
             for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
             ts.ms_tets = ms_since(t0);
             const auto t1 = Clock::now();
             stage_inside(ts, P);
             ts.ms_inside = ms_since(t1);
-            detail::team_barrier();
             const auto t2 = Clock::now();
-            merge_team();
-            if (rank == 0) ms_sort = ms_since(t2);
+            sort_own_contacts(ts, num_vertices);
+            ts.ms_sort = ms_since(t2);
         }
     }
     if (!built) diagnose_build_failure(positions, ids, count);
@@ -612,6 +592,42 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         if (ts.too_many_cells)
             throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
                         std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells; use a larger cell size");
+
+    // Merge the threads' sorted runs: sorted by (vertex, tet), the same for any thread count.
+    const auto t_merge = Clock::now();
+    {
+        std::size_t total = 0;
+        for (const ThreadState& ts : threads) total += ts.contacts.size();
+        contacts.resize(total);
+        merge_pos.assign(threads.size(), 0);
+        std::size_t* pos = merge_pos.data();
+        const int runs = static_cast<int>(threads.size());
+        for (std::size_t out = 0; out < total; ++out) {
+            int best = -1;
+            Index bv = 0, bt = 0;
+            for (int r = 0; r < runs; ++r) {
+                const ThreadState& ts = threads[static_cast<std::size_t>(r)];
+                if (pos[r] == ts.contacts.size()) continue;
+                const RawContact& rc = ts.contacts[pos[r]];
+                if (best < 0 || rc.vertex < bv || (rc.vertex == bv && rc.tet < bt)) {
+                    best = r;
+                    bv = rc.vertex;
+                    bt = rc.tet;
+                }
+            }
+            const RawContact& rc = threads[static_cast<std::size_t>(best)].contacts[pos[best]++];
+            Contact& c = contacts[out];
+            c.vertex = rc.vertex;
+            c.tet = rc.tet;
+            c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
+            c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
+            for (int k = 0; k < 4; ++k) c.bary[k] = rc.bary[k];
+            c.depth = std::numeric_limits<double>::quiet_NaN();
+            c.direction[0] = c.direction[1] = c.direction[2] = 0;
+        }
+    }
+    double ms_sort = ms_since(t_merge);
+    for (const ThreadState& ts : threads) ms_sort_own = std::max(ms_sort_own, ts.ms_sort);
 
     if (stats) {
         Counters sum;
@@ -623,7 +639,7 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
             s.ms_tets = std::max(s.ms_tets, ts.ms_tets);
             s.ms_inside = std::max(s.ms_inside, ts.ms_inside);
         }
-        s.ms_sort = ms_sort;
+        s.ms_sort = ms_sort_own + ms_sort;
         s.cell_size = cell_size;
         s.table_size = table_sizes[0];
         s.threads = T;

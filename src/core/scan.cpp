@@ -143,14 +143,6 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
     const float* Z = t.z.data();
     const std::int32_t* ID = t.id.data();
     const std::uint32_t* KEY = t.key.data();
-    // Start the loads of every range first (the ranges lie scattered over the table).
-    for (std::int32_t r = 0; r < count; ++r) {
-        const std::int32_t b = ranges[r].begin;
-        _mm_prefetch(reinterpret_cast<const char*>(X + b), _MM_HINT_T0);
-        _mm_prefetch(reinterpret_cast<const char*>(Y + b), _MM_HINT_T0);
-        _mm_prefetch(reinterpret_cast<const char*>(Z + b), _MM_HINT_T0);
-        _mm_prefetch(reinterpret_cast<const char*>(KEY + b), _MM_HINT_T0);
-    }
     std::int32_t n = 0;
     for (std::int32_t r = 0; r < count; ++r) {
         const std::int32_t begin = ranges[r].begin, end = ranges[r].end;

@@ -52,6 +52,10 @@ void write_atomically(const std::string& path, const std::function<void(const st
 /// temporary first; only when all are complete are they renamed into place.
 void write_atomically(const std::vector<std::string>& paths,
                       const std::function<void(const std::vector<std::string>& tmp_paths)>& write);
+/// Removes every temporary file that write_atomically is writing at this moment. Async-signal-safe:
+/// for the handler of SIGINT/SIGTERM in a program, so that an interrupted write leaves nothing behind.
+void remove_temporaries_now() noexcept;
+
 /// Writes `text` to `path` through write_atomically, checking every write (Error naming `path`).
 void write_text_file(const std::string& path, const std::string& text);
 
