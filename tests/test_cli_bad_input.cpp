@@ -7,8 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <thread>
 #include <string>
+#include <signal.h>
 #include <unistd.h>
 #include <vector>
 
@@ -77,6 +82,19 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
         expect_one_line_error(r, args, {fragment, "--help"});
         EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
     }
+    // Options that contradict each other.
+    const std::vector<std::pair<std::string, std::string>> conflicts = {
+        {"generate box -o " + sq(dir / "g.vtu") + " --size 1 1 1 --scale 2", "--scale"},
+        {"generate box --list -o " + sq(dir / "g.vtu"), "--list"},
+        {"study cell-size --mesh " + sq(kBox) + " --scene x.toml --out " + sq(dir / "s"), "--scene"},
+        {"study integrator --mesh " + sq(kBox) + " --out " + sq(dir / "s"), "--mesh"},
+        {"study hash --mesh " + sq(kBox) + " --from 1 --to 2 --points 2 --out " + sq(dir / "s"), "--from"},
+    };
+    for (const auto& [args, fragment] : conflicts) {
+        expect_one_line_error(run_tethash(args), args, {fragment});
+        EXPECT_FALSE(fs::exists(dir / "g.vtu")) << args;
+        EXPECT_FALSE(fs::exists(dir / "s")) << args;
+    }
     const std::string too_fine = "generate box -o " + sq(dir / "g.vtu") + " --resolution 5000";
     expect_one_line_error(run_tethash(too_fine), too_fine, {"--resolution 5000", "at most 1000"});
     // Help still goes to standard output with status 0, names the program (not its path) and shows defaults.
@@ -103,6 +121,7 @@ TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
         {"detect " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
         {"convert " + sq(dir / "folder.vtu") + " " + sq(dir / "o.vtu"), {"folder.vtu", "directory"}},
         {"study cell-size --no-plot --out " + sq(dir / "s") + " --mesh " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"study integrator --no-plot --out " + sq(dir / "s") + " --scene " + sq(dir / "folder.vtu"), {"--scene", "directory"}},
         {"tetrahedralize " + sq(dir / "missing.obj") + " -o " + sq(dir / "t.vtu"), {"missing.obj", "no such file"}},
         {"tetrahedralize " + sq(kBox) + " -o " + sq(dir / "t.vtu"), {"box.vtu", "tet mesh", "surface"}},
         {"info " + sq(dir / "empty.vtu"), {"empty.vtu", "end of file"}},
@@ -239,4 +258,40 @@ TEST(CliBadInput, PlotScriptRejectsWhatIsNotAStudyInOneLine)
         EXPECT_NE(r.err.find(fragment), std::string::npos) << r.err;
         EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
     }
+}
+
+// Ctrl-C while a file is being written: the temporary goes, the old file stays. The signal has to land
+// during the write; when the machine is too fast to catch the temporary, the test is skipped.
+TEST(CliBadInput, InterruptedWriteLeavesNoTemporary)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "a.vtu", "good\n");
+    // The shell writes its pid and becomes tethash (exec): that pid is the one to interrupt.
+    const std::string cmd = "echo $$ > " + sq(dir / "pid") + "; exec " + sq(TETHASH_EXE) + " generate box -r 40 -o " +
+                            sq(dir / "a.vtu") + " >/dev/null 2>&1";
+    std::atomic<bool> done{false};
+    std::thread run([&] {
+        (void)std::system(cmd.c_str());
+        done = true;
+    });
+    auto temporary_with_data = [&] {
+        for (const auto& e : fs::directory_iterator(dir)) {
+            std::error_code ec;
+            if (e.path().filename().string().find(".tmp") != std::string::npos && fs::file_size(e.path(), ec) > 0 && !ec)
+                return true;
+        }
+        return false;
+    };
+    bool caught = false;
+    while (!done && !caught) {
+        if (temporary_with_data()) {
+            const std::string pid = read_text(dir / "pid");
+            caught = !pid.empty() && ::kill(std::stoi(pid), SIGINT) == 0;
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    run.join();
+    if (!caught) GTEST_SKIP() << "the write finished before the temporary file was seen";
+    EXPECT_TRUE(temporaries(dir).empty()) << temporaries(dir).front();
+    EXPECT_EQ(read_text(dir / "a.vtu"), "good\n");
 }

@@ -192,6 +192,15 @@ int resolve_threads(int requested)
 #endif
 }
 
+/// Tets per chunk of the stage-2 schedule; a chunk's candidate runs are kept together for reuse.
+constexpr Index chunk_tets = 256;
+
+/// Where the candidate runs of one chunk of tets are kept: threads[thread].runs[begin, end).
+struct ChunkRuns {
+    std::int32_t thread = 0;
+    std::int32_t begin = 0, end = 0;
+};
+
 /// Largest number of columns (column hash) or cells (Teschner's hash) one tet may visit.
 constexpr std::int64_t max_cells_per_tet = std::int64_t{1} << 24;
 
@@ -215,6 +224,14 @@ public:
     double origin[3] = {0, 0, 0};
     std::int64_t table_sizes[2] = {1, 1};
     VertexTable tables[2];   // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
+    double skin = 0;         // candidate reuse: tet boxes inflated by skin (length; 0 = off)
+    double reuse_limit = 0;  // largest per-axis displacement that still allows reuse (just below skin / 2)
+    // candidate cache (skin > 0): the kept candidates are the threads' candidate runs of the last full detection
+    bool cache_valid = false;
+    int cache_threads = 0;
+    std::vector<double> reference;   // positions of the moving vertices at the last full detection (dynamic order)
+    std::vector<ChunkRuns> chunks;   // per chunk of chunk_tets tets: the thread holding its runs and which
+    std::vector<std::int64_t> last_chunk;   // keep_for_reuse: per thread, its last chunk so far
     // buffers
     std::vector<ThreadState> threads;
     std::vector<Contact> contacts;
@@ -224,7 +241,10 @@ public:
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
-    void stage_inside(ThreadState& ts, const double* P);
+    void stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs, const Index* candidates,
+                      const double* P);
+    bool moved_less_than_limit(const double* P, int T) const;
+    void keep_for_reuse(const double* P, Index m);
     std::int64_t memory_bytes() const;
 };
 
@@ -246,6 +266,16 @@ void DetectorImpl::prepare(const PositionsRef& positions)
     if (!(cell_size > 0) || !std::isfinite(cell_size))
         throw Error("cell size must be positive and finite, got " + std::to_string(cell_size));
     inv_cell = 1.0 / cell_size;
+    skin = params.skin_mode == DetectParams::SkinMode::factor_of_cell_size ? params.skin * cell_size : params.skin;
+    if (!std::isfinite(skin))
+        throw Error("skin " + std::to_string(params.skin) + " × cell size " + std::to_string(cell_size) +
+                    " is not a finite length");
+    // Reuse needs a displacement strictly below skin / 2 per axis, after rounding of the difference that is
+    // measured (relative error ≤ 2^-53): the limit sits a relative 1e-12 below. Skins below 1e-290 are treated as
+    // off (the limit would lose its margin in subnormal arithmetic).
+    if (!(skin >= 1e-290)) skin = 0;
+    reuse_limit = 0.5 * skin * (1.0 - 1e-12);
+    cache_valid = false;
     if (num_vertices > 0) {
         const Eigen::RowVector3d lo = positions.colwise().minCoeff(), hi = positions.colwise().maxCoeff();
         for (int a = 0; a < 3; ++a) origin[a] = 0.5 * (lo(a) + hi(a));
@@ -282,6 +312,8 @@ std::int64_t DetectorImpl::memory_bytes() const
     std::int64_t m = static_cast<std::int64_t>(tets.capacity() + vertex_object.capacity() + tet_object.capacity() +
                                                dynamic_ids.capacity() + static_ids.capacity()) * 4;
     m += tables[0].memory_bytes() + tables[1].memory_bytes();
+    m += static_cast<std::int64_t>(reference.capacity() * sizeof(double) + chunks.capacity() * sizeof(ChunkRuns) +
+                                   last_chunk.capacity() * sizeof(std::int64_t));
     for (const ThreadState& ts : threads)
         m += static_cast<std::int64_t>(ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() +
                                        ts.values.capacity() * sizeof(double) +
@@ -306,9 +338,12 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
     }
     detail::ScanQuery q;
     std::int32_t c0[3], c1[3];
+    // With a skin the box is inflated by it (clamped to the guarded cell range, beyond which no vertex is hashed):
+    // the candidates then stay valid while every vertex moves less than skin / 2 (see detect()).
+    const double limit = max_cell_coordinate * cell_size;
     for (int k = 0; k < 3; ++k) {
-        const double lo = std::min(std::min(a[k], b[k]), std::min(c[k], d[k]));
-        const double hi = std::max(std::max(a[k], b[k]), std::max(c[k], d[k]));
+        const double lo = std::max(std::min(std::min(a[k], b[k]), std::min(c[k], d[k])) - skin, -limit);
+        const double hi = std::min(std::max(std::max(a[k], b[k]), std::max(c[k], d[k])) + skin, limit);
         // The same expressions as the vertex table's (p · (1/l), floor): monotone, so a vertex in the box has
         // its cell in [c0, c1]. Float box relative to the origin: rounding is monotone too, never a false reject.
         c0[k] = floor_to_int(lo * inv_cell);
@@ -423,7 +458,18 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         ts.counters.box_rejections += sc.box_rejections;
         ts.counters.own += sc.own;
     }
-    const std::int32_t run_end = static_cast<std::int32_t>(ts.used);
+    std::int32_t run_end = static_cast<std::int32_t>(ts.used);
+    // Self-collision off for this tet's object: drop the candidates of the same object here, so that the kept
+    // candidates of a skin are already filtered.
+    const Index to = tet_object[static_cast<std::size_t>(t)];
+    if (any_self_off && !flags.self_collision[static_cast<std::size_t>(to)]) {
+        Index* cand = ts.candidates.data();
+        std::int32_t kept = run_begin;
+        for (std::int32_t j = run_begin; j < run_end; ++j)
+            if (vertex_object[static_cast<std::size_t>(cand[j])] != to) cand[kept++] = cand[j];
+        run_end = kept;
+        ts.used = static_cast<std::size_t>(kept);
+    }
     // Branch-free append (most tets have candidates, but not predictably which).
     if (ts.num_runs == ts.runs.size()) ts.runs.resize(std::max<std::size_t>(64, 2 * ts.runs.size()));
     ts.runs[ts.num_runs] = {t, run_begin, run_end};
@@ -433,26 +479,19 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
 // Stage 3 over a thread's candidate runs: face planes per tet (only tets with candidates), filtered
 // plane tests for all candidates of the tet at once (AVX2 where available), exact orientation only where
 // the filter cannot decide.
-void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
+void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs,
+                                const Index* candidates, const double* P)
 {
-    for (std::size_t r = 0; r < ts.num_runs; ++r) {
-        const CandidateRun& run = ts.runs[r];
+    for (std::size_t r = 0; r < num_runs; ++r) {
+        const CandidateRun& run = runs[r];
         const Index t = run.tet;
         const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
         const double* A = P + 3 * static_cast<std::size_t>(tv[0]);
         const double* B = P + 3 * static_cast<std::size_t>(tv[1]);
         const double* C = P + 3 * static_cast<std::size_t>(tv[2]);
         const double* D = P + 3 * static_cast<std::size_t>(tv[3]);
-        const Index to = tet_object[static_cast<std::size_t>(t)];
-        Index* cand = ts.candidates.data() + run.begin;
-        std::int32_t count = run.end - run.begin;
-        if (any_self_off && !flags.self_collision[static_cast<std::size_t>(to)]) {
-            std::int32_t kept = 0;
-            for (std::int32_t j = 0; j < count; ++j)
-                if (vertex_object[static_cast<std::size_t>(cand[j])] != to) cand[kept++] = cand[j];
-            count = kept;
-            if (count == 0) continue;
-        }
+        const Index* cand = candidates + run.begin;
+        const std::int32_t count = run.end - run.begin;   // > 0; the self-collision rule was applied in stage 2
         // Face planes with the tet's orientation folded in (AVX2: four faces in four lanes); the orientation's
         // exact sign comes from face 3's plane at D.
         detail::FacePlanes f;
@@ -500,6 +539,64 @@ void DetectorImpl::stage_inside(ThreadState& ts, const double* P)
     }
 }
 
+// Skin: true when every moving vertex moved less than reuse_limit (< skin / 2) per axis since the last full detection.
+// A non-finite coordinate counts as moved too far (the full detection then reports it). Blocks of 1,024 values with an
+// early exit; parallel over the team for big scenes only (a region costs more than checking 20,000 vertices).
+bool DetectorImpl::moved_less_than_limit(const double* P, int T) const
+{
+    const double h = reuse_limit;
+    const double* R = reference.data();
+    const std::int64_t n = static_cast<std::int64_t>(dynamic_ids.size());
+    const Index* ids = dynamic_ids.data();
+    constexpr std::int64_t block = 1024;
+    const std::int64_t blocks = (n + block - 1) / block;
+    int far = 0;
+#pragma omp parallel for schedule(static) reduction(| : far) num_threads(T) if (T > 1 && n >= 65536)
+    for (std::int64_t b = 0; b < blocks; ++b) {
+        if (far) continue;
+        const std::int64_t i0 = b * block, i1 = std::min(n, i0 + block);
+        int bad = 0;
+        if (!any_static) {   // all vertices move: one contiguous pass over both arrays
+            for (std::int64_t i = 3 * i0; i < 3 * i1; ++i) bad |= !(std::fabs(P[i] - R[i]) < h);
+        } else {
+            for (std::int64_t i = i0; i < i1; ++i) {
+                const double* p = P + 3 * static_cast<std::size_t>(ids[i]);
+                const double* r = R + 3 * i;
+                bad |= !(std::fabs(p[0] - r[0]) < h) | !(std::fabs(p[1] - r[1]) < h) | !(std::fabs(p[2] - r[2]) < h);
+            }
+        }
+        far |= bad;
+    }
+    return !far;
+}
+
+// Skin: after a full detection, remembers the moving vertices' positions and where each chunk's candidate runs are
+// (each thread's chunks are in increasing order, monotonic schedule: a chunk's runs end where the thread's next
+// chunk begins, or at the thread's last run).
+void DetectorImpl::keep_for_reuse(const double* P, Index m)
+{
+    const std::size_t n = dynamic_ids.size();
+    reference.resize(3 * n);
+    if (!any_static) std::copy(P, P + 3 * n, reference.data());
+    else
+        for (std::size_t i = 0; i < n; ++i)
+            for (int a = 0; a < 3; ++a)
+                reference[3 * i + static_cast<std::size_t>(a)] = P[3 * static_cast<std::size_t>(dynamic_ids[i]) + static_cast<std::size_t>(a)];
+    const std::size_t num_chunks = static_cast<std::size_t>((m + chunk_tets - 1) / chunk_tets);
+    last_chunk.assign(threads.size(), -1);
+    for (std::size_t k = 0; k < num_chunks; ++k) {
+        const int r = chunks[k].thread;
+        if (last_chunk[static_cast<std::size_t>(r)] >= 0)
+            chunks[static_cast<std::size_t>(last_chunk[static_cast<std::size_t>(r)])].end = chunks[k].begin;
+        last_chunk[static_cast<std::size_t>(r)] = static_cast<std::int64_t>(k);
+    }
+    for (std::size_t r = 0; r < threads.size(); ++r)
+        if (last_chunk[r] >= 0)
+            chunks[static_cast<std::size_t>(last_chunk[r])].end = static_cast<std::int32_t>(threads[r].num_runs);
+    cache_threads = static_cast<int>(threads.size());
+    cache_valid = true;
+}
+
 // Sorts a thread's contacts by (vertex, tet) without any synchronisation: they come out of stage 3 in increasing
 // tet order (monotonic dynamic schedule, runs in order), so a stable LSD radix sort by vertex (11-bit digits) does
 // it. The result is in ts.contacts.
@@ -545,53 +642,105 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     const Index count = static_cast<Index>(dynamic_ids.size());
     const Index m = static_cast<Index>(tets.size() / 4);
     const bool with_stats = stats != nullptr;
+    double ms_vertices = 0, ms_sort_own = 0;
+    // Candidate reuse (skin > 0): when every moving vertex moved less than skin / 2 since the last full detection,
+    // the kept candidates contain every contact (docs/detection.md) and only stage 3 runs.
+    bool reuse = false;
+    if (skin > 0 && cache_valid && cache_threads == T) {
+        reuse = moved_less_than_limit(P, T);
+        ms_vertices = ms_since(t_start);
+    }
     for (ThreadState& ts : threads) {
-        ts.used = 0;
-        ts.num_runs = 0;
+        if (!reuse) {
+            ts.used = 0;
+            ts.num_runs = 0;
+        }
         ts.contacts.clear();
         ts.counters = Counters{};
         ts.too_many_cells = false;
     }
-    tables[0].reserve(count, table_sizes[0], T);
-    // Stage 1: moving vertices. Split over the team only for big scenes (VertexTable::team_parts); else built here,
-    // before the region: each barrier can cost the team a scheduler time slice on a busy machine.
-    const bool team_build = VertexTable::team_parts(count, T) > 1;
-    bool built = true;
-    double ms_vertices = 0, ms_sort_own = 0;
-    if (!team_build) {
-        built = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
-        ms_vertices = ms_since(t_start);
-    }
-#pragma omp parallel num_threads(T) if (T > 1 && built)
-    {
-        const int rank = detail::team_rank();
-        ThreadState& ts = threads[static_cast<std::size_t>(rank)];
-        bool ok = built;
-        if (team_build) {   // every thread gets the same answer
-            ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
-            if (rank == 0) {
-                built = ok;
-                ms_vertices = ms_since(t_start);
-            }
-        }
-        if (ok) {
-            const auto t0 = Clock::now();
-#pragma omp for schedule(monotonic : dynamic, 256) nowait
-            for (Index t = 0; t < m; ++t) stage_tets(ts, t, P, with_stats);
-            ts.ms_tets = ms_since(t0);
+    const Index num_chunks = (m + chunk_tets - 1) / chunk_tets;
+    if (reuse) {
+        // Stage 3 only, over the kept runs chunk by chunk (monotonic dynamic: each thread's contacts come out in
+        // increasing tet order, whichever thread kept the chunk's runs), then each thread sorts its own contacts.
+#pragma omp parallel num_threads(T) if (T > 1)
+        {
+            ThreadState& ts = threads[static_cast<std::size_t>(detail::team_rank())];
             const auto t1 = Clock::now();
-            stage_inside(ts, P);
+#pragma omp for schedule(monotonic : dynamic, 1) nowait
+            for (Index k = 0; k < num_chunks; ++k) {
+                const ChunkRuns& c = chunks[static_cast<std::size_t>(k)];
+                const ThreadState& owner = threads[static_cast<std::size_t>(c.thread)];
+                stage_inside(ts, owner.runs.data() + c.begin, static_cast<std::size_t>(c.end - c.begin),
+                             owner.candidates.data(), P);
+                if (with_stats)
+                    for (Index t = k * chunk_tets; t < std::min(m, (k + 1) * chunk_tets); ++t) {
+                        const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
+                        ts.counters.degenerate += predicates::orient3d(P + 3 * static_cast<std::size_t>(tv[0]),
+                                                                      P + 3 * static_cast<std::size_t>(tv[1]),
+                                                                      P + 3 * static_cast<std::size_t>(tv[2]),
+                                                                      P + 3 * static_cast<std::size_t>(tv[3]))
+                                                      .sign == 0;
+                    }
+            }
+            ts.ms_tets = 0;
             ts.ms_inside = ms_since(t1);
             const auto t2 = Clock::now();
             sort_own_contacts(ts, num_vertices);
             ts.ms_sort = ms_since(t2);
         }
+    } else {
+        cache_valid = false;
+        if (skin > 0) chunks.resize(static_cast<std::size_t>(num_chunks));
+        tables[0].reserve(count, table_sizes[0], T);
+        // Stage 1: moving vertices. Split over the team only for big scenes (VertexTable::team_parts); else built here,
+        // before the region: each barrier can cost the team a scheduler time slice on a busy machine.
+        const bool team_build = VertexTable::team_parts(count, T) > 1;
+        bool built = true;
+        if (!team_build) {
+            built = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+            ms_vertices = ms_since(t_start);
+        }
+#pragma omp parallel num_threads(T) if (T > 1 && built)
+        {
+            const int rank = detail::team_rank();
+            ThreadState& ts = threads[static_cast<std::size_t>(rank)];
+            bool ok = built;
+            if (team_build) {   // every thread gets the same answer
+                ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+                if (rank == 0) {
+                    built = ok;
+                    ms_vertices = ms_since(t_start);
+                }
+            }
+            if (ok) {
+                const auto t0 = Clock::now();
+                const bool keep = skin > 0;
+#pragma omp for schedule(monotonic : dynamic, chunk_tets) nowait
+                for (Index t = 0; t < m; ++t) {
+                    if (keep && t % chunk_tets == 0)   // a chunk starts: remember where its runs go
+                        chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank, static_cast<std::int32_t>(ts.num_runs), 0};
+                    stage_tets(ts, t, P, with_stats);
+                }
+                ts.ms_tets = ms_since(t0);
+                const auto t1 = Clock::now();
+                stage_inside(ts, ts.runs.data(), ts.num_runs, ts.candidates.data(), P);
+                ts.ms_inside = ms_since(t1);
+                const auto t2 = Clock::now();
+                sort_own_contacts(ts, num_vertices);
+                ts.ms_sort = ms_since(t2);
+            }
+        }
+        if (!built) diagnose_build_failure(positions, ids, count);
+        for (const ThreadState& ts : threads)
+            if (ts.too_many_cells)
+                throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
+                            std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells" +
+                            (skin > 0 ? " with its box inflated by the skin " + std::to_string(skin) +
+                                            "; use a larger cell size or a smaller skin"
+                                      : "; use a larger cell size"));
+        if (skin > 0) keep_for_reuse(P, m);
     }
-    if (!built) diagnose_build_failure(positions, ids, count);
-    for (const ThreadState& ts : threads)
-        if (ts.too_many_cells)
-            throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
-                        std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells; use a larger cell size");
 
     // Merge the threads' sorted runs: sorted by (vertex, tet), the same for any thread count.
     const auto t_merge = Clock::now();
@@ -656,6 +805,10 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         s.contacts = static_cast<std::int64_t>(contacts.size());
         s.table_load = static_cast<double>(count) / static_cast<double>(table_sizes[0]);
         s.memory_bytes = memory_bytes();
+        s.skin = skin;
+        s.reused = reuse ? 1 : 0;
+        if (skin > 0)
+            for (const ThreadState& ts : threads) s.cached_candidates += static_cast<std::int64_t>(ts.used);
         s.ms_total = ms_since(t_start);
     }
     return contacts;
@@ -677,6 +830,13 @@ void validate_params(const DetectParams& p)
         throw Error("table_size " + std::to_string(p.table_size) + " is too large (at most " +
                     std::to_string(max_table_size) + ")");
     if (p.threads < 0) throw Error("threads must be ≥ 0 (0 = all), got " + std::to_string(p.threads));
+    if (!(p.skin >= 0) || !std::isfinite(p.skin)) {
+        std::ostringstream s;
+        s << "skin must be ≥ 0 and finite (0 = no candidate reuse), got " << p.skin;
+        throw Error(s.str());
+    }
+    if (p.skin_mode != DetectParams::SkinMode::absolute && p.skin_mode != DetectParams::SkinMode::factor_of_cell_size)
+        throw Error("skin mode out of range: " + std::to_string(static_cast<int>(p.skin_mode)));
     if (p.hash != HashFunction::teschner && p.hash != HashFunction::column)
         throw Error("hash function out of range: " + std::to_string(static_cast<int>(p.hash)));
 }

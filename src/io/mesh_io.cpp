@@ -14,6 +14,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <memory>
 #include <unistd.h>
 
 namespace tethash::io {
@@ -92,6 +93,44 @@ std::string replace_all(std::string text, const std::string& from, const std::st
     return text;
 }
 
+/// Temporary files being written, for remove_temporaries_now(): fixed slots so that a signal handler
+/// can walk them without locks or allocation. A path that does not fit or finds no slot is not tracked.
+struct TemporarySlot {
+    std::atomic<bool> used{false};
+    char path[4096] = {};
+};
+TemporarySlot g_temporaries[16];
+std::atomic<bool> g_claimed[16];
+
+/// Tracks `path` while alive.
+class TrackedTemporary {
+public:
+    explicit TrackedTemporary(const std::string& path)
+    {
+        if (path.size() >= sizeof(TemporarySlot::path)) return;
+        for (int i = 0; i < 16; ++i) {
+            bool expected = false;
+            if (g_claimed[i].compare_exchange_strong(expected, true)) {
+                std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
+                g_temporaries[i].used.store(true, std::memory_order_release);
+                m_slot = i;
+                return;
+            }
+        }
+    }
+    ~TrackedTemporary()
+    {
+        if (m_slot < 0) return;
+        g_temporaries[m_slot].used.store(false, std::memory_order_release);
+        g_claimed[m_slot].store(false);
+    }
+    TrackedTemporary(const TrackedTemporary&) = delete;
+    TrackedTemporary& operator=(const TrackedTemporary&) = delete;
+
+private:
+    int m_slot = -1;
+};
+
 void check_target(const std::string& path)
 {
     const fs::path target(path);
@@ -110,6 +149,8 @@ void write_atomically(const std::vector<std::string>& paths,
     for (const std::string& p : paths) check_target(p);
     std::vector<std::string> tmps;
     for (const std::string& p : paths) tmps.push_back(temporary_for(p).string());
+    std::vector<std::unique_ptr<TrackedTemporary>> tracked;
+    for (const std::string& t : tmps) tracked.push_back(std::make_unique<TrackedTemporary>(t));
     auto remove_temporaries = [&] {
         for (const std::string& t : tmps) {
             std::error_code ec;
@@ -132,6 +173,12 @@ void write_atomically(const std::vector<std::string>& paths,
         remove_temporaries();
         throw;
     }
+}
+
+void remove_temporaries_now() noexcept
+{
+    for (auto& slot : g_temporaries)
+        if (slot.used.load(std::memory_order_acquire)) ::unlink(slot.path);
 }
 
 void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write)

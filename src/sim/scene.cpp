@@ -287,7 +287,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             }
         } else if (key == "detector") {
             const toml::table& t = r.table(v, key);
-            r.check_keys(t, "detector.", {"cell_size", "table_size", "hash", "threads"});
+            r.check_keys(t, "detector.", {"cell_size", "table_size", "hash", "threads", "skin"});
             for (auto&& [dk, dv] : t) {
                 const std::string d(dk.str()), full = "detector." + d;
                 if (d == "cell_size") {
@@ -315,6 +315,21 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                     try { s.detect.hash = parse_hash_function(r.string(dv, full)); }
                     catch (const Error& e) { r.fail(&dv, full, e.what()); }
                 } else if (d == "threads") s.detect.threads = static_cast<int>(r.integer_at_least(dv, full, 0));
+                else if (d == "skin") {   // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
+                    if (dv.is_number()) {
+                        s.detect.skin_mode = DetectParams::SkinMode::absolute;
+                        s.detect.skin = r.non_negative(dv, full);
+                    } else {
+                        const std::string str = r.string(dv, full);
+                        char* end = nullptr;
+                        const double f = str.size() > 1 && str[0] == 'x' ? std::strtod(str.c_str() + 1, &end) : -1.0;
+                        if (!end || *end != '\0' || !(f >= 0) || !std::isfinite(f))
+                            r.fail(&dv, full, "expected a number ≥ 0 or \"xF\" (F ≥ 0, a factor of the cell size), found \"" +
+                                                  str + "\"");
+                        s.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
+                        s.detect.skin = f;
+                    }
+                }
             }
         } else if (key == "output") {
             const toml::table& t = r.table(v, key);

@@ -141,6 +141,8 @@ void plan_sim_study(StudyPlan& plan)
 
     if (!o.scene_file.empty()) {
         if (!std::filesystem::exists(o.scene_file)) throw Error("--scene: file not found: " + o.scene_file);
+        if (std::filesystem::is_directory(o.scene_file))
+            throw Error("--scene: " + o.scene_file + ": is a directory, expected a scene file (.toml)");
         sp->scene = sim::load_scene(o.scene_file);
         sp->scene_name = std::filesystem::path(o.scene_file).stem().string();
     } else {

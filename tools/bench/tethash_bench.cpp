@@ -5,6 +5,7 @@
 //
 //   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--no-baseline] [--cell-factor F]
 //                 [--hash column|teschner] [--table-factor F]
+//   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/hash_grid.hpp"
@@ -285,12 +286,152 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
     std::fflush(stdout);
 }
 
+// ---- moving scenes (candidate reuse with a skin) --------------------------------------------------
+
+/// The objects of `m` moving rigidly, each by its own small rotation about its centroid and translation per step
+/// (random axis and direction per object; the fastest vertex moves about `speed` × mean edge per step), plus a
+/// random perturbation of both per step (a quarter of that); the translations reverse every 40 steps, so objects
+/// move apart and together again.
+class MovingScene {
+public:
+    MovingScene(const TetMesh& m, double mean_edge, double speed, std::uint32_t seed)
+        : m_mesh(m), m_positions(m.positions), m_rng(seed), m_step_length(speed * mean_edge)
+    {
+        const int objects = m.num_objects();
+        m_members.assign(static_cast<std::size_t>(objects), {});
+        for (Eigen::Index v = 0; v < m.positions.rows(); ++v)
+            m_members[static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)])].push_back(static_cast<Index>(v));
+        std::normal_distribution<double> g;
+        for (int o = 0; o < objects; ++o) {
+            Eigen::Vector3d dir(g(m_rng), g(m_rng), g(m_rng)), axis(g(m_rng), g(m_rng), g(m_rng));
+            m_velocity.push_back(0.5 * m_step_length * dir.normalized());
+            m_axis.push_back(axis.normalized());
+            double radius = 1e-12;
+            const Eigen::RowVector3d c = centroid(o);
+            for (Index v : m_members[static_cast<std::size_t>(o)]) radius = std::max(radius, (m_positions.row(v) - c).norm());
+            m_omega.push_back(0.5 * m_step_length / radius);   // rim speed: half a step length
+        }
+    }
+    const Positions& positions() const { return m_positions; }
+    void step()
+    {
+        ++m_step;
+        std::normal_distribution<double> g;
+        const double sign = (m_step / 40) % 2 ? -1.0 : 1.0;
+        for (std::size_t o = 0; o < m_members.size(); ++o) {
+            const Eigen::RowVector3d c = centroid(static_cast<int>(o));
+            const Eigen::Vector3d jitter_axis = Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
+            const Eigen::Matrix3d R = (Eigen::AngleAxisd(m_omega[o], m_axis[o]) *
+                                       Eigen::AngleAxisd(0.25 * m_omega[o] * g(m_rng), jitter_axis))
+                                          .toRotationMatrix();
+            const Eigen::Vector3d shift = sign * m_velocity[o] +
+                                          0.25 * 0.5 * m_step_length * Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
+            for (Index v : m_members[o]) {
+                const Eigen::Vector3d p = (m_positions.row(v) - c).transpose();
+                m_positions.row(v) = (R * p + c.transpose() + shift).transpose();
+            }
+        }
+    }
+
+private:
+    Eigen::RowVector3d centroid(int o) const
+    {
+        Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+        for (Index v : m_members[static_cast<std::size_t>(o)]) c += m_positions.row(v);
+        return c / std::max<double>(1.0, static_cast<double>(m_members[static_cast<std::size_t>(o)].size()));
+    }
+    const TetMesh& m_mesh;
+    Positions m_positions;
+    std::mt19937 m_rng;
+    double m_step_length;
+    int m_step = 0;
+    std::vector<std::vector<Index>> m_members;
+    std::vector<Eigen::Vector3d> m_velocity, m_axis;
+    std::vector<double> m_omega;
+};
+
+/// --moving: ms per step over `steps` steps of a moving scenario at skin off and several skins (factors of the cell
+/// size), 1 thread (CPU time) and all threads (wall); then, in a second pass over the same steps with statistics,
+/// the rebuild rate, kept candidates and memory; contacts summed over the steps must not depend on the skin.
+void report_moving(const study::Scenario& sc, const DetectParams& base, int threads_all, int steps, double speed)
+{
+    const TetMesh& m = sc.mesh;
+    const double edge = mean_edge_length(m.positions, m.tets);
+    std::printf("moving scene: scenario %s r%d, %d objects, %d tets, %d vertices, %d steps, fastest vertex ~%.3g x mean "
+                "edge per step\n",
+                sc.shape.c_str(), sc.resolution, m.num_objects(), m.num_tets(), m.num_vertices(), steps, speed);
+    long long reference_contacts = -1;
+    for (double skin : {0.0, 0.05, 0.1, 0.2, 0.3, 0.5}) {
+        double times[2] = {0, 0};
+        int thread_counts[2] = {1, threads_all};
+        for (int k = 0; k < 2; ++k) {
+            DetectParams p = base;
+            p.threads = thread_counts[k];
+            p.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
+            p.skin = skin;
+            Detector det(p);
+            det.set_topology(m);
+            MovingScene scene(m, edge, speed, 11);
+            det.detect(scene.positions());   // warm-up (auto cell size, buffers): the first step
+            std::vector<double> t;
+            for (int s = 1; s < steps; ++s) {
+                scene.step();
+                const double c0 = thread_cpu_ms();
+                const auto t0 = Clock::now();
+                det.detect(scene.positions());
+                t.push_back(k == 0 ? thread_cpu_ms() - c0
+                                   : std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+            }
+            double sum = 0;
+            for (double x : t) sum += x;
+            times[k] = sum / static_cast<double>(t.size());
+            if (threads_all == 1) {
+                times[1] = times[0];
+                break;
+            }
+        }
+        // Statistics pass (slower scan kernel): rebuilds, kept candidates, contacts.
+        DetectParams p = base;
+        p.threads = 1;
+        p.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
+        p.skin = skin;
+        Detector det(p);
+        det.set_topology(m);
+        MovingScene scene(m, edge, speed, 11);
+        DetectStats st;
+        det.detect(scene.positions(), &st);
+        int rebuilds = 0;
+        long long contacts = 0, cached = 0, tests = 0;
+        std::int64_t memory = 0;
+        for (int s = 1; s < steps; ++s) {
+            scene.step();
+            det.detect(scene.positions(), &st);
+            rebuilds += !st.reused;
+            contacts += st.contacts;
+            cached += st.cached_candidates;
+            tests += st.inside_tests;
+            memory = std::max(memory, st.memory_bytes);
+        }
+        if (reference_contacts < 0) reference_contacts = contacts;
+        std::printf("  skin %.2f x cell (%.4g)  %8.3f ms/step at 1 thread (cpu)  %8.3f ms/step at %d threads (wall)  "
+                    "rebuilds %3d/%d (%4.1f%%)  inside tests/step %lld  kept candidates/step %lld  memory %.1f B/tet  "
+                    "contacts/step %.0f%s\n",
+                    skin, skin * st.cell_size, times[0], times[1], threads_all, rebuilds, steps - 1,
+                    100.0 * rebuilds / std::max(1, steps - 1), tests / std::max(1, steps - 1),
+                    cached / std::max(1, steps - 1), double(memory) / m.num_tets(),
+                    double(contacts) / std::max(1, steps - 1),
+                    contacts == reference_contacts ? "" : "  ERROR: contacts differ from skin off");
+        std::fflush(stdout);
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
-    int repeat = 21, threads = 0, only = -1, profile = 0;
-    bool sweep = false, meshes = true, baseline = true;
+    int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100;
+    bool sweep = false, meshes = true, baseline = true, moving = false;
+    double speed = 0.01;
     double cell_factor = 1.0;
     std::string hash = "column";
     for (int i = 1; i < argc; ++i) {
@@ -312,10 +453,14 @@ int main(int argc, char** argv)
         else if (a == "--table-factor") g_table_factor = std::stod(next());
         else if (a == "--cell-factor") cell_factor = std::stod(next());
         else if (a == "--hash") hash = next();
+        else if (a == "--moving") moving = true;
+        else if (a == "--steps") steps = std::max(2, std::stoi(next()));
+        else if (a == "--speed") speed = std::stod(next());
         else {
             std::fprintf(stderr,
                          "usage: tethash_bench [--repeat K] [--threads N] [--scenario 1..5] [--sweep] [--no-meshes] "
-                         "[--no-baseline] [--profile N] [--table-factor F] [--cell-factor F] [--hash column|teschner]\n");
+                         "[--no-baseline] [--profile N] [--table-factor F] [--cell-factor F] [--hash column|teschner]\n"
+                         "       tethash_bench --moving [--scenario 1..5] [--steps N] [--speed F] [--threads N]\n");
             return 2;
         }
     }
@@ -357,6 +502,11 @@ int main(int argc, char** argv)
                         double(r.stats.contacts) / m.num_tets());
             std::fflush(stdout);
         }
+        return 0;
+    }
+
+    if (moving) {
+        report_moving(study::teschner_scenario(only > 0 ? only - 1 : 4), base, threads_all, steps, speed);
         return 0;
     }
 

@@ -22,6 +22,7 @@ struct DetectOptions {
     std::vector<std::string> meshes;
     std::string cell_size = "auto";
     std::string table_size = "auto";
+    std::string skin = "0";
     std::string hash = "column";
     int threads = 0;
     int repeat = 1;
@@ -55,6 +56,24 @@ void parse_cell_size(const std::string& s, DetectParams& p)
     p.cell_size = v;
 }
 
+/// L (a length ≥ 0; 0 = no candidate reuse) | "xF" (F ≥ 0, a factor of the cell size).
+void parse_skin(const std::string& s, DetectParams& p)
+{
+    const bool factor = !s.empty() && (s[0] == 'x' || s[0] == 'X');
+    const std::string num = factor ? s.substr(1) : s;
+    double v = 0;
+    std::size_t used = 0;
+    try {
+        v = std::stod(num, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != num.size() || !(v >= 0) || !std::isfinite(v))
+        throw Error("--skin: expected a length ≥ 0 or 'xF' (F ≥ 0, a factor of the cell size), got '" + s + "'");
+    p.skin_mode = factor ? DetectParams::SkinMode::factor_of_cell_size : DetectParams::SkinMode::absolute;
+    p.skin = v;
+}
+
 void parse_table_size(const std::string& s, DetectParams& p)
 {
     if (s == "auto") {
@@ -78,6 +97,7 @@ void run(const DetectOptions& o)
     DetectParams params;
     parse_cell_size(o.cell_size, params);
     parse_table_size(o.table_size, params);
+    parse_skin(o.skin, params);
     params.hash = parse_hash_function(o.hash);
     if (o.threads < 0) throw Error("--threads: expected ≥ 0 (0 = all), got " + std::to_string(o.threads));
     if (o.repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(o.repeat));
@@ -179,6 +199,8 @@ void run(const DetectOptions& o)
                          stats.box_rejections, stats.own_vertex_skips, stats.inside_tests);
         f += fmt::format("  \"exact_fallbacks\": {},\n  \"degenerate_tets\": {},\n  \"table_load\": {:.6f},\n",
                          stats.exact_fallbacks, stats.degenerate_tets, stats.table_load);
+        f += fmt::format("  \"skin\": {:.17g},\n  \"reused\": {},\n  \"cached_candidates\": {},\n", stats.skin,
+                         stats.reused, stats.cached_candidates);
         f += fmt::format("  \"memory_bytes\": {}\n}}\n", stats.memory_bytes);
         io::write_text_file(o.stats_path, f);
     }
@@ -192,6 +214,9 @@ Registrar reg{{"detect", "Find every vertex inside a tet of another object or of
                    sub.add_option("--cell-size", o->cell_size, "Cell edge length: L, auto (the mean edge length) or xF (F × mean edge)")
                        ->capture_default_str();
                    sub.add_option("--table-size", o->table_size, "Hash table size: N ≥ 1 or auto (chosen from the vertex count)")
+                       ->capture_default_str();
+                   sub.add_option("--skin", o->skin,
+                                  "Candidate reuse between calls (--repeat): L (a length, 0 = off) or xF (F × cell size)")
                        ->capture_default_str();
                    sub.add_option("--hash", o->hash, "Hash function: column or teschner")->capture_default_str();
                    sub.add_option("--threads", o->threads, "Threads (0 = all)")->capture_default_str();

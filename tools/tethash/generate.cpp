@@ -43,6 +43,9 @@ struct GenerateOptions {
 
 void run_generate(const GenerateOptions& o)
 {
+    if (o.list && (!o.shape.empty() || !o.out.empty()))
+        throw Error("--list prints the shapes and makes nothing: give it alone, or drop --list to make '" +
+                    (o.shape.empty() ? std::string("SHAPE") : o.shape) + "'");
     if (o.list) {
         for (const io::ShapeInfo& s : io::shape_catalog())
             fmt::print("{:<10} {:.4g} x {:.4g} x {:.4g}  {}\n", s.name, s.natural_size.x(), s.natural_size.y(),

@@ -2,8 +2,10 @@
 #include "command.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/io/mesh_io.hpp"
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -72,8 +74,23 @@ std::string objects_from_labels(TetMesh& mesh, const std::string& path, const st
 
 } // namespace tethash::cli
 
+namespace {
+
+/// SIGINT/SIGTERM/SIGHUP: remove the temporary files of writes in progress (the target keeps its old
+/// content), then die of the signal as usual. Commands with their own handling (study) replace it.
+extern "C" void on_fatal_signal(int sig)
+{
+    tethash::io::remove_temporaries_now();
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+}
+
+} // namespace
+
 int main(int argc, char** argv)
 {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP})
+        if (std::signal(sig, on_fatal_signal) == SIG_IGN) std::signal(sig, SIG_IGN); // ignored stays ignored (nohup, &)
     using namespace tethash;
     CLI::App app{"tethash: collision detection for deformable tetrahedral meshes by spatial hashing,\n"
                  "and a mass-spring simulator that uses it.",
