@@ -125,7 +125,8 @@ TEST(CliDetect, BadOptionsExitTwoNamingTheOption)
                           {"--cell-size 1e999", "--cell-size"}, {"--table-size 0", "--table-size"},
                           {"--table-size -4", "--table-size"},  {"--table-size 3.5", "--table-size"},
                           {"--hash sha1", "sha1"},              {"--threads -1", "--threads"},
-                          {"--repeat 0", "--repeat"}};
+                          {"--repeat 0", "--repeat"},           {"--skin -0.1", "--skin"},
+                          {"--skin xabc", "--skin"},            {"--skin nan", "--skin"}};
     for (const Case& c : cases) {
         const auto r = run_tethash("detect " + sq(f.a) + " " + c.args);
         EXPECT_EQ(r.status, 2) << c.args;
@@ -182,4 +183,24 @@ $EndElements
     const auto bad = run_tethash("detect " + file + " --objects-from-labels --static 2");
     EXPECT_EQ(bad.status, 2);
     EXPECT_NE(bad.err.find("--static"), std::string::npos) << bad.err;
+}
+
+// With a skin the repeated detections reuse the first call's candidates: the same contacts as the oracle, and
+// the statistics say that the last call reused them.
+TEST(CliDetect, SkinReusesCandidatesWithTheSameContacts)
+{
+    const auto dir = temp_dir();
+    const Files f = two_objects(dir);
+    const auto want = brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object);
+    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --skin x0.3 --repeat 3 --contacts " +
+                               sq(dir / "c.csv") + " --stats " + sq(dir / "s.json"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string js = read_text(dir / "s.json");
+    EXPECT_NE(js.find("\"contacts\": " + std::to_string(want.size())), std::string::npos) << js;
+    EXPECT_NE(js.find("\"reused\": 1"), std::string::npos) << js;
+    std::istringstream csv(read_text(dir / "c.csv"));
+    std::string line;
+    std::size_t rows = 0;
+    while (std::getline(csv, line)) ++rows;
+    EXPECT_EQ(rows, want.size() + 1);
 }
