@@ -164,3 +164,16 @@ TEST(SimScene, MissingFileIsAnError)
         EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.toml"), std::string::npos);
     }
 }
+
+TEST(SimScene, DirectoryIsNamedAsSuch)
+{
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tethash_scene_dir_test";
+    std::filesystem::create_directories(dir);
+    try {
+        load_scene(dir.string());
+        FAIL() << "a directory was accepted as a scene";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+    }
+    std::filesystem::remove_all(dir);
+}

@@ -390,6 +390,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
 
 Scene load_scene(const std::string& path)
 {
+    if (!std::filesystem::exists(path)) throw Error(path + ": no such scene file");
+    if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a scene file (.toml)");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path + ": cannot open scene file");
     std::stringstream ss;
