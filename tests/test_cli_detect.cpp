@@ -13,14 +13,7 @@ using namespace tethash::test;
 
 namespace {
 
-/// Shell-quoted path (own helper: GCC 12 warns falsely on "'" + string inlined from support.hpp's quote()).
-std::string sq(const std::filesystem::path& p)
-{
-    std::string s(1, '\'');
-    s.append(p.string());
-    s.push_back('\'');
-    return s;
-}
+std::string sq(const std::filesystem::path& p) { return tethash::test::quote(p); }
 
 /// Writes one object as a Medit .mesh file (1-based indices).
 void write_medit(const std::filesystem::path& p, const Scene& s)

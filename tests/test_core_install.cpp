@@ -7,13 +7,7 @@
 using namespace tethash::test;
 
 namespace {
-std::string sq(const std::filesystem::path& p)
-{
-    std::string s(1, '\'');
-    s.append(p.string());
-    s.push_back('\'');
-    return s;
-}
+std::string sq(const std::filesystem::path& p) { return tethash::test::quote(p); }
 } // namespace
 
 TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)

@@ -13,13 +13,7 @@ using namespace tethash::predicates;
 
 namespace {
 
-std::string sq(const std::filesystem::path& p)
-{
-    std::string s(1, '\'');
-    s.append(p.string());
-    s.push_back('\'');
-    return s;
-}
+std::string sq(const std::filesystem::path& p) { return tethash::test::quote(p); }
 
 /// Exact sign of det[b−a, c−a, d−a] for integer coordinates (|difference| < 2^40).
 __extension__ typedef __int128 i128;
