@@ -59,7 +59,8 @@ inline Scene lattice_object(int nx, int ny, int nz, double h, const Eigen::Vecto
 inline void append_object(Scene& s, const Scene& o)
 {
     const Index base = static_cast<Index>(s.positions.rows());
-    const Index obj = s.vertex_object.empty() ? 0 : *std::max_element(s.vertex_object.begin(), s.vertex_object.end()) + 1;
+    const Index obj =
+        s.vertex_object.empty() ? 0 : *std::max_element(s.vertex_object.begin(), s.vertex_object.end()) + 1;
     Positions p(s.positions.rows() + o.positions.rows(), 3);
     p << s.positions, o.positions;
     Tets t(s.tets.rows() + o.tets.rows(), 4);

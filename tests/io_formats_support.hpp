@@ -48,7 +48,8 @@ inline std::string expect_error(const std::function<void()>& fn, std::initialize
         fn();
     } catch (const Error& e) {
         const std::string msg = e.what();
-        for (const std::string& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
+        for (const std::string& p : parts)
+            EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
         return msg;
     } catch (const std::exception& e) {
         ADD_FAILURE() << "expected tethash::Error, got another exception: " << e.what();
@@ -99,7 +100,8 @@ inline TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2, bool two_objects = 
                     t[0] = id(i, j, k);
                     for (int s = 0; s < 3; ++s) {
                         bits |= p[s];
-                        t[static_cast<std::size_t>(s + 1)] = id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1));
+                        t[static_cast<std::size_t>(s + 1)] =
+                            id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1));
                     }
                     if (signed_volume(m.positions, t) < 0) std::swap(t[2], t[3]);
                     tets.push_back(t);
@@ -108,7 +110,8 @@ inline TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2, bool two_objects = 
                 }
     m.tets.resize(static_cast<Index>(tets.size()), 4);
     for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int c = 0; c < 4; ++c) m.tets(static_cast<Index>(t), c) = tets[t][static_cast<std::size_t>(c)];
+        for (int c = 0; c < 4; ++c)
+            m.tets(static_cast<Index>(t), c) = tets[t][static_cast<std::size_t>(c)];
     if (two_objects) {
         m.vertex_object.assign(static_cast<std::size_t>(m.num_vertices()), 0);
         // Not a real two-object mesh (objects share vertices); only the tet-side ids matter to writers.
@@ -122,7 +125,8 @@ inline void write_reference(const std::filesystem::path& path, const TetMesh& m)
     std::ostringstream s;
     s.precision(17);
     s << m.num_vertices() << " " << m.num_tets() << "\n";
-    for (Index v = 0; v < m.num_vertices(); ++v) s << m.positions(v, 0) << " " << m.positions(v, 1) << " " << m.positions(v, 2) << "\n";
+    for (Index v = 0; v < m.num_vertices(); ++v)
+        s << m.positions(v, 0) << " " << m.positions(v, 1) << " " << m.positions(v, 2) << "\n";
     for (Index t = 0; t < m.num_tets(); ++t)
         s << m.tets(t, 0) << " " << m.tets(t, 1) << " " << m.tets(t, 2) << " " << m.tets(t, 3) << " "
           << (m.tet_label.empty() ? 0 : m.tet_label[static_cast<std::size_t>(t)]) << "\n";
@@ -137,10 +141,12 @@ inline TetMesh read_reference(const std::filesystem::path& path)
     Index n = 0, k = 0;
     s >> n >> k;
     m.positions.resize(n, 3);
-    for (Index v = 0; v < n; ++v) s >> m.positions(v, 0) >> m.positions(v, 1) >> m.positions(v, 2);
+    for (Index v = 0; v < n; ++v)
+        s >> m.positions(v, 0) >> m.positions(v, 1) >> m.positions(v, 2);
     m.tets.resize(k, 4);
     m.tet_label.resize(static_cast<std::size_t>(k));
-    for (Index t = 0; t < k; ++t) s >> m.tets(t, 0) >> m.tets(t, 1) >> m.tets(t, 2) >> m.tets(t, 3) >> m.tet_label[static_cast<std::size_t>(t)];
+    for (Index t = 0; t < k; ++t)
+        s >> m.tets(t, 0) >> m.tets(t, 1) >> m.tets(t, 2) >> m.tets(t, 3) >> m.tet_label[static_cast<std::size_t>(t)];
     EXPECT_TRUE(static_cast<bool>(s)) << "bad reference file " << path;
     return m;
 }
@@ -204,7 +210,8 @@ for f in sys.argv[2:]:
     blocks = [c for c in mm.cells if c.type == "tetra"]
     t = np.concatenate([c.data for c in blocks])
     assert np.array_equal(t, tets), f + ": tets differ"
-    key = ")PY" + label_key + R"PY("
+    key = ")PY" +
+           label_key + R"PY("
     if key != "-":
         lab = np.concatenate([d for d, c in zip(mm.cell_data[key], mm.cells) if c.type == "tetra"])
         assert np.array_equal(lab, labels), (f, "labels differ", lab[:10], labels[:10])

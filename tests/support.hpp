@@ -16,9 +16,9 @@
 namespace tethash::test {
 
 struct RunResult {
-    int status = -1;        ///< exit status
-    std::string out;        ///< standard output
-    std::string err;        ///< standard error
+    int status = -1; ///< exit status
+    std::string out; ///< standard output
+    std::string err; ///< standard error
 };
 
 /// A fresh empty folder under the build tree, named after the running test.
@@ -93,7 +93,8 @@ inline std::optional<std::string> python_with(const std::string& modules)
 {
     std::string imports;
     std::istringstream ss(modules);
-    for (std::string m; ss >> m;) imports += "import " + m + ";";
+    for (std::string m; ss >> m;)
+        imports += "import " + m + ";";
     for (const char* candidate : {"/usr/bin/python3", "python3"}) {
         const std::string cmd = std::string(candidate) + " -c '" + imports + "' >/dev/null 2>&1";
         if (std::system(cmd.c_str()) == 0) return std::string(candidate);
@@ -109,10 +110,9 @@ inline std::optional<std::filesystem::path> shared_mesh(const std::string& name)
     return std::nullopt;
 }
 
-
 } // namespace tethash::test
 
-#define TETHASH_SKIP_WITHOUT_PYTHON(var, modules)                                \
-    auto var##_opt = ::tethash::test::python_with(modules);                      \
-    if (!var##_opt) GTEST_SKIP() << "no python3 that imports: " << modules;      \
+#define TETHASH_SKIP_WITHOUT_PYTHON(var, modules)                                                                      \
+    auto var##_opt = ::tethash::test::python_with(modules);                                                            \
+    if (!var##_opt) GTEST_SKIP() << "no python3 that imports: " << modules;                                            \
     const std::string var = *var##_opt

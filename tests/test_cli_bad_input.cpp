@@ -11,9 +11,9 @@
 #include <chrono>
 #include <csignal>
 #include <filesystem>
-#include <thread>
-#include <string>
 #include <signal.h>
+#include <string>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -37,7 +37,8 @@ const fs::path kBox = fs::path(TETHASH_SOURCE_DIR) / "meshes" / "box.vtu";
 std::size_t line_count(const std::string& text)
 {
     std::size_t n = 0;
-    for (char c : text) n += c == '\n';
+    for (char c : text)
+        n += c == '\n';
     return n + (!text.empty() && text.back() != '\n');
 }
 
@@ -47,7 +48,8 @@ void expect_one_line_error(const RunResult& r, const std::string& args, const st
     EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
     EXPECT_EQ(line_count(r.err), 1u) << args << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("tethash: error: ", 0), 0u) << args << "\n" << r.err;
-    for (const auto& f : fragments) EXPECT_NE(r.err.find(f), std::string::npos) << args << ": no '" << f << "' in\n" << r.err;
+    for (const auto& f : fragments)
+        EXPECT_NE(r.err.find(f), std::string::npos) << args << ": no '" << f << "' in\n" << r.err;
 }
 
 /// Names in `dir` that look like temporary files (hidden, .tmp, .partial).
@@ -109,7 +111,8 @@ TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
 {
     const auto dir = temp_dir();
     fs::create_directories(dir / "folder.vtu");
-    for (const char* ext : {".vtu", ".vtk", ".msh", ".mesh", ".veg", ".node"}) write_text(dir / (std::string("empty") + ext), "");
+    for (const char* ext : {".vtu", ".vtk", ".msh", ".mesh", ".veg", ".node"})
+        write_text(dir / (std::string("empty") + ext), "");
     struct Case {
         std::string args;
         std::vector<std::string> fragments;
@@ -120,8 +123,10 @@ TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
         {"detect " + sq(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
         {"detect " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
         {"convert " + sq(dir / "folder.vtu") + " " + sq(dir / "o.vtu"), {"folder.vtu", "directory"}},
-        {"study cell-size --no-plot --out " + sq(dir / "s") + " --mesh " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
-        {"study integrator --no-plot --out " + sq(dir / "s") + " --scene " + sq(dir / "folder.vtu"), {"--scene", "directory"}},
+        {"study cell-size --no-plot --out " + sq(dir / "s") + " --mesh " + sq(dir / "folder.vtu"),
+         {"folder.vtu", "directory"}},
+        {"study integrator --no-plot --out " + sq(dir / "s") + " --scene " + sq(dir / "folder.vtu"),
+         {"--scene", "directory"}},
         {"tetrahedralize " + sq(dir / "missing.obj") + " -o " + sq(dir / "t.vtu"), {"missing.obj", "no such file"}},
         {"tetrahedralize " + sq(kBox) + " -o " + sq(dir / "t.vtu"), {"box.vtu", "tet mesh", "surface"}},
         {"info " + sq(dir / "empty.vtu"), {"empty.vtu", "end of file"}},
@@ -132,7 +137,8 @@ TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
         {"info " + sq(dir / "empty.node"), {"empty"}},
         {"info " + sq(dir / "mesh.xyz"), {"mesh.xyz"}},
     };
-    for (const Case& c : cases) expect_one_line_error(run_tethash(c.args), c.args, c.fragments);
+    for (const Case& c : cases)
+        expect_one_line_error(run_tethash(c.args), c.args, c.fragments);
 }
 
 TEST(CliBadInput, UnreadableFileNamesIt)
@@ -141,7 +147,8 @@ TEST(CliBadInput, UnreadableFileNamesIt)
     const auto dir = temp_dir();
     fs::copy_file(kBox, dir / "locked.vtu");
     fs::permissions(dir / "locked.vtu", fs::perms::none);
-    expect_one_line_error(run_tethash("info " + sq(dir / "locked.vtu")), "info locked.vtu", {"locked.vtu", "cannot open"});
+    expect_one_line_error(run_tethash("info " + sq(dir / "locked.vtu")), "info locked.vtu",
+                          {"locked.vtu", "cannot open"});
 }
 
 TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
@@ -171,8 +178,8 @@ TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
     cases.push_back({"generate box -o " + sq(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
     cases.push_back({"generate box -o " + sq(dir / "folder"), {"folder", "is a directory"}});
     if (tethash::io::have_assimp())
-        cases.push_back({"tetrahedralize " + sq(fs::path(TETHASH_SOURCE_DIR) / "meshes" / "surfaces" / "blob.obj") + " -o " +
-                             sq(dir / "missing" / "t.vtu"),
+        cases.push_back({"tetrahedralize " + sq(fs::path(TETHASH_SOURCE_DIR) / "meshes" / "surfaces" / "blob.obj") +
+                             " -o " + sq(dir / "missing" / "t.vtu"),
                          {"t.vtu", "does not exist"}});
     for (const Case& c : cases) {
         const RunResult r = run_tethash(c.args);
@@ -210,14 +217,16 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
     // The same for detect's outputs (the contacts of two overlapping boxes fill more than 4 KiB).
     write_text(dir / "c.csv", good);
     ASSERT_EQ(run_tethash("generate box -r 6 -o " + sq(dir / "b.vtu")).status, 0);
-    const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " detect " + sq(dir / "b.vtu") + " " +
-                                  sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"));
+    const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " detect " + sq(dir / "b.vtu") +
+                                  " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"));
     expect_one_line_error(r, "detect --contacts", {"c.csv"});
     EXPECT_EQ(read_text(dir / "c.csv"), good);
     EXPECT_TRUE(temporaries(dir).empty());
     fs::remove(dir / "c.csv");
     // Without the limit the same command writes the file: the failure above was the write.
-    ASSERT_EQ(run_tethash("detect " + sq(dir / "b.vtu") + " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv")).status, 0);
+    ASSERT_EQ(run_tethash("detect " + sq(dir / "b.vtu") + " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"))
+                  .status,
+              0);
     EXPECT_GT(fs::file_size(dir / "c.csv"), 4096u);
 }
 
@@ -277,7 +286,8 @@ TEST(CliBadInput, InterruptedWriteLeavesNoTemporary)
     auto temporary_with_data = [&] {
         for (const auto& e : fs::directory_iterator(dir)) {
             std::error_code ec;
-            if (e.path().filename().string().find(".tmp") != std::string::npos && fs::file_size(e.path(), ec) > 0 && !ec)
+            if (e.path().filename().string().find(".tmp") != std::string::npos && fs::file_size(e.path(), ec) > 0 &&
+                !ec)
                 return true;
         }
         return false;

@@ -62,8 +62,8 @@ TEST(CliConvert, VtuOutputOnceTheVtkWriterExists)
     auto py = python_with("meshio numpy");
     if (py) {
         write_reference(dir / "ref.txt", ref);
-        const RunResult c = run_python(*py, dir, python_check_with_meshio("-"),
-                                       q(dir / "ref.txt") + " " + q(dir / "out.vtu"));
+        const RunResult c =
+            run_python(*py, dir, python_check_with_meshio("-"), q(dir / "ref.txt") + " " + q(dir / "out.vtu"));
         EXPECT_EQ(c.status, 0) << c.out << c.err;
     } else {
         expect_same_geometry(io::read_mesh((dir / "out.vtu").string()), ref, "vtu");
@@ -110,11 +110,12 @@ TEST(CliConvert, BadInputExitsTwoWithTheMessage)
             int line;
             const char* what;
         };
-        for (const Bad& b : {Bad{"b.msh", "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n", 2, "expected MSH version 2.2 or 4.1"},
-                             Bad{"b.mesh", "MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 nan 0 0\n", 5, "finite y coordinate"},
-                             Bad{"b.veg", "*VERTICES\n1 3 0 0\n1 0 0 0\n*ELEMENTS\nTET\n1 4 0\n1 1 1 1 2\n", 7,
-                                 "vertex index 2 is past the end"},
-                             Bad{"b.node", "1 3 0 0\n0 0 0\n", 2, "z coordinate of node 0, found end of file"}}) {
+        for (const Bad& b :
+             {Bad{"b.msh", "$MeshFormat\n9.9 0 8\n$EndMeshFormat\n", 2, "expected MSH version 2.2 or 4.1"},
+              Bad{"b.mesh", "MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 nan 0 0\n", 5, "finite y coordinate"},
+              Bad{"b.veg", "*VERTICES\n1 3 0 0\n1 0 0 0\n*ELEMENTS\nTET\n1 4 0\n1 1 1 1 2\n", 7,
+                  "vertex index 2 is past the end"},
+              Bad{"b.node", "1 3 0 0\n0 0 0\n", 2, "z coordinate of node 0, found end of file"}}) {
             write_text(dir / b.name, b.text);
             if (std::string(b.name) == "b.node") write_text(dir / "b.ele", "0 4 0\n");
             const RunResult r = run_tethash("convert " + q(dir / b.name) + " " + q(dir / "o.msh"));

@@ -13,7 +13,10 @@ using namespace tethash::test;
 
 namespace {
 
-std::string sq(const std::filesystem::path& p) { return tethash::test::quote(p); }
+std::string sq(const std::filesystem::path& p)
+{
+    return tethash::test::quote(p);
+}
 
 /// Writes one object as a Medit .mesh file (1-based indices).
 void write_medit(const std::filesystem::path& p, const Scene& s)
@@ -25,14 +28,15 @@ void write_medit(const std::filesystem::path& p, const Scene& s)
         o << s.positions(v, 0) << " " << s.positions(v, 1) << " " << s.positions(v, 2) << " 0\n";
     o << "Tetrahedra\n" << s.tets.rows() << "\n";
     for (Eigen::Index t = 0; t < s.tets.rows(); ++t)
-        o << s.tets(t, 0) + 1 << " " << s.tets(t, 1) + 1 << " " << s.tets(t, 2) + 1 << " " << s.tets(t, 3) + 1 << " 0\n";
+        o << s.tets(t, 0) + 1 << " " << s.tets(t, 1) + 1 << " " << s.tets(t, 2) + 1 << " " << s.tets(t, 3) + 1
+          << " 0\n";
     o << "End\n";
     write_text(p, o.str());
 }
 
 struct Files {
     std::filesystem::path a, b;
-    Scene scene;   ///< a then b, as one scene
+    Scene scene; ///< a then b, as one scene
 };
 
 Files two_objects(const std::filesystem::path& dir)
@@ -55,12 +59,12 @@ TEST(CliDetect, ContactsCsvMatchesOracleSortedWithHeader)
 {
     const auto dir = temp_dir();
     const Files f = two_objects(dir);
-    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --contacts " + sq(dir / "c.csv") +
-                               " --stats " + sq(dir / "s.json") + " --threads 2 --repeat 3 --cell-size x1.5");
+    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --contacts " + sq(dir / "c.csv") + " --stats " +
+                               sq(dir / "s.json") + " --threads 2 --repeat 3 --cell-size x1.5");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("contacts:"), std::string::npos);
-    const std::vector<Contact> want = brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object,
-                                                           f.scene.tet_object);
+    const std::vector<Contact> want =
+        brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object);
     ASSERT_FALSE(want.empty());
     std::istringstream csv(read_text(dir / "c.csv"));
     std::string line;
@@ -78,7 +82,8 @@ TEST(CliDetect, ContactsCsvMatchesOracleSortedWithHeader)
         ASSERT_LT(i, want.size());
         EXPECT_EQ(v, want[i].vertex);
         EXPECT_EQ(t, want[i].tet);
-        for (int k = 0; k < 4; ++k) EXPECT_NEAR(b[k], want[i].bary[k], 1e-9);
+        for (int k = 0; k < 4; ++k)
+            EXPECT_NEAR(b[k], want[i].bary[k], 1e-9);
         ++i;
     }
     EXPECT_EQ(i, want.size());
@@ -95,9 +100,12 @@ TEST(CliDetect, NoSelfAndStaticObjects)
     const Files f = two_objects(dir);
     std::vector<ObjectOptions> objs(2);
     objs[0].self_collision = objs[1].self_collision = false;
-    const auto want = brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object, objs);
-    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) + " --no-self --static 0 --hash teschner "
-                               "--table-size 17 --stats " + sq(dir / "s.json"));
+    const auto want =
+        brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object, objs);
+    const auto r = run_tethash("detect " + sq(f.a) + " " + sq(f.b) +
+                               " --no-self --static 0 --hash teschner "
+                               "--table-size 17 --stats " +
+                               sq(dir / "s.json"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(read_text(dir / "s.json").find("\"contacts\": " + std::to_string(want.size())), std::string::npos);
     EXPECT_NE(read_text(dir / "s.json").find("\"table_size\": 17"), std::string::npos);
@@ -113,13 +121,20 @@ TEST(CliDetect, BadOptionsExitTwoNamingTheOption)
     struct Case {
         std::string args, fragment;
     };
-    const Case cases[] = {{"--cell-size 0", "--cell-size"},     {"--cell-size -1", "--cell-size"},
-                          {"--cell-size x0", "--cell-size"},    {"--cell-size abc", "--cell-size"},
-                          {"--cell-size 1e999", "--cell-size"}, {"--table-size 0", "--table-size"},
-                          {"--table-size -4", "--table-size"},  {"--table-size 3.5", "--table-size"},
-                          {"--hash sha1", "sha1"},              {"--threads -1", "--threads"},
-                          {"--repeat 0", "--repeat"},           {"--skin -0.1", "--skin"},
-                          {"--skin xabc", "--skin"},            {"--skin nan", "--skin"}};
+    const Case cases[] = {{"--cell-size 0", "--cell-size"},
+                          {"--cell-size -1", "--cell-size"},
+                          {"--cell-size x0", "--cell-size"},
+                          {"--cell-size abc", "--cell-size"},
+                          {"--cell-size 1e999", "--cell-size"},
+                          {"--table-size 0", "--table-size"},
+                          {"--table-size -4", "--table-size"},
+                          {"--table-size 3.5", "--table-size"},
+                          {"--hash sha1", "sha1"},
+                          {"--threads -1", "--threads"},
+                          {"--repeat 0", "--repeat"},
+                          {"--skin -0.1", "--skin"},
+                          {"--skin xabc", "--skin"},
+                          {"--skin nan", "--skin"}};
     for (const Case& c : cases) {
         const auto r = run_tethash("detect " + sq(f.a) + " " + c.args);
         EXPECT_EQ(r.status, 2) << c.args;
@@ -194,6 +209,7 @@ TEST(CliDetect, SkinReusesCandidatesWithTheSameContacts)
     std::istringstream csv(read_text(dir / "c.csv"));
     std::string line;
     std::size_t rows = 0;
-    while (std::getline(csv, line)) ++rows;
+    while (std::getline(csv, line))
+        ++rows;
     EXPECT_EQ(rows, want.size() + 1);
 }

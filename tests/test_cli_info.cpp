@@ -148,8 +148,9 @@ TEST(CliInfo, ObjectsFromLabels)
     EXPECT_EQ(json_int(r.out, "objects"), 4);
 
     // Tets of two labels that share a face: an error naming the file and a vertex, or one object with =join.
-    write_text(dir / "glued.msh", std::string(kTwoBodies).replace(std::string(kTwoBodies).find("1 4 2 6 60 5 6 7 8"), 18,
-                                                                  "1 4 2 6 60 2 3 4 6"));
+    write_text(
+        dir / "glued.msh",
+        std::string(kTwoBodies).replace(std::string(kTwoBodies).find("1 4 2 6 60 5 6 7 8"), 18, "1 4 2 6 60 2 3 4 6"));
     r = run_tethash("info --objects-from-labels " + quote(dir / "glued.msh"));
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("glued.msh"), std::string::npos) << r.err;

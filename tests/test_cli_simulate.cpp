@@ -61,8 +61,9 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
 {
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
-    const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --steps 3 --dt 1e-3 --integrator local_global --threads 1 --out " +
-                               quote(dir / "out"));
+    const auto r =
+        run_tethash("simulate " + quote(dir / "s.toml") +
+                    " --steps 3 --dt 1e-3 --integrator local_global --threads 1 --out " + quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("local_global"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("steps: 3 "), std::string::npos) << r.out;
@@ -124,7 +125,7 @@ TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)
     const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
                                " --integrator symplectic_euler --dt 0.05 --steps 200 --out " + quote(dir / "out"));
     EXPECT_EQ(r.status, 1) << r.out << r.err;
-    EXPECT_NE(r.err.find("stability limit"), std::string::npos) << r.err;   // the warning up front
+    EXPECT_NE(r.err.find("stability limit"), std::string::npos) << r.err; // the warning up front
     EXPECT_NE(r.err.find("blew up at step"), std::string::npos) << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "scene.pvd"));
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
@@ -136,8 +137,8 @@ TEST(CliSimulate, ExplicitStabilityWarningIsPrintedUpFront)
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
     // dt above the limit: warned before the first step (the run itself survives one step).
-    auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --integrator symplectic_euler --dt 0.002 --steps 1 --out " +
-                         quote(dir / "a"));
+    auto r = run_tethash("simulate " + quote(dir / "s.toml") +
+                         " --integrator symplectic_euler --dt 0.002 --steps 1 --out " + quote(dir / "a"));
     ASSERT_EQ(r.status, 0) << r.err;
     const auto warn = r.err.find("warning: time step 0.002 s");
     ASSERT_NE(warn, std::string::npos) << r.err;
@@ -162,8 +163,9 @@ TEST(CliSimulate, BlowUpWithinSubstepsIsARunFailureNamingTheStep)
     // detector error about the grid), keep the frames written so far, and never write a NaN frame.
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
-    const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
-                               " --integrator symplectic_euler --dt 0.004 --substeps 2 --steps 100 --out " + quote(dir / "out"));
+    const auto r =
+        run_tethash("simulate " + quote(dir / "s.toml") +
+                    " --integrator symplectic_euler --dt 0.004 --substeps 2 --steps 100 --out " + quote(dir / "out"));
     EXPECT_EQ(r.status, 1) << r.out << r.err;
     EXPECT_NE(r.err.find("blew up at step "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(", substep "), std::string::npos) << r.err;

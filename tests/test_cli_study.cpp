@@ -23,7 +23,8 @@ std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
     p.resolution = resolution;
     TetMesh a = io::generate(p);
     TetMesh b = a;
-    for (Eigen::Index v = 0; v < b.positions.rows(); ++v) b.positions.row(v) += Eigen::RowVector3d(0.31, 0.17, 0.23);
+    for (Eigen::Index v = 0; v < b.positions.rows(); ++v)
+        b.positions.row(v) += Eigen::RowVector3d(0.31, 0.17, 0.23);
     io::write_mesh((dir / "a.vtu").string(), a);
     io::write_mesh((dir / "b.vtu").string(), b);
     return quote((dir / "a.vtu").string() + "+" + (dir / "b.vtu").string());
@@ -41,7 +42,8 @@ Table deterministic(const Table& t)
         }
     for (const auto& r : t.rows) {
         study::Row x;
-        for (auto c : keep) x.push_back(r[c]);
+        for (auto c : keep)
+            x.push_back(r[c]);
         d.rows.push_back(std::move(x));
     }
     return d;
@@ -51,36 +53,64 @@ TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
 {
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir);
-    const auto r = run_tethash("study cell-size --mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 "
-                               "--repeat 2 --no-plot --out " + quote(dir / "s"));
+    const auto r = run_tethash("study cell-size --mesh " + mesh +
+                               " --from 0.25 --to 4 --points 5 --table-size 1,x1 "
+                               "--repeat 2 --no-plot --out " +
+                               quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"point", "repeat", "scene", "cell_factor", "cell_size", "table_size", "hash", "threads",
-                            "vertices", "tets", "cells_visited", "entries_scanned", "hash_collisions", "box_rejections",
-                            "own_vertex_skips", "inside_tests", "exact_fallbacks", "degenerate_tets", "contacts",
-                            "table_load", "memory_bytes", "oracle_contacts", "missed", "extra", "ms_total", "ms_vertices",
-                            "ms_tets", "ms_inside", "ms_sort"})
+    for (const char* col : {"point",
+                            "repeat",
+                            "scene",
+                            "cell_factor",
+                            "cell_size",
+                            "table_size",
+                            "hash",
+                            "threads",
+                            "vertices",
+                            "tets",
+                            "cells_visited",
+                            "entries_scanned",
+                            "hash_collisions",
+                            "box_rejections",
+                            "own_vertex_skips",
+                            "inside_tests",
+                            "exact_fallbacks",
+                            "degenerate_tets",
+                            "contacts",
+                            "table_load",
+                            "memory_bytes",
+                            "oracle_contacts",
+                            "missed",
+                            "extra",
+                            "ms_total",
+                            "ms_vertices",
+                            "ms_tets",
+                            "ms_inside",
+                            "ms_sort"})
         EXPECT_GE(t.index_of(col), 0) << col;
-    ASSERT_EQ(t.rows.size(), 5u * 2 * 2);   // 5 cell sizes × 2 table sizes × 2 repeats
+    ASSERT_EQ(t.rows.size(), 5u * 2 * 2); // 5 cell sizes × 2 table sizes × 2 repeats
     for (const auto& row : t.rows) {
         EXPECT_EQ(row[t.index_of("missed")], "0");
         EXPECT_EQ(row[t.index_of("extra")], "0");
         EXPECT_EQ(row[t.index_of("contacts")], row[t.index_of("oracle_contacts")]);
     }
     const std::string json = test::read_text(dir / "s" / "study.json");
-    EXPECT_NE(json.find("study cell-size"), std::string::npos);   // the command line is recorded
-    EXPECT_NE(r.err.find("study: point 1/10"), std::string::npos) << r.err;   // plain progress lines off a terminal
+    EXPECT_NE(json.find("study cell-size"), std::string::npos);             // the command line is recorded
+    EXPECT_NE(r.err.find("study: point 1/10"), std::string::npos) << r.err; // plain progress lines off a terminal
 }
 
 TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
 {
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir, 2);
-    const std::string common = "study table-size --mesh " + mesh + " --table-size x0.1:x10:3 --cell-size 0.7,1.4 "
+    const std::string common = "study table-size --mesh " + mesh +
+                               " --table-size x0.1:x10:3 --cell-size 0.7,1.4 "
                                "--repeat 2 --no-plot --quiet";
     ASSERT_EQ(run_tethash(common + " --out " + quote(dir / "all")).status, 0);
     for (int i = 0; i < 3; ++i) {
-        const auto r = run_tethash(common + " --shard " + std::to_string(i) + "/3 --out " + quote(dir / ("s" + std::to_string(i))));
+        const auto r = run_tethash(common + " --shard " + std::to_string(i) + "/3 --out " +
+                                   quote(dir / ("s" + std::to_string(i))));
         ASSERT_EQ(r.status, 0) << r.err;
     }
     const auto m = run_tethash("study merge " + quote(dir / "s2") + " " + quote(dir / "s0") + " " + quote(dir / "s1") +
@@ -109,14 +139,14 @@ TEST(CliStudy, PlotScriptWritesFiguresWhenMatplotlibIsPresent)
     TETHASH_SKIP_WITHOUT_PYTHON(py, "matplotlib");
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir, 2);
-    const auto r = run_tethash("study cell-size --mesh " + mesh + " --cell-size 0.5:2:3 --table-size 31,x1 --repeat 1 --out " +
-                               quote(dir / "s"));
+    const auto r = run_tethash("study cell-size --mesh " + mesh +
+                               " --cell-size 0.5:2:3 --table-size 31,x1 --repeat 1 --out " + quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     for (const char* f : {"stages_vs_cell.png", "stages_vs_cell.svg", "candidates_vs_cell.svg", "exactness.svg"})
         EXPECT_TRUE(std::filesystem::exists(dir / "s" / f)) << f << "\n" << r.out << r.err;
     const std::string svg = test::read_text(dir / "s" / "stages_vs_cell.svg");
-    EXPECT_NE(svg.find("cell size / mean edge length"), std::string::npos);   // labelled axes
-    EXPECT_NE(svg.find("command:"), std::string::npos);                       // the footer names the command
+    EXPECT_NE(svg.find("cell size / mean edge length"), std::string::npos); // labelled axes
+    EXPECT_NE(svg.find("command:"), std::string::npos);                     // the footer names the command
 
     const auto t = run_tethash("study table-size --mesh " + mesh + " --table-size x0.1:x10:3 --repeat 1 --out " +
                                quote(dir / "t"));
@@ -138,7 +168,8 @@ material = { density = 500, young = 1e4 }
 )");
     const auto r = run_tethash("study integrator --scene " + quote(dir / "tiny.toml") +
                                " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator implicit_euler,symplectic_euler "
-                               "--reference-factor 4 --no-plot --out " + quote(dir / "s"));
+                               "--reference-factor 4 --no-plot --out " +
+                               quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     const Table t = Table::read_csv((dir / "s" / "study.csv").string());
     for (const char* col : {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration",
@@ -149,7 +180,7 @@ material = { density = 500, young = 1e4 }
         const auto& row = t.rows[i];
         EXPECT_EQ(row[t.index_of("status")], "ok");
         EXPECT_DOUBLE_EQ(std::stod(row[t.index_of("ref_dt")]), 0.0025 / 4);
-        if (i % 3 != 0) {   // within one integrator: a larger dt gives a larger error (first-order methods)
+        if (i % 3 != 0) { // within one integrator: a larger dt gives a larger error (first-order methods)
             EXPECT_GT(std::stod(row[t.index_of("err_rms")]), std::stod(t.rows[i - 1][t.index_of("err_rms")])) << i;
         }
     }
@@ -211,7 +242,7 @@ TEST(CliStudy, InterruptKeepsTheRowsMeasuredInAValidCsv)
         finished = test::read_text(dir / "s" / "study.json").find("\"interrupted\": true") != std::string::npos;
     }
     ASSERT_TRUE(finished);
-    const Table t = Table::read_csv(csv.string());   // throws on a torn row
+    const Table t = Table::read_csv(csv.string()); // throws on a torn row
     EXPECT_FALSE(std::filesystem::exists(partial));
     EXPECT_GT(t.rows.size(), 2u);
     EXPECT_LT(t.rows.size(), 400u * 20);

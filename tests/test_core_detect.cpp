@@ -62,12 +62,13 @@ std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
         for (int k = 0; k < 4; ++k) {
             sum += a.bary[k];
             if (std::fabs(a.bary[k] - b.bary[k]) > 1e-6 || a.bary[k] < -1e-9)
-                return ::testing::AssertionFailure() << "contact " << i << ": bary[" << k << "] " << a.bary[k]
-                                                     << " vs oracle " << b.bary[k];
+                return ::testing::AssertionFailure()
+                       << "contact " << i << ": bary[" << k << "] " << a.bary[k] << " vs oracle " << b.bary[k];
             if ((a.bary[k] == 0.0) != (b.bary[k] == 0.0))
                 return ::testing::AssertionFailure() << "contact " << i << ": exact zero of bary[" << k << "] differs";
         }
-        if (std::fabs(sum - 1.0) > 1e-9) return ::testing::AssertionFailure() << "contact " << i << ": bary sum " << sum;
+        if (std::fabs(sum - 1.0) > 1e-9)
+            return ::testing::AssertionFailure() << "contact " << i << ": bary sum " << sum;
     }
     if (got.size() != want.size())
         return ::testing::AssertionFailure() << got.size() << " contacts, oracle " << want.size();
@@ -90,7 +91,8 @@ std::vector<Variant> variants(std::uint32_t seed)
     std::vector<Variant> out;
     for (unsigned k = 0; k < 12; ++k)
         out.push_back({cells[(k + seed) % 5], tables[(k + 3 * seed) % 6],
-                       (k + seed) % 2 ? HashFunction::teschner : HashFunction::column, 1 + static_cast<int>((k / 2) % 2)});
+                       (k + seed) % 2 ? HashFunction::teschner : HashFunction::column,
+                       1 + static_cast<int>((k / 2) % 2)});
     return out;
 }
 
@@ -107,9 +109,8 @@ void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
         p.threads = v.threads;
         DetectStats st;
         const std::vector<Contact> got = run_detector(s, p, &st);
-        EXPECT_TRUE(same_contacts(got, want))
-            << what << " seed " << seed << " cell ×" << v.cell_factor << " table " << v.table << " hash "
-            << to_string(v.hash) << " threads " << v.threads;
+        EXPECT_TRUE(same_contacts(got, want)) << what << " seed " << seed << " cell ×" << v.cell_factor << " table "
+                                              << v.table << " hash " << to_string(v.hash) << " threads " << v.threads;
         EXPECT_EQ(st.degenerate_tets, os.degenerate_tets) << what;
         EXPECT_EQ(st.contacts, static_cast<std::int64_t>(want.size()));
     }
@@ -128,17 +129,18 @@ TEST(CoreDetect, RandomDeformedOverlappingObjects)
 TEST(CoreDetect, StronglyDeformedWithInvertedTets)
 {
     for (std::uint32_t seed = 20; seed < 26; ++seed) {
-        Scene s = test::random_scene(seed, 3, 3, 1.2);   // jitter beyond half a cell: many inverted tets
+        Scene s = test::random_scene(seed, 3, 3, 1.2); // jitter beyond half a cell: many inverted tets
         // Explicitly inverted tets: swap two indices of every 7th tet.
-        for (Eigen::Index t = 0; t < s.tets.rows(); t += 7) std::swap(s.tets(t, 0), s.tets(t, 1));
+        for (Eigen::Index t = 0; t < s.tets.rows(); t += 7)
+            std::swap(s.tets(t, 0), s.tets(t, 1));
         check_scene(s, seed, "inverted");
     }
 }
 
 TEST(CoreDetect, LatticeAlignedContactsOnFacesEdgesCorners)
 {
-    const double h = 0.25;   // exactly representable lattice
-    const Eigen::Vector3d shifts[] = {{h / 2, 0, 0}, {h / 2, h / 2, 0}, {h / 2, h / 2, h / 2}, {h, 0, 0},
+    const double h = 0.25; // exactly representable lattice
+    const Eigen::Vector3d shifts[] = {{h / 2, 0, 0}, {h / 2, h / 2, 0}, {h / 2, h / 2, h / 2},    {h, 0, 0},
                                       {h, h, 0},     {0, 0, 0},         {h / 4, h / 2, 3 * h / 4}};
     const Eigen::Vector3d origins[] = {{0, 0, 0}, {-37.0, -2.5, -0.75}, {1e6, 1e6, -1e6}};
     std::uint32_t seed = 0;
@@ -168,9 +170,11 @@ TEST(CoreDetect, CoincidentVerticesAndFlatTets)
         std::mt19937 rng(seed);
         std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
         // Coincident vertices (distinct ids, across and within objects): tets holding both become flat.
-        for (int k = 0; k < 25; ++k) s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
+        for (int k = 0; k < 25; ++k)
+            s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
         // Flat tets: one vertex moved exactly onto another vertex of the same tet.
-        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41) s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
+            s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
         // A vertex exactly at a corner of a tet of another object.
         s.positions.row(0) = s.positions.row(s.tets(s.tets.rows() - 1, 2)).eval();
         OracleStats os;
@@ -236,7 +240,8 @@ TEST(CoreDetect, DeterministicAcrossThreadsAndRepeats)
             for (std::size_t i = 0; i < a.size(); ++i) {
                 ASSERT_EQ(a[i].vertex, b[i].vertex);
                 ASSERT_EQ(a[i].tet, b[i].tet);
-                for (int k = 0; k < 4; ++k) ASSERT_EQ(a[i].bary[k], b[i].bary[k]);   // bitwise
+                for (int k = 0; k < 4; ++k)
+                    ASSERT_EQ(a[i].bary[k], b[i].bary[k]); // bitwise
             }
         }
     }
@@ -250,7 +255,7 @@ TEST(CoreDetect, DeterministicAcrossThreadsAndRepeats)
 // with statistics.
 TEST(CoreDetect, TeamBuiltTablesAndMergeAreThreadCountIndependent)
 {
-    const Scene s = test::random_scene(91, 4, 32, 0.3);   // 4 objects × 35,937 vertices
+    const Scene s = test::random_scene(91, 4, 32, 0.3); // 4 objects × 35,937 vertices
     ASSERT_GT(s.positions.rows(), 4 * 35000);
     const std::vector<ObjectOptions> objects = {{true, false}, {true, true}, {false, false}, {true, true}};
     std::vector<Contact> first;
@@ -288,11 +293,11 @@ TEST(CoreDetect, SteadyStateKeepsBuffers)
     DetectStats st1, st2;
     det.detect(s.positions, &st1);
     det.detect(s.positions, &st2);
-    EXPECT_EQ(det.contacts().data(), data);   // the output array was not reallocated
+    EXPECT_EQ(det.contacts().data(), data); // the output array was not reallocated
     EXPECT_EQ(st1.memory_bytes, st2.memory_bytes);
     EXPECT_GT(st2.memory_bytes, 0);
     EXPECT_EQ(st2.entries_scanned, st2.hash_collisions + st2.box_rejections + st2.own_vertex_skips +
-                                       (st2.inside_tests));   // no object rules here: every survivor is tested
+                                       (st2.inside_tests)); // no object rules here: every survivor is tested
     EXPECT_GE(st2.inside_tests, st2.contacts);
 }
 
@@ -336,8 +341,7 @@ TEST(CoreDetect, HashNames)
 }
 
 namespace {
-template <class F>
-void expect_error(F&& f, const std::string& fragment)
+template <class F> void expect_error(F&& f, const std::string& fragment)
 {
     try {
         f();
@@ -393,7 +397,7 @@ TEST(CoreDetect, ApiErrorsNameTheProblem)
     nan(6, 1) = std::nan("");
     expect_error([&] { det.detect(nan); }, "vertex 6");
     det.detect(s.positions);
-    expect_error([&] { det.detect(nan); }, "vertex 6");   // also after the first call
+    expect_error([&] { det.detect(nan); }, "vertex 6"); // also after the first call
     Positions inf = s.positions;
     inf(2, 2) = INFINITY;
     expect_error([&] { det.detect(inf); }, "vertex 2");
@@ -439,8 +443,8 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
     s.tet_object = {0};
     auto small_tet = [&](const Eigen::Vector3d& p) {
         const Index b = static_cast<Index>(pts.size());
-        for (const Eigen::Vector3d& d : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.25, 0, 0), Eigen::Vector3d(0, 0.25, 0),
-                                         Eigen::Vector3d(0, 0, 0.25)}) {
+        for (const Eigen::Vector3d& d : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.25, 0, 0),
+                                         Eigen::Vector3d(0, 0.25, 0), Eigen::Vector3d(0, 0, 0.25)}) {
             pts.push_back(p + d);
             s.vertex_object.push_back(1);
         }
@@ -448,18 +452,20 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
         s.tet_object.push_back(1);
     };
     for (double z = 0; z <= 2000; z += 24.75) {
-        const double f = 1.0 - z / 2000;   // the needle's cross-section shrinks linearly towards its tip
-        small_tet({z / 2000 + 0.5 * f, z / 2000 + 0.5 * f, z});   // inside
-        small_tet({z / 2000, z / 2000 + 2.0 * f, z});             // on the face x = z/2000 (exactly, when representable)
-        small_tet({0.5, 0.5, z + 1024});                                    // same key as a needle cell, far above
+        const double f = 1.0 - z / 2000; // the needle's cross-section shrinks linearly towards its tip
+        small_tet({z / 2000 + 0.5 * f, z / 2000 + 0.5 * f, z}); // inside
+        small_tet({z / 2000, z / 2000 + 2.0 * f, z});           // on the face x = z/2000 (exactly, when representable)
+        small_tet({0.5, 0.5, z + 1024});                        // same key as a needle cell, far above
         small_tet({0.5 + 2048, 0.5, z});
         small_tet({0.5, 0.5 - 2048, z});
     }
     s.positions.resize(static_cast<Eigen::Index>(pts.size()), 3);
-    for (std::size_t i = 0; i < pts.size(); ++i) s.positions.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+    for (std::size_t i = 0; i < pts.size(); ++i)
+        s.positions.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
     s.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
     for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int k = 0; k < 4; ++k) s.tets(static_cast<Eigen::Index>(t), k) = tets[t][static_cast<std::size_t>(k)];
+        for (int k = 0; k < 4; ++k)
+            s.tets(static_cast<Eigen::Index>(t), k) = tets[t][static_cast<std::size_t>(k)];
     const std::vector<Contact> want = run_oracle(s);
     ASSERT_GT(want.size(), 80u);
     for (double cell : {1.0, 4.0})
@@ -473,6 +479,7 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
                     p.hash = hash;
                     p.threads = threads;
                     EXPECT_TRUE(same_contacts(run_detector(s, p), want))
-                        << "cell " << cell << " table " << table << " hash " << to_string(hash) << " threads " << threads;
+                        << "cell " << cell << " table " << table << " hash " << to_string(hash) << " threads "
+                        << threads;
                 }
 }

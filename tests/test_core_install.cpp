@@ -7,7 +7,10 @@
 using namespace tethash::test;
 
 namespace {
-std::string sq(const std::filesystem::path& p) { return tethash::test::quote(p); }
+std::string sq(const std::filesystem::path& p)
+{
+    return tethash::test::quote(p);
+}
 } // namespace
 
 TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
@@ -19,12 +22,14 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
     ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
-    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io"));   // core only
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io")); // core only
 
     const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer";
     const auto cbuild = dir / "consumer";
-    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) + " -DCMAKE_BUILD_TYPE=Release"
-                                " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) +
+                                " -DCMAKE_BUILD_TYPE=Release"
+                                " -DCMAKE_PREFIX_PATH=" +
+                                sq(prefix));
     ASSERT_EQ(conf.status, 0) << conf.out << conf.err;
     const auto bld = run_shell("cmake --build " + sq(cbuild) + " -j2");
     ASSERT_EQ(bld.status, 0) << bld.out << bld.err;

@@ -113,7 +113,8 @@ TEST(Mesh, UniqueEdges)
     EXPECT_EQ(unique_edges(unit_tet().tets).rows(), 6);
     const Edges e = unique_edges(kuhn_cube().tets);
     EXPECT_EQ(e.rows(), 19); // 12 cube edges + 6 face diagonals + 1 body diagonal
-    for (Eigen::Index i = 0; i < e.rows(); ++i) EXPECT_LT(e(i, 0), e(i, 1));
+    for (Eigen::Index i = 0; i < e.rows(); ++i)
+        EXPECT_LT(e(i, 0), e(i, 1));
 }
 
 TEST(Mesh, BoundaryFacesAreOutward)
@@ -268,9 +269,11 @@ TEST(MeshLabels, SharedVertexIsAnErrorNamingItOrJoinsTheLabels)
     // Vertices used by both halves, counted independently of the implementation.
     std::set<Index> first, second;
     for (Index t = 0; t < 6; ++t)
-        for (int k = 0; k < 4; ++k) (t < 3 ? first : second).insert(m.tets(t, k));
+        for (int k = 0; k < 4; ++k)
+            (t < 3 ? first : second).insert(m.tets(t, k));
     std::int64_t both = 0;
-    for (Index v : first) both += second.count(v);
+    for (Index v : first)
+        both += second.count(v);
     EXPECT_EQ(s.shared_vertices, both);
     EXPECT_EQ(m.num_objects(), 1);
 }

@@ -36,7 +36,8 @@ std::vector<Contact> brute_contacts(const TetMesh& m)
             if (m.vertex_object[static_cast<size_t>(v)] == m.tet_object[static_cast<size_t>(t)]) continue;
             Eigen::Matrix3d A;
             const Eigen::Vector3d a = m.positions.row(m.tets(t, 0)).transpose();
-            for (int k = 0; k < 3; ++k) A.col(k) = m.positions.row(m.tets(t, k + 1)).transpose() - a;
+            for (int k = 0; k < 3; ++k)
+                A.col(k) = m.positions.row(m.tets(t, k + 1)).transpose() - a;
             const Eigen::Vector3d l = A.lu().solve(m.positions.row(v).transpose() - a);
             const double b[4] = {1 - l.sum(), l[0], l[1], l[2]};
             if (*std::min_element(b, b + 4) < -1e-12) continue;
@@ -92,7 +93,7 @@ TEST(CorePenetration, DeepVerticesAreValuedByPropagation)
 {
     TetMesh m = box(5, 1.0, {0, 0, 0});
     m.ensure_object_ids();
-    m.append(box(5, 1.0, {0.55, 0.0, 0.0}));   // 0.45 overlap: several layers of colliding vertices
+    m.append(box(5, 1.0, {0.55, 0.0, 0.0})); // 0.45 overlap: several layers of colliding vertices
     std::vector<Contact> contacts = brute_contacts(m);
     PenetrationStats st;
     compute_penetration(m, contacts, &st);
@@ -110,13 +111,14 @@ TEST(CorePenetration, FullyEmbeddedObjectFallsBackToClosestPoint)
 {
     TetMesh m = box(4, 1.0, {0, 0, 0});
     m.ensure_object_ids();
-    m.append(box(1, 0.2, {0.25, 0.0, 0.0}));   // entirely inside A: no border edge
+    m.append(box(1, 0.2, {0.25, 0.0, 0.0})); // entirely inside A: no border edge
     std::vector<Contact> contacts = brute_contacts(m);
     PenetrationStats st;
     compute_penetration(m, contacts, &st);
-    std::vector<Index> inner;   // B's vertices (all inside A) have no border edge: every one falls back
+    std::vector<Index> inner; // B's vertices (all inside A) have no border edge: every one falls back
     for (const Contact& c : contacts)
-        if (c.tet_object == 0 && std::find(inner.begin(), inner.end(), c.vertex) == inner.end()) inner.push_back(c.vertex);
+        if (c.tet_object == 0 && std::find(inner.begin(), inner.end(), c.vertex) == inner.end())
+            inner.push_back(c.vertex);
     EXPECT_GE(st.fallback, static_cast<std::int64_t>(inner.size()));
     for (const Contact& c : contacts) {
         if (c.tet_object != 0) continue;
@@ -139,7 +141,8 @@ TEST(CorePenetration, ExactDepthsAreDistancesToTheBoundary)
     ASSERT_EQ(exact.size(), contacts.size());
     for (size_t i = 0; i < contacts.size(); ++i) {
         const Eigen::Vector3d p = m.positions.row(contacts[i].vertex).transpose();
-        const Eigen::Vector3d centre = contacts[i].tet_object == 0 ? Eigen::Vector3d(0, 0, 0) : Eigen::Vector3d(0.7, 0.3, -0.2);
+        const Eigen::Vector3d centre =
+            contacts[i].tet_object == 0 ? Eigen::Vector3d(0, 0, 0) : Eigen::Vector3d(0.7, 0.3, -0.2);
         const double expect = 0.5 - (p - centre).cwiseAbs().maxCoeff();
         EXPECT_NEAR(exact[i], std::max(0.0, expect), 1e-9);
     }

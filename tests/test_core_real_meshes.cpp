@@ -32,7 +32,8 @@ void deform(Positions& p, double edge, std::uint32_t seed)
     for (Eigen::Index v = 0; v < p.rows(); ++v) {
         const Eigen::Vector3d x = p.row(v).transpose();
         Eigen::Vector3d d = Eigen::Vector3d::Zero();
-        for (int i = 0; i < 4; ++i) d += a[i] * std::sin(k[i].dot(x) + phase[i]);
+        for (int i = 0; i < 4; ++i)
+            d += a[i] * std::sin(k[i].dot(x) + phase[i]);
         p.row(v) += d.transpose();
     }
 }
@@ -91,10 +92,31 @@ void check_mesh(const std::string& name)
 
 } // namespace
 
-TEST(CoreRealMeshes, Octopus) { check_mesh("octopus-low.mesh"); }
-TEST(CoreRealMeshes, Armadillo) { check_mesh("armadillo_4k.ele"); }
-TEST(CoreRealMeshes, ScrewGmsh) { check_mesh("screw.msh"); }
-TEST(CoreRealMeshes, P1WithInvertedTets) { check_mesh("P1.msh"); }
-TEST(CoreRealMeshes, RaptorVtu) { check_mesh("raptorTetra_8418.vtu"); }
-TEST(CoreRealMeshes, Hand) { check_mesh("hand.mesh"); }
-TEST(CoreRealMeshes, QuintupleTorusVeg) { check_mesh("quintupleTorus.veg"); }
+TEST(CoreRealMeshes, Octopus)
+{
+    check_mesh("octopus-low.mesh");
+}
+TEST(CoreRealMeshes, Armadillo)
+{
+    check_mesh("armadillo_4k.ele");
+}
+TEST(CoreRealMeshes, ScrewGmsh)
+{
+    check_mesh("screw.msh");
+}
+TEST(CoreRealMeshes, P1WithInvertedTets)
+{
+    check_mesh("P1.msh");
+}
+TEST(CoreRealMeshes, RaptorVtu)
+{
+    check_mesh("raptorTetra_8418.vtu");
+}
+TEST(CoreRealMeshes, Hand)
+{
+    check_mesh("hand.mesh");
+}
+TEST(CoreRealMeshes, QuintupleTorusVeg)
+{
+    check_mesh("quintupleTorus.veg");
+}

@@ -29,8 +29,14 @@ void* operator new(std::size_t n)
     if (void* p = std::malloc(n ? n : 1)) return p;
     throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept
+{
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept
+{
+    std::free(p);
+}
 
 using namespace tethash;
 using tethash::test::Scene;
@@ -59,8 +65,8 @@ bool identical(const std::vector<Contact>& a, const std::vector<Contact>& b)
                                                  << "), oracle (" << b.vertex << ", " << b.tet << ")";
         for (int k = 0; k < 4; ++k)
             if (std::fabs(a.bary[k] - b.bary[k]) > 1e-6 || (a.bary[k] == 0.0) != (b.bary[k] == 0.0))
-                return ::testing::AssertionFailure() << "contact " << i << ": bary[" << k << "] " << a.bary[k]
-                                                     << " vs oracle " << b.bary[k];
+                return ::testing::AssertionFailure()
+                       << "contact " << i << ": bary[" << k << "] " << a.bary[k] << " vs oracle " << b.bary[k];
     }
     return ::testing::AssertionSuccess();
 }
@@ -189,7 +195,9 @@ TEST(CoreReuse, EveryHashTableAndCellSize)
         double cell;
         std::int64_t table;
         HashFunction hash;
-    } vs[] = {{0.4, 0, HashFunction::column}, {2.0, 1, HashFunction::column}, {1.0, 97, HashFunction::teschner},
+    } vs[] = {{0.4, 0, HashFunction::column},
+              {2.0, 1, HashFunction::column},
+              {1.0, 97, HashFunction::teschner},
               {1.0, 2, HashFunction::teschner}};
     for (const V& v : vs) {
         DetectParams p;
@@ -246,11 +254,12 @@ TEST(CoreReuse, LatticeContactsOnFacesEdgesCornersWhileMoving)
         EXPECT_FALSE(oracle.empty());
         EXPECT_TRUE(same_as_oracle(got, oracle)) << "step " << step;
         EXPECT_TRUE(identical(got, det2.detect(s.positions))) << "step " << step;
-        for (const Contact& c : got) with_zeros += c.bary[0] == 0 || c.bary[1] == 0 || c.bary[2] == 0 || c.bary[3] == 0;
+        for (const Contact& c : got)
+            with_zeros += c.bary[0] == 0 || c.bary[1] == 0 || c.bary[2] == 0 || c.bary[3] == 0;
         reused += st.reused;
     }
     EXPECT_GT(reused, 10);
-    EXPECT_GT(with_zeros, 0);   // contacts exactly on the boundary were checked
+    EXPECT_GT(with_zeros, 0); // contacts exactly on the boundary were checked
 }
 
 TEST(CoreReuse, SkinOffNeverReusesAndStatsSayWhatWasUsed)
@@ -268,17 +277,17 @@ TEST(CoreReuse, SkinOffNeverReusesAndStatsSayWhatWasUsed)
     DetectParams p;
     p.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
     p.skin = 0.3;
-    det.set_params(p);   // invalidates the cache: the next call is a full detection
+    det.set_params(p); // invalidates the cache: the next call is a full detection
     det.detect(s.positions, &st);
     EXPECT_EQ(st.reused, 0);
     EXPECT_DOUBLE_EQ(st.skin, 0.3 * st.cell_size);
     DetectStats again;
-    det.detect(s.positions, &again);   // nothing moved
+    det.detect(s.positions, &again); // nothing moved
     EXPECT_EQ(again.reused, 1);
     EXPECT_EQ(again.cached_candidates, st.cached_candidates);
     EXPECT_EQ(again.contacts, st.contacts);
     EXPECT_EQ(again.memory_bytes, st.memory_bytes);
-    set_topology(det, s);   // so does a new topology
+    set_topology(det, s); // so does a new topology
     det.detect(s.positions, &again);
     EXPECT_EQ(again.reused, 0);
 }
@@ -305,7 +314,8 @@ TEST(CoreReuse, NoAllocationOnceWarm)
             frames.push_back(s);
         }
         DetectStats st;
-        for (const Scene& f : frames) det.detect(f.positions, &st);
+        for (const Scene& f : frames)
+            det.detect(f.positions, &st);
         const Contact* data = det.contacts().data();
         long allocations = -1;
         for (int pass = 0; pass < (threads == 1 ? 1 : 6) && allocations != 0; ++pass) {
@@ -347,7 +357,8 @@ TEST(CoreReuse, NonFinitePositionAfterReuseIsAnError)
 
 TEST(CoreReuse, BadSkinIsAnErrorNamingTheParameter)
 {
-    for (double bad : {-1.0, -1e-300, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    for (double bad :
+         {-1.0, -1e-300, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
         DetectParams p;
         p.skin = bad;
         try {

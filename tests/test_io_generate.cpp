@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numbers>
 #include <numeric>
@@ -17,7 +17,10 @@ using namespace tethash;
 
 namespace {
 
-double volume(const TetMesh& m) { return volume_stats(m.positions, m.tets).total; }
+double volume(const TetMesh& m)
+{
+    return volume_stats(m.positions, m.tets).total;
+}
 
 std::pair<double, double> dihedral_range(const TetMesh& m)
 {
@@ -54,13 +57,15 @@ long boundary_manifold_problems(const TetMesh& m)
         if (c != 2) ++bad;
     std::vector<std::vector<Eigen::Index>> around(static_cast<std::size_t>(m.num_vertices()));
     for (Eigen::Index i = 0; i < bf.rows(); ++i)
-        for (int k = 0; k < 3; ++k) around[static_cast<std::size_t>(bf(i, k))].push_back(i);
+        for (int k = 0; k < 3; ++k)
+            around[static_cast<std::size_t>(bf(i, k))].push_back(i);
     for (Index v = 0; v < m.num_vertices(); ++v) {
         const auto& tris = around[static_cast<std::size_t>(v)];
         std::vector<std::size_t> parent(tris.size());
         std::iota(parent.begin(), parent.end(), std::size_t{0});
         auto find = [&](std::size_t x) {
-            while (parent[x] != x) x = parent[x] = parent[parent[x]];
+            while (parent[x] != x)
+                x = parent[x] = parent[parent[x]];
             return x;
         };
         for (std::size_t a = 0; a < tris.size(); ++a)
@@ -228,7 +233,8 @@ TEST(TetrahedralizeSdf, CustomFunctionAndEmptyInside)
 {
     // A ball of radius 0.3 off-centre in a 1-box.
     auto ball = [](const Eigen::Vector3d& p) { return (p - Eigen::Vector3d(0.1, 0, 0)).norm() - 0.3; };
-    const TetMesh m = io::tetrahedralize_sdf(ball, Eigen::Vector3d(-0.2, -0.3, -0.3), Eigen::Vector3d(0.4, 0.3, 0.3), 16, true);
+    const TetMesh m =
+        io::tetrahedralize_sdf(ball, Eigen::Vector3d(-0.2, -0.3, -0.3), Eigen::Vector3d(0.4, 0.3, 0.3), 16, true);
     const double expect = 4.0 / 3.0 * std::numbers::pi * 0.027;
     EXPECT_NEAR(volume(m), expect, 0.03 * expect);
     EXPECT_EQ(validate(m).inverted_tets, 0);

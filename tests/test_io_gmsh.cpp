@@ -17,8 +17,7 @@ namespace {
 struct Bytes {
     bool swap = false;
     std::string s;
-    template <class T>
-    std::size_t put(T v)
+    template <class T> std::size_t put(T v)
     {
         const std::size_t at = s.size();
         char b[sizeof(T)];
@@ -40,19 +39,23 @@ std::string binary41(bool swap, bool nan = false, std::size_t* nan_at = nullptr)
     b.text("$MeshFormat\n4.1 1 8\n");
     b.int_(1);
     b.text("\n$EndMeshFormat\n$Entities\n");
-    for (std::uint64_t c : {0, 0, 0, 1}) b.size_t_(c);
+    for (std::uint64_t c : {0, 0, 0, 1})
+        b.size_t_(c);
     b.int_(1);
-    for (double v : {0., 0., 0., 1., 1., 1.}) b.put(v);
+    for (double v : {0., 0., 0., 1., 1., 1.})
+        b.put(v);
     b.size_t_(1);
     b.int_(7);
     b.size_t_(0);
     b.text("\n$EndEntities\n$Nodes\n");
-    for (std::uint64_t c : {1, 5, 1, 5}) b.size_t_(c);
+    for (std::uint64_t c : {1, 5, 1, 5})
+        b.size_t_(c);
     b.int_(3);
     b.int_(1);
     b.int_(0);
     b.size_t_(5);
-    for (std::uint64_t t = 1; t <= 5; ++t) b.size_t_(t);
+    for (std::uint64_t t = 1; t <= 5; ++t)
+        b.size_t_(t);
     const TetMesh ref = two_tets();
     for (Index v = 0; v < 5; ++v)
         for (int a = 0; a < 3; ++a) {
@@ -61,17 +64,20 @@ std::string binary41(bool swap, bool nan = false, std::size_t* nan_at = nullptr)
             if (bad && nan_at) *nan_at = at;
         }
     b.text("\n$EndNodes\n$Elements\n");
-    for (std::uint64_t c : {2, 3, 1, 3}) b.size_t_(c);
+    for (std::uint64_t c : {2, 3, 1, 3})
+        b.size_t_(c);
     b.int_(2);
     b.int_(1);
     b.int_(2);
     b.size_t_(1);
-    for (std::uint64_t c : {1, 1, 2, 3}) b.size_t_(c);
+    for (std::uint64_t c : {1, 1, 2, 3})
+        b.size_t_(c);
     b.int_(3);
     b.int_(1);
     b.int_(4);
     b.size_t_(2);
-    for (std::uint64_t c : {2, 1, 2, 3, 4, 3, 2, 3, 4, 5}) b.size_t_(c);
+    for (std::uint64_t c : {2, 1, 2, 3, 4, 3, 2, 3, 4, 5})
+        b.size_t_(c);
     b.text("\n$EndElements\n");
     return b.s;
 }
@@ -87,11 +93,14 @@ std::string binary22(bool swap)
     const TetMesh ref = two_tets();
     for (Index v = 0; v < 5; ++v) {
         b.int_(3 + 2 * v);
-        for (int a = 0; a < 3; ++a) b.put(ref.positions(v, a));
+        for (int a = 0; a < 3; ++a)
+            b.put(ref.positions(v, a));
     }
     b.text("\n$EndNodes\n$Elements\n3\n");
-    for (std::int32_t c : {15, 1, 2, /*elem*/ 1, 0, 1, 3}) b.int_(c);
-    for (std::int32_t c : {4, 2, 2, /*elem*/ 2, 7, 1, 3, 5, 7, 9, /*elem*/ 3, 0, 2, 5, 7, 9, 11}) b.int_(c);
+    for (std::int32_t c : {15, 1, 2, /*elem*/ 1, 0, 1, 3})
+        b.int_(c);
+    for (std::int32_t c : {4, 2, 2, /*elem*/ 2, 7, 1, 3, 5, 7, 9, /*elem*/ 3, 0, 2, 5, 7, 9, 11})
+        b.int_(c);
     b.text("\n$EndElements\n");
     return b.s;
 }
@@ -115,9 +124,10 @@ TEST(GmshAscii, Reads41WithEntitiesSparseTagsAndSkippedSections)
     ASSERT_EQ(m.num_tets(), 2);
     const TetMesh ref = two_tets();
     const Index order[5] = {0, 1, 2, 4, 3};
-    for (Index v = 0; v < 5; ++v) EXPECT_TRUE(m.positions.row(v) == ref.positions.row(order[v])) << v;
+    for (Index v = 0; v < 5; ++v)
+        EXPECT_TRUE(m.positions.row(v) == ref.positions.row(order[v])) << v;
     expect_same_tets_by_coordinates(m, ref, "two_tets_41");
-    EXPECT_EQ(m.tet_label, (std::vector<Index>{7, 2}));   // entity 1 has physical 7; entity 2 has none
+    EXPECT_EQ(m.tet_label, (std::vector<Index>{7, 2})); // entity 1 has physical 7; entity 2 has none
     EXPECT_EQ(notes.skipped_cells, 2);
     EXPECT_TRUE(validate(m).ok());
 }
@@ -188,7 +198,7 @@ TEST(GmshBinary, SkipsBinarySectionsItDoesNotNeed)
     data.text("$NodeData\n1\n\"t\"\n1\n0.0\n3\n0\n1\n5\n");
     for (std::int32_t t = 1; t <= 5; ++t) {
         data.int_(t);
-        data.put(t == 3 ? 36.0 : -1.5);   // arbitrary bytes, including '$' and line breaks
+        data.put(t == 3 ? 36.0 : -1.5); // arbitrary bytes, including '$' and line breaks
     }
     data.text("\n$End\n$EndNodeData\n");
     write_text(dir / "nd.msh", binary41(false) + data.s);
@@ -226,7 +236,8 @@ TEST(GmshWrite, InterleavedLabelsKeepTetOrder)
 {
     const auto dir = temp_dir();
     TetMesh m = grid_mesh(2, 2, 2, /*two_objects=*/true);
-    for (std::size_t t = 0; t < m.tet_label.size(); ++t) m.tet_label[t] = static_cast<Index>(t % 3 + 1);
+    for (std::size_t t = 0; t < m.tet_label.size(); ++t)
+        m.tet_label[t] = static_cast<Index>(t % 3 + 1);
     for (bool binary : {false, true}) {
         const auto p = dir / (binary ? "b.msh" : "a.msh");
         io::write_msh(p.string(), m, binary);
@@ -248,7 +259,8 @@ TEST(GmshWrite, WriteMeshByExtensionIsAtomic)
     EXPECT_THROW(io::write_msh((dir / "x.msh").string(), bad), Error);
     EXPECT_EQ(io::read_mesh((dir / "x.msh").string()).num_tets(), 6);
     int files = 0;
-    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir))
+        ++files;
     EXPECT_EQ(files, 1);
 }
 
@@ -358,9 +370,10 @@ TEST(GmshErrors, TruncatedFile)
 {
     const auto dir = temp_dir();
     std::string text = read_text(data_file("gmsh/two_tets_41.msh"));
-    text = text.substr(0, text.find("0 1 0\n3 2 0 2"));   // cut inside the coordinates of the first node block
+    text = text.substr(0, text.find("0 1 0\n3 2 0 2")); // cut inside the coordinates of the first node block
     write_text(dir / "cut.msh", text);
-    expect_read_error(dir / "cut.msh", {(dir / "cut.msh").string() + ":", "coordinate of node 30", "found end of file"});
+    expect_read_error(dir / "cut.msh",
+                      {(dir / "cut.msh").string() + ":", "coordinate of node 30", "found end of file"});
     // Cut inside the elements: the last tet misses nodes.
     text = read_text(data_file("gmsh/two_tets_41.msh"));
     text = text.substr(0, text.find("4 20 30 40 50") + 8);
@@ -398,8 +411,8 @@ TEST(GmshErrors, NanAndInfCoordinates)
     const auto dir = temp_dir();
     {
         const auto [p, text] = edited41(dir, "0 1 0\n3 2 0 2", "0 nan 0\n3 2 0 2", "nan.msh");
-        expect_read_error(p, {at_line(p, line_of(text, "0 nan 0")), "expected a finite y coordinate of node 30",
-                              "found 'nan'"});
+        expect_read_error(
+            p, {at_line(p, line_of(text, "0 nan 0")), "expected a finite y coordinate of node 30", "found 'nan'"});
     }
     {
         const auto [p, text] = edited41(dir, "1 1 1\n0 0 1\n$EndNodes", "1 1 -inf\n0 0 1\n$EndNodes", "inf.msh");
@@ -462,7 +475,7 @@ TEST(GmshErrors, BinaryProblemsNameTheByteOffset)
     {
         std::string s = binary22(false);
         const std::size_t at = std::string("$MeshFormat\n2.2 1 8\n").size();
-        s[at] = 2;   // the byte-order check reads 2 instead of 1
+        s[at] = 2; // the byte-order check reads 2 instead of 1
         write_text(dir / "order.msh", s);
         expect_read_error(dir / "order.msh", {(dir / "order.msh").string() + ": byte " + std::to_string(at) + ":",
                                               "expected the integer 1", "found 2"});

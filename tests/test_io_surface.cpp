@@ -16,7 +16,7 @@ using tethash::test::temp_dir;
 
 namespace {
 
-#define SKIP_WITHOUT_ASSIMP() \
+#define SKIP_WITHOUT_ASSIMP()                                                                                          \
     if (!io::have_assimp()) GTEST_SKIP() << "built without assimp"
 
 io::SurfaceMesh sphere_surface(int resolution)
@@ -39,7 +39,10 @@ double enclosed_volume(const io::SurfaceMesh& s)
     return v;
 }
 
-double volume(const TetMesh& m) { return volume_stats(m.positions, m.tets).total; }
+double volume(const TetMesh& m)
+{
+    return volume_stats(m.positions, m.tets).total;
+}
 
 } // namespace
 
@@ -55,7 +58,8 @@ TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
     EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);     // outward orientation, closed
     // Every surface vertex is used.
     std::vector<int> used(static_cast<std::size_t>(s.vertices.rows()), 0);
-    for (Eigen::Index i = 0; i < s.triangles.size(); ++i) used[static_cast<std::size_t>(s.triangles.data()[i])] = 1;
+    for (Eigen::Index i = 0; i < s.triangles.size(); ++i)
+        used[static_cast<std::size_t>(s.triangles.data()[i])] = 1;
     EXPECT_TRUE(std::all_of(used.begin(), used.end(), [](int u) { return u == 1; }));
 }
 

@@ -49,7 +49,8 @@ TEST(TetgenRead, ShortHeadersUseTetgenDefaults)
 {
     const auto dir = temp_dir();
     // Only the counts: dimension 3, no attributes, no markers, 4 nodes per tet.
-    const auto p = write_pair(dir, "s", std::string("5\n") + (std::string(k_node0).substr(8)), "2\n0 0 1 2 3\n1 1 2 3 4\n");
+    const auto p =
+        write_pair(dir, "s", std::string("5\n") + (std::string(k_node0).substr(8)), "2\n0 0 1 2 3\n1 1 2 3 4\n");
     expect_same_geometry(io::read_tetgen(p.string()), two_tets(), "short headers");
 }
 
@@ -80,8 +81,9 @@ TEST(TetgenWrite, RoundTripExactWithLabelsAndMarkers)
     const auto dir = temp_dir();
     TetMesh m = grid_mesh(3, 2, 2);
     m.vertex_label.resize(static_cast<std::size_t>(m.num_vertices()));
-    for (std::size_t v = 0; v < m.vertex_label.size(); ++v) m.vertex_label[v] = static_cast<Index>(v % 4);
-    io::write_mesh((dir / "g.ele").string(), m);   // either name writes both files
+    for (std::size_t v = 0; v < m.vertex_label.size(); ++v)
+        m.vertex_label[v] = static_cast<Index>(v % 4);
+    io::write_mesh((dir / "g.ele").string(), m); // either name writes both files
     ASSERT_TRUE(std::filesystem::exists(dir / "g.node"));
     const TetMesh r = io::read_mesh((dir / "g.node").string());
     expect_same_geometry(r, m, "tetgen round trip");
@@ -109,8 +111,8 @@ print("written")
     EXPECT_EQ(m.tet_label, ref.tet_label);
 
     io::write_mesh((dir / "ours.node").string(), ref);
-    const RunResult r = run_python(py, dir, python_check_with_meshio("tetgen:ref"),
-                                   q(dir / "ref.txt") + " " + q(dir / "ours.node"));
+    const RunResult r =
+        run_python(py, dir, python_check_with_meshio("tetgen:ref"), q(dir / "ref.txt") + " " + q(dir / "ours.node"));
     EXPECT_EQ(r.status, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("OK "), std::string::npos) << r.out << r.err;
 }

@@ -32,7 +32,7 @@ TEST(MeditRead, HandMadeWithRefsAndSkippedBlocks)
     expect_same_geometry(m, two_tets(), "two_tets.mesh");
     EXPECT_EQ(m.tet_label, (std::vector<Index>{7, -2}));
     EXPECT_EQ(m.vertex_label, (std::vector<Index>{1, 2, 0, 3, 4}));
-    EXPECT_EQ(notes.skipped_cells, 3);   // 1 edge + 2 triangles
+    EXPECT_EQ(notes.skipped_cells, 3); // 1 edge + 2 triangles
 }
 
 TEST(MeditWrite, RoundTripExact)
@@ -68,8 +68,8 @@ print("written")
     EXPECT_EQ(notes.skipped_cells, 2);
 
     io::write_mesh((dir / "ours.mesh").string(), ref);
-    const RunResult r = run_python(py, dir, python_check_with_meshio("medit:ref"),
-                                   q(dir / "ref.txt") + " " + q(dir / "ours.mesh"));
+    const RunResult r =
+        run_python(py, dir, python_check_with_meshio("medit:ref"), q(dir / "ref.txt") + " " + q(dir / "ours.mesh"));
     EXPECT_EQ(r.status, 0) << r.out << r.err;
     EXPECT_NE(r.out.find("OK "), std::string::npos) << r.out << r.err;
 }
@@ -91,8 +91,8 @@ TEST(MeditErrors, TruncatedAndWrongCounts)
     {
         std::string text = k_good;
         write_text(dir / "cut.mesh", text.substr(0, text.find("2 3 4 5")));
-        expect_read_error(dir / "cut.mesh", {(dir / "cut.mesh").string() + ":", "vertex 1 of tetrahedron 2",
-                                             "found end of file"});
+        expect_read_error(dir / "cut.mesh",
+                          {(dir / "cut.mesh").string() + ":", "vertex 1 of tetrahedron 2", "found end of file"});
     }
     // The Vertices count is 6 but there are 5 vertices: "Tetrahedra" is read as a coordinate.
     const auto p = edited(dir, "Vertices\n5\n", "Vertices\n6\n", "count.mesh");
@@ -102,8 +102,9 @@ TEST(MeditErrors, TruncatedAndWrongCounts)
 TEST(MeditErrors, IndexPastTheEndNanGarbage)
 {
     const auto dir = temp_dir();
-    expect_read_error(edited(dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh"),
-                      {at_line(dir / "i.mesh", 13), "tetrahedron 2: vertex index 6 is past the end (Vertices has 1..5)"});
+    expect_read_error(
+        edited(dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh"),
+        {at_line(dir / "i.mesh", 13), "tetrahedron 2: vertex index 6 is past the end (Vertices has 1..5)"});
     expect_read_error(edited(dir, "2 3 4 5 1", "2 3 0 5 1", "z.mesh"),
                       {at_line(dir / "z.mesh", 13), "tetrahedron 2: vertex index 0"});
     expect_read_error(edited(dir, "0 0 1 0\n", "0 0 NaN 0\n", "n.mesh"),

@@ -30,13 +30,14 @@ TEST(VegaRead, HandMadeWithSkippedSections)
     io::ReadNotes notes;
     const TetMesh m = io::read_mesh(data_file("vega/two_tets.veg").string(), &notes);
     expect_same_geometry(m, two_tets(), "two_tets.veg");
-    EXPECT_EQ(notes.messages.size(), 3u);   // *MATERIAL, *REGION, *SET
+    EXPECT_EQ(notes.messages.size(), 3u); // *MATERIAL, *REGION, *SET
 }
 
 TEST(VegaRead, ElementsTypeOnTheSameLineAndCommas)
 {
     const auto dir = temp_dir();
-    const auto p = edited(dir, "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n", "*ELEMENTS TET\n2, 4, 0\n1, 1, 2, 3, 4  # first\n", "s.veg");
+    const auto p =
+        edited(dir, "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n", "*ELEMENTS TET\n2, 4, 0\n1, 1, 2, 3, 4  # first\n", "s.veg");
     expect_same_geometry(io::read_mesh(p.string()), two_tets(), "same line");
 }
 
@@ -46,7 +47,8 @@ TEST(VegaErrors, TruncatedAndWrongCounts)
     {
         std::string text = k_good;
         write_text(dir / "cut.veg", text.substr(0, text.find("2 2 3 4 5") + 6));
-        expect_read_error(dir / "cut.veg", {(dir / "cut.veg").string() + ":", "vertex 3 of element 2", "found end of file"});
+        expect_read_error(dir / "cut.veg",
+                          {(dir / "cut.veg").string() + ":", "vertex 3 of element 2", "found end of file"});
     }
     expect_read_error(edited(dir, "5 3 0 0", "6 3 0 0", "n.veg"),
                       {at_line(dir / "n.veg", 9), "expected a vertex number (an integer), found '*ELEMENTS'"});

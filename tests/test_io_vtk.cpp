@@ -35,7 +35,8 @@ TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2)
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i) {
                 Index c[8];
-                for (int b = 0; b < 8; ++b) c[b] = id(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
+                for (int b = 0; b < 8; ++b)
+                    c[b] = id(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
                 for (const auto& t : kuhn) {
                     tets.push_back({c[t[0]], c[t[1]], c[t[2]], c[t[3]]});
                     m.tet_object.push_back(i < nx / 2 ? 0 : 1);
@@ -44,10 +45,12 @@ TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2)
             }
     m.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
     for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int c = 0; c < 4; ++c) m.tets(static_cast<Eigen::Index>(t), c) = tets[t][c];
+        for (int c = 0; c < 4; ++c)
+            m.tets(static_cast<Eigen::Index>(t), c) = tets[t][c];
     m.vertex_object.assign(static_cast<std::size_t>(m.num_vertices()), 0);
     for (std::size_t t = 0; t < tets.size(); ++t)
-        for (Index v : tets[t]) m.vertex_object[static_cast<std::size_t>(v)] = m.tet_object[t];
+        for (Index v : tets[t])
+            m.vertex_object[static_cast<std::size_t>(v)] = m.tet_object[t];
     return m;
 }
 
@@ -56,10 +59,12 @@ io::Fields sample_fields(const TetMesh& m)
     io::Fields f;
     io::Field vel{"velocity", 3, {}}, contact{"contact", 1, {}}, stress{"stress", 1, {}};
     for (Index v = 0; v < m.num_vertices(); ++v) {
-        for (int k = 0; k < 3; ++k) vel.values.push_back(0.1 * v + k / 7.0);
+        for (int k = 0; k < 3; ++k)
+            vel.values.push_back(0.1 * v + k / 7.0);
         contact.values.push_back(v % 3 == 0 ? 1.0 : 0.0);
     }
-    for (Index t = 0; t < m.num_tets(); ++t) stress.values.push_back(std::exp(-0.1 * t));
+    for (Index t = 0; t < m.num_tets(); ++t)
+        stress.values.push_back(std::exp(-0.1 * t));
     f.point = {vel, contact};
     f.cell = {stress};
     return f;
@@ -71,19 +76,25 @@ void expect_same_mesh(const TetMesh& a, const TetMesh& b, double tol, const std:
     ASSERT_EQ(a.num_tets(), b.num_tets()) << what;
     for (Index v = 0; v < a.num_vertices(); ++v)
         for (int k = 0; k < 3; ++k) {
-            if (tol == 0) ASSERT_EQ(a.positions(v, k), b.positions(v, k)) << what << " vertex " << v;
-            else ASSERT_NEAR(a.positions(v, k), b.positions(v, k), tol * (1 + std::abs(a.positions(v, k)))) << what << " vertex " << v;
+            if (tol == 0)
+                ASSERT_EQ(a.positions(v, k), b.positions(v, k)) << what << " vertex " << v;
+            else
+                ASSERT_NEAR(a.positions(v, k), b.positions(v, k), tol * (1 + std::abs(a.positions(v, k))))
+                    << what << " vertex " << v;
         }
     for (Index t = 0; t < a.num_tets(); ++t)
-        for (int k = 0; k < 4; ++k) ASSERT_EQ(a.tets(t, k), b.tets(t, k)) << what << " tet " << t;
+        for (int k = 0; k < 4; ++k)
+            ASSERT_EQ(a.tets(t, k), b.tets(t, k)) << what << " tet " << t;
 }
 
 void write_reference(const std::filesystem::path& dir, const TetMesh& m)
 {
     std::ofstream p(dir / "ref_points.txt"), t(dir / "ref_tets.txt");
     p.precision(17);
-    for (Index v = 0; v < m.num_vertices(); ++v) p << m.positions(v, 0) << ' ' << m.positions(v, 1) << ' ' << m.positions(v, 2) << '\n';
-    for (Index i = 0; i < m.num_tets(); ++i) t << m.tets(i, 0) << ' ' << m.tets(i, 1) << ' ' << m.tets(i, 2) << ' ' << m.tets(i, 3) << '\n';
+    for (Index v = 0; v < m.num_vertices(); ++v)
+        p << m.positions(v, 0) << ' ' << m.positions(v, 1) << ' ' << m.positions(v, 2) << '\n';
+    for (Index i = 0; i < m.num_tets(); ++i)
+        t << m.tets(i, 0) << ' ' << m.tets(i, 1) << ' ' << m.tets(i, 2) << ' ' << m.tets(i, 3) << '\n';
 }
 
 TetMesh read_reference(const std::filesystem::path& dir)
@@ -92,11 +103,13 @@ TetMesh read_reference(const std::filesystem::path& dir)
     std::vector<Index> t;
     {
         std::ifstream in(dir / "ref_points.txt");
-        for (double x; in >> x;) p.push_back(x);
+        for (double x; in >> x;)
+            p.push_back(x);
     }
     {
         std::ifstream in(dir / "ref_tets.txt");
-        for (double x; in >> x;) t.push_back(static_cast<Index>(x));
+        for (double x; in >> x;)
+            t.push_back(static_cast<Index>(x));
     }
     TetMesh m;
     m.positions.resize(static_cast<Eigen::Index>(p.size() / 3), 3);
@@ -186,13 +199,14 @@ TEST(IoVtk, WriterRejectsBadFieldsAndLeavesNoFile)
         io::write_vtu((dir / "m.vtu").string(), m, f);
         FAIL() << "expected an Error";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("'velocity' has 5 values, expected 8 × 3 = 24"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'velocity' has 5 values, expected 8 × 3 = 24"), std::string::npos)
+            << e.what();
     }
     EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
     io::Fields spaced;
     spaced.cell.push_back({"von mises", 1, std::vector<double>(static_cast<std::size_t>(m.num_tets()), 1.0)});
     EXPECT_THROW(io::write_vtk((dir / "m.vtk").string(), m, spaced), Error);
-    EXPECT_NO_THROW(io::write_vtu((dir / "m.vtu").string(), m, spaced));   // XML stores spaces
+    EXPECT_NO_THROW(io::write_vtu((dir / "m.vtu").string(), m, spaced)); // XML stores spaces
     // A failed write keeps the previous good file.
     const std::string before = read_text(dir / "m.vtu");
     EXPECT_THROW(io::write_vtu((dir / "m.vtu").string(), m, f), Error);
@@ -399,7 +413,8 @@ TEST(IoVtk, ReadsEveryVariantMeshioWrites)
     std::vector<Index> labels;
     {
         std::ifstream in(dir / "ref_labels.txt");
-        for (Index x; in >> x;) labels.push_back(x);
+        for (Index x; in >> x;)
+            labels.push_back(x);
     }
     ASSERT_EQ(ref.num_tets(), 72);
     ASSERT_EQ(labels.size(), 72u);
@@ -433,7 +448,8 @@ TEST(IoVtk, ReadsEveryVariantMeshioWrites)
         // meshio's ASCII .vtu keeps 12 significant digits.
         const double tol = f32 ? 1e-6 : name == "m_ascii.vtu" ? 1e-10 : 0;
         expect_same_mesh(ref, m, tol, name);
-        EXPECT_EQ(notes.skipped_cells, name.rfind("a_", 0) == 0 || name.rfind("z_raw", 0) == 0 || name.rfind("z_b64", 0) == 0 ? 5 : 7);
+        EXPECT_EQ(notes.skipped_cells,
+                  name.rfind("a_", 0) == 0 || name.rfind("z_raw", 0) == 0 || name.rfind("z_b64", 0) == 0 ? 5 : 7);
         EXPECT_EQ(m.tet_label, labels) << "gmsh:physical as tet labels";
     }
     EXPECT_EQ(files, 17);
@@ -454,9 +470,12 @@ TEST(IoVtk, MeshioReadsEveryFileWeWrite)
         std::ofstream v(dir / "ref_velocity.txt"), s(dir / "ref_stress.txt"), o(dir / "ref_objects.txt");
         v.precision(17);
         s.precision(17);
-        for (double x : f.point[0].values) v << x << '\n';
-        for (double x : f.cell[0].values) s << x << '\n';
-        for (Index x : m.tet_object) o << x << '\n';
+        for (double x : f.point[0].values)
+            v << x << '\n';
+        for (double x : f.cell[0].values)
+            s << x << '\n';
+        for (Index x : m.tet_object)
+            o << x << '\n';
     }
     write_text(dir / "read.py", kMeshioRead);
     const RunResult r = run_shell(py + " " + quote(dir / "read.py") + " " + quote(dir));
@@ -584,7 +603,8 @@ TEST(IoVtk, VtkLibraryReadsOursAndWeReadVtkLibraryFiles)
         expect_same_mesh(m, back, ascii ? 1e-9 : 0, name);
         EXPECT_EQ(notes.skipped_cells, 1);
         ASSERT_EQ(back.tet_label.size(), static_cast<std::size_t>(m.num_tets()));
-        for (Index t = 0; t < m.num_tets(); ++t) ASSERT_EQ(back.tet_label[static_cast<std::size_t>(t)], 5 + t % 3);
+        for (Index t = 0; t < m.num_tets(); ++t)
+            ASSERT_EQ(back.tet_label[static_cast<std::size_t>(t)], 5 + t % 3);
     }
     EXPECT_EQ(files, 1 + 3 * 2 * 2 * 2 + 4);
 }

@@ -75,7 +75,8 @@ TEST(SimContact, BodyDroppedOnGroundComesToRestAtTheRightHeight)
         s.integrator = integ;
         s.output.every = 0;
         Simulation sim(s);
-        for (int i = 0; i < 750; ++i) sim.step();
+        for (int i = 0; i < 750; ++i)
+            sim.step();
         const Positions& x = sim.positions();
         // Resting: bottom on the ground (penalty sinks it by m g / k per vertex at most), centre at half the size.
         EXPECT_NEAR(x.col(2).minCoeff(), 0.0, 0.01) << to_string(integ);
@@ -91,7 +92,7 @@ TEST(SimContact, OverlappingBodiesSeparateAndConserveMomentum)
         if (integ == Integrator::symplectic_euler) s.substeps = 20;
         Simulation sim(s);
         ASSERT_GT(sim.contacts().size(), 0u);
-        const double scale = total_mass(sim) * 1.0;   // momentum of the whole mass at 1 length/s
+        const double scale = total_mass(sim) * 1.0; // momentum of the whole mass at 1 length/s
         int separated_at = -1;
         for (int i = 0; i < 400 && separated_at < 0; ++i) {
             sim.step();
@@ -110,7 +111,8 @@ TEST(SimContact, StiffnessFrom1e1To1e9StaysFiniteAndBoundedWithImplicitEuler)
 {
     for (double young : {1e1, 1e3, 1e5, 1e7, 1e9}) {
         Scene s = two_overlapping(Integrator::implicit_euler);
-        for (ObjectSpec& o : s.objects) o.material.young = young;
+        for (ObjectSpec& o : s.objects)
+            o.material.young = young;
         s.dt = 1e-2;
         Simulation sim(s);
         const double e0 = sim.energy().total();
@@ -128,7 +130,7 @@ TEST(SimContact, MassRatio1e6)
     Scene s;
     s.objects.push_back(box_object(0.5, {0, 0, 0.25}));
     s.objects.push_back(box_object(0.5, {0.05, 0.0, 0.76}));
-    s.objects[1].material.density = 1e8;   // 1e6 × the lower box
+    s.objects[1].material.density = 1e8; // 1e6 × the lower box
     s.ground.enabled = true;
     s.dt = 2e-3;
     s.output.every = 0;
@@ -168,7 +170,7 @@ TEST(SimContact, VelocityCrossingAnObjectInOneStep)
     Scene s;
     s.objects.push_back(box_object(0.5, {0, 0, 0}));
     s.objects.push_back(box_object(0.5, {-1.0, 0.0, 0.0}));
-    s.objects[1].velocity = Eigen::Vector3d(150, 0, 0);   // 1.5 length units per step: through and past A
+    s.objects[1].velocity = Eigen::Vector3d(150, 0, 0); // 1.5 length units per step: through and past A
     s.gravity.setZero();
     s.dt = 1e-2;
     s.output.every = 0;
@@ -177,7 +179,7 @@ TEST(SimContact, VelocityCrossingAnObjectInOneStep)
     const double emax = run(sim, 5);
     EXPECT_TRUE(sim.positions().allFinite());
     EXPECT_LE(emax, e0 * (1 + 1e-6));
-    EXPECT_LT(sim.momentum().norm(), 1.001 * e0);   // finite, nothing created
+    EXPECT_LT(sim.momentum().norm(), 1.001 * e0); // finite, nothing created
 }
 
 TEST(SimContact, InvertedTetsAtStartAreRestored)
@@ -206,7 +208,8 @@ TEST(SimContact, InvertedTetsAtStartAreRestored)
         auto inverted = [&] {
             int count = 0;
             for (Index t = 0; t < sim.mesh().num_tets(); ++t) {
-                const std::array<Index, 4> tet{sim.mesh().tets(t, 0), sim.mesh().tets(t, 1), sim.mesh().tets(t, 2), sim.mesh().tets(t, 3)};
+                const std::array<Index, 4> tet{sim.mesh().tets(t, 0), sim.mesh().tets(t, 1), sim.mesh().tets(t, 2),
+                                               sim.mesh().tets(t, 3)};
                 count += signed_volume(sim.positions(), tet) <= 0 ? 1 : 0;
             }
             return count;
@@ -255,13 +258,15 @@ TEST(SimContact, FoldedBarEndsWithoutDeepSelfPenetration)
     std::int64_t self_contacts = 0;
     for (int i = 0; i < 300; ++i) {
         sim.step();
-        for (const Contact& c : sim.contacts()) self_contacts += c.vertex_object == c.tet_object ? 1 : 0;
+        for (const Contact& c : sim.contacts())
+            self_contacts += c.vertex_object == c.tet_object ? 1 : 0;
     }
     EXPECT_GT(self_contacts, 0);
     EXPECT_TRUE(sim.positions().allFinite());
-    EXPECT_LT(sim.positions().col(2).maxCoeff(), 2.0);   // it did fold over
+    EXPECT_LT(sim.positions().col(2).maxCoeff(), 2.0); // it did fold over
     // Bound: a quarter of the bar's thickness (0.3), measured against the exact distance to the boundary.
     const std::vector<double> exact = sim.exact_depths();
-    for (double d : exact) EXPECT_LT(d, 0.075);
+    for (double d : exact)
+        EXPECT_LT(d, 0.075);
     EXPECT_LT(sim.max_penetration(), 0.075);
 }

@@ -33,7 +33,8 @@ Scene free_box(Integrator integ, double dt, double damping = 0.0, double perturb
     std::uniform_real_distribution<double> u(-perturb, perturb);
     m.rest_positions = m.positions;
     for (Index i = 0; i < m.num_vertices(); ++i)
-        for (int c = 0; c < 3; ++c) m.positions(i, c) += u(rng);
+        for (int c = 0; c < 3; ++c)
+            m.positions(i, c) += u(rng);
     o.data = m;
     o.self_collision = false;
     o.material.young = 1e4;
@@ -56,7 +57,8 @@ TEST(SimModel, MassesSumToDensityTimesVolume)
     mat.density = 250;
     Model model = Model::build(m, {mat}, {0});
     double total = 0;
-    for (double v : model.mass) total += v;
+    for (double v : model.mass)
+        total += v;
     EXPECT_NEAR(total, 250 * 8.0, 1e-9 * total);
     EXPECT_EQ(model.springs.edges.rows(), unique_edges(m.tets).rows());
 }
@@ -67,7 +69,8 @@ TEST(SimModel, StiffnessDirectOrScaledByEdgeLength)
     Material a;
     a.young = 3e5;
     Model ma = Model::build(m, {a}, {0});
-    for (size_t e = 0; e < ma.springs.k.size(); ++e) EXPECT_NEAR(ma.springs.k[e], 3e5 * ma.springs.rest[e], 1e-6);
+    for (size_t e = 0; e < ma.springs.k.size(); ++e)
+        EXPECT_NEAR(ma.springs.k[e], 3e5 * ma.springs.rest[e], 1e-6);
     Material b;
     b.stiffness = 42;
     b.damping = 0.5;
@@ -84,7 +87,8 @@ TEST(SimModel, StaticObjectsHaveNoSpringsAndAreFixed)
     a.append(b);
     Model m = Model::build(a, {Material{}, Material{}}, {0, 1});
     EXPECT_EQ(m.springs.edges.rows(), unique_edges(b.tets).rows());
-    for (Index i = 0; i < a.num_vertices(); ++i) EXPECT_EQ(m.fixed[static_cast<size_t>(i)] != 0, i >= b.num_vertices());
+    for (Index i = 0; i < a.num_vertices(); ++i)
+        EXPECT_EQ(m.fixed[static_cast<size_t>(i)] != 0, i >= b.num_vertices());
 }
 
 TEST(SimModel, RestStateHasNoForceAndZeroElasticEnergy)
@@ -108,7 +112,8 @@ TEST(SimModel, ForcesAreMinusEnergyGradient)
     std::uniform_real_distribution<double> u(-0.1, 0.1);
     Positions x = m.positions;
     for (Index i = 0; i < x.rows(); ++i)
-        for (int c = 0; c < 3; ++c) x(i, c) += u(rng);
+        for (int c = 0; c < 3; ++c)
+            x(i, c) += u(rng);
     const Positions v = Positions::Zero(x.rows(), 3);
     Positions f = Positions::Zero(x.rows(), 3);
     model.add_forces(x, v, f);
@@ -137,7 +142,7 @@ TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
     Material mat;
     mat.damping = 0.1;
     Model model = Model::build(m, {mat}, {0});
-    model.fixed[0] = 1;   // a pinned vertex: its rows and columns are skipped by both
+    model.fixed[0] = 1; // a pinned vertex: its rows and columns are skipped by both
     model.ground.enabled = true;
     model.ground.height = -0.45;
     model.ground.stiffness = 1e3;
@@ -146,7 +151,8 @@ TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
     std::uniform_real_distribution<double> u(-0.08, 0.08);
     Positions x = m.positions;
     for (Index i = 0; i < x.rows(); ++i)
-        for (int c = 0; c < 3; ++c) x(i, c) += u(rng);
+        for (int c = 0; c < 3; ++c)
+            x(i, c) += u(rng);
     std::vector<Eigen::Triplet<double>> t;
     model.add_matrix_triplets(x, 0.7, 0.3, t);
     const Index N = 3 * x.rows();
@@ -160,7 +166,7 @@ TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(N);
     model.add_matrix_diagonal(x, 0.7, 0.3, diag);
     EXPECT_LT((Eigen::VectorXd(A.diagonal()) - diag).norm(), 1e-9 * diag.norm());
-    EXPECT_LT((Eigen::SparseMatrix<double>(A.transpose()) - A).norm(), 1e-9 * A.norm());   // symmetric
+    EXPECT_LT((Eigen::SparseMatrix<double>(A.transpose()) - A).norm(), 1e-9 * A.norm()); // symmetric
 
     // The linearised (cached) operator used by CG gives the same products and diagonal.
     const Model::Linearised lin = model.linearise(x, 0.7, 0.3);
@@ -192,7 +198,8 @@ TEST(SimModel, ZeroVolumeRestTetIsRefused)
 {
     TetMesh m = box_mesh(2);
     const Index t = 5;
-    for (int k = 1; k < 4; ++k) m.positions.row(m.tets(t, k)) = m.positions.row(m.tets(t, 0));
+    for (int k = 1; k < 4; ++k)
+        m.positions.row(m.tets(t, k)) = m.positions.row(m.tets(t, 0));
     try {
         Model::build(m, {Material{}}, {0});
         FAIL() << "no error";
@@ -226,7 +233,7 @@ TEST(SimIntegrators, ImplicitEulerEnergyNonIncreasing)
     for (LinearSolver solver : {LinearSolver::cg, LinearSolver::ldlt}) {
         Scene s = free_box(Integrator::implicit_euler, 1.0);
         Simulation probe(s);
-        s.dt = 20 * probe.explicit_dt_limit();  // far above the explicit limit
+        s.dt = 20 * probe.explicit_dt_limit(); // far above the explicit limit
         s.solver = solver;
         s.tolerance = 1e-10;
         Simulation sim(s);
@@ -238,7 +245,7 @@ TEST(SimIntegrators, ImplicitEulerEnergyNonIncreasing)
             EXPECT_LE(e, prev * (1 + 1e-6) + 1e-12 * e0) << "step " << i << " solver " << to_string(solver);
             prev = e;
         }
-        EXPECT_LT(prev, 0.5 * e0);   // and it dissipates
+        EXPECT_LT(prev, 0.5 * e0); // and it dissipates
     }
 }
 
@@ -266,7 +273,8 @@ TEST(SimIntegrators, ExplicitAboveLimitWarnsThenStopsWithoutNaN)
     ASSERT_FALSE(sim.warnings().empty());
     EXPECT_NE(sim.warnings()[0].find("stability limit"), std::string::npos) << sim.warnings()[0];
     try {
-        for (int i = 0; i < 10000; ++i) sim.step();
+        for (int i = 0; i < 10000; ++i)
+            sim.step();
         FAIL() << "no blow-up detected";
     } catch (const RunFailure& e) {
         const std::string msg = e.what();
@@ -285,7 +293,8 @@ TEST(SimIntegrators, SubstepsBringExplicitUnderTheLimit)
     s.substeps = 6;
     Simulation sim(s);
     EXPECT_TRUE(sim.warnings().empty());
-    for (int i = 0; i < 300; ++i) sim.step();
+    for (int i = 0; i < 300; ++i)
+        sim.step();
     EXPECT_TRUE(sim.positions().allFinite());
 }
 
@@ -301,7 +310,8 @@ TEST(SimIntegrators, PinnedVerticesStayPut)
         s.pins.push_back(p);
         Simulation sim(s);
         const Positions x0 = sim.positions();
-        for (int i = 0; i < 50; ++i) sim.step();
+        for (int i = 0; i < 50; ++i)
+            sim.step();
         Index pinned = 0;
         for (Index i = 0; i < x0.rows(); ++i)
             if (x0(i, 2) >= 0.4) {
@@ -309,6 +319,6 @@ TEST(SimIntegrators, PinnedVerticesStayPut)
                 EXPECT_EQ((sim.positions().row(i) - x0.row(i)).norm(), 0.0);
             }
         EXPECT_GT(pinned, 0);
-        EXPECT_LT(sim.positions().col(2).minCoeff(), x0.col(2).minCoeff());   // the rest sags
+        EXPECT_LT(sim.positions().col(2).minCoeff(), x0.col(2).minCoeff()); // the rest sags
     }
 }

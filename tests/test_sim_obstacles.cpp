@@ -68,9 +68,9 @@ TEST(SimObstacle, BodyComesToRestOnAClosedSurfaceObstacle)
     Simulation sim(s);
     const auto [o0, on] = sim.object_vertices(0);
     ASSERT_GT(on, 0);
-    ASSERT_GT(sim.object_tets(0).second, 0);   // tetrahedralized
+    ASSERT_GT(sim.object_tets(0).second, 0); // tetrahedralized
     const double top = sim.positions().middleRows(o0, on).col(2).maxCoeff();
-    EXPECT_NEAR(top, 0.2, 0.05);               // the slab spans z in [-0.2, 0.2]
+    EXPECT_NEAR(top, 0.2, 0.05); // the slab spans z in [-0.2, 0.2]
     const auto [b0, bn] = sim.object_vertices(1);
     double lowest = 1e9;
     for (int i = 0; i < 400; ++i) {
@@ -96,15 +96,16 @@ TEST(SimFriction, GroundFrictionDeceleratesAndStopsASlidingBox)
         s.dt = 2e-3;
         s.output.every = 0;
         Simulation sim(s);
-        for (int i = 0; i < 200; ++i) sim.step();   // 0.4 s
+        for (int i = 0; i < 200; ++i)
+            sim.step(); // 0.4 s
         EXPECT_TRUE(sim.positions().allFinite());
         return horizontal_speed(sim, 0);
     };
     const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
-    EXPECT_GT(free, 1.8);                  // without friction it keeps sliding
-    EXPECT_LT(some, free - 0.6);           // μ g t ≈ 1.2 less after 0.4 s
-    EXPECT_GT(some, 0.2);                  // ... but has not stopped yet
-    EXPECT_LT(high, 0.02);                 // μ = 2 stops it within ~0.1 s
+    EXPECT_GT(free, 1.8);        // without friction it keeps sliding
+    EXPECT_LT(some, free - 0.6); // μ g t ≈ 1.2 less after 0.4 s
+    EXPECT_GT(some, 0.2);        // ... but has not stopped yet
+    EXPECT_LT(high, 0.02);       // μ = 2 stops it within ~0.1 s
 }
 
 TEST(SimFriction, ContactFrictionOnAStaticObstacle)
@@ -120,10 +121,11 @@ TEST(SimFriction, ContactFrictionOnAStaticObstacle)
         s.dt = 2e-3;
         s.output.every = 0;
         Simulation sim(s);
-        for (int i = 0; i < 200; ++i) sim.step();
+        for (int i = 0; i < 200; ++i)
+            sim.step();
         EXPECT_TRUE(sim.positions().allFinite());
         const auto [b0, bn] = sim.object_vertices(1);
-        EXPECT_GT(sim.positions().middleRows(b0, bn).col(2).minCoeff(), -0.05);   // stayed on the plate
+        EXPECT_GT(sim.positions().middleRows(b0, bn).col(2).minCoeff(), -0.05); // stayed on the plate
         return horizontal_speed(sim, 1);
     };
     const double free = slide(0.0), some = slide(0.3), high = slide(2.0);
@@ -151,7 +153,8 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
         const auto [first, count] = sim.object_vertices(k);
         const Edges& e = sim.model().springs.edges;
         for (Index q = 0; q < e.rows(); ++q)
-            if (e(q, 0) >= first && e(q, 0) < first + count) m = std::max(m, sim.model().springs.k[static_cast<size_t>(q)]);
+            if (e(q, 0) >= first && e(q, 0) < first + count)
+                m = std::max(m, sim.model().springs.k[static_cast<size_t>(q)]);
         return m;
     };
     const double k_soft = stiffest(0), k_hard = stiffest(1);
@@ -160,7 +163,7 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
     EXPECT_LE(sim.contact_stiffness(0, 1), 20 * k_soft);
     EXPECT_GT(sim.contact_stiffness(0, 1), 10 * k_soft);
     EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 1), sim.contact_stiffness(1, 0));
-    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 2), 10 * k_soft);   // static partner: as stiff as the cushion
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 2), 10 * k_soft); // static partner: as stiff as the cushion
     EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 1), 10 * k_hard);
     EXPECT_THROW(sim.contact_stiffness(0, 3), Error);
 
@@ -176,7 +179,7 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
     EXPECT_LE(emax, e0 + 1e-6 * std::abs(e0));
     EXPECT_LT(sim.max_penetration(), 0.05);
 
-    s.contact.stiffness = 123.0;   // given: used for every pair
+    s.contact.stiffness = 123.0; // given: used for every pair
     Simulation fixed(s);
     EXPECT_DOUBLE_EQ(fixed.contact_stiffness(0, 1), 123.0);
     EXPECT_DOUBLE_EQ(fixed.contact_stiffness(1, 1), 123.0);

@@ -67,7 +67,8 @@ object = 0
 vertices = [0, 3]
 box_min = [0, 0, 0]
 box_max = [1, 1, 1]
-)", "s.toml", "/base");
+)",
+                                "s.toml", "/base");
     EXPECT_EQ(s.dt, 0.005);
     EXPECT_EQ(s.steps, 12);
     EXPECT_EQ(s.substeps, 3);

@@ -27,7 +27,8 @@ std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
     p.resolution = resolution;
     TetMesh a = io::generate(p);
     TetMesh b = a;
-    for (Eigen::Index v = 0; v < b.positions.rows(); ++v) b.positions.row(v) += Eigen::RowVector3d(0.37, 0.21, 0.13);
+    for (Eigen::Index v = 0; v < b.positions.rows(); ++v)
+        b.positions.row(v) += Eigen::RowVector3d(0.37, 0.21, 0.13);
     io::write_mesh((dir / "a.vtu").string(), a);
     io::write_mesh((dir / "b.vtu").string(), b);
     return (dir / "a.vtu").string() + "+" + (dir / "b.vtu").string();
@@ -63,13 +64,18 @@ TEST(StudyPlan, BadInputIsRejectedWithTheOptionNamed)
     EXPECT_NE(with([](StudyOptions& c) { c.table_size = {"0"}; }).find("--table-size"), std::string::npos);
     EXPECT_NE(with([](StudyOptions& c) { c.hash = {"md5"}; }).find("md5"), std::string::npos);
     EXPECT_NE(with([](StudyOptions& c) { c.threads = {"0"}; }).find("--threads"), std::string::npos);
-    EXPECT_NE(with([](StudyOptions& c) { c.meshes = {"/nonexistent/x.vtu"}; }).find("file not found: /nonexistent/x.vtu"),
-              std::string::npos);
+    EXPECT_NE(
+        with([](StudyOptions& c) { c.meshes = {"/nonexistent/x.vtu"}; }).find("file not found: /nonexistent/x.vtu"),
+        std::string::npos);
     EXPECT_NE(with([](StudyOptions& c) { c.meshes.clear(); }).find("no scene"), std::string::npos);
     EXPECT_NE(with([](StudyOptions& c) { c.repeat = 0; }).find("--repeat"), std::string::npos);
-    EXPECT_NE(with([](StudyOptions& c) { c.sweep = Sweep::grid; c.grid = {"cell-size"}; }).find("--grid"), std::string::npos);
+    EXPECT_NE(with([](StudyOptions& c) {
+                  c.sweep = Sweep::grid;
+                  c.grid = {"cell-size"};
+              }).find("--grid"),
+              std::string::npos);
     EXPECT_EQ(with([](StudyOptions&) {}), "");
-    EXPECT_FALSE(std::filesystem::exists(dir / "out"));   // planning does no work
+    EXPECT_FALSE(std::filesystem::exists(dir / "out")); // planning does no work
 
     int i = 0, n = 0;
     EXPECT_THROW(study::parse_shard("2/2", i, n), Error);
@@ -88,7 +94,7 @@ TEST(StudyPlan, RangesGiveLogSpacedCellsAndPrimeAndPowerOfTwoTables)
     o.meshes = {two_boxes(dir)};
     o.table_size = {"x0.5:x2:3"};
     auto plan = study::plan_study(o);
-    ASSERT_EQ(study::points_total(*plan), 6);   // 3 values × (power of two, prime)
+    ASSERT_EQ(study::points_total(*plan), 6); // 3 values × (power of two, prime)
     o.sweep = Sweep::cell_size;
     o.table_size.clear();
     o.cell_size = {"0.25:4:5", "7"};
@@ -97,7 +103,7 @@ TEST(StudyPlan, RangesGiveLogSpacedCellsAndPrimeAndPowerOfTwoTables)
     o.shard_index = 1;
     o.shard_count = 4;
     plan = study::plan_study(o);
-    EXPECT_EQ(study::points_in_shard(*plan), 2);   // points 1 and 5
+    EXPECT_EQ(study::points_in_shard(*plan), 2); // points 1 and 5
 }
 
 TEST(StudyTable, CsvRoundTripsQuotedFields)
@@ -151,12 +157,13 @@ TEST(StudyRun, SmallSweepMatchesTheOracleInEveryRow)
         EXPECT_EQ(r[static_cast<std::size_t>(missed)], "0");
         EXPECT_EQ(r[static_cast<std::size_t>(extra)], "0");
         EXPECT_EQ(r[static_cast<std::size_t>(contacts)], r[static_cast<std::size_t>(oracle)]);
-        EXPECT_NE(r[static_cast<std::size_t>(contacts)], "0");   // the boxes overlap
+        EXPECT_NE(r[static_cast<std::size_t>(contacts)], "0"); // the boxes overlap
         tables.insert(r[static_cast<std::size_t>(table)]);
     }
     EXPECT_TRUE(tables.count("1") && tables.count("2") && tables.count("97"));
     const std::string json = test::read_text(res.json_path);
-    for (const char* key : {"\"machine\"", "\"cores\"", "\"cpu\"", "\"compiler\"", "\"summary\"", "\"median\"", "\"points_total\": 24"})
+    for (const char* key :
+         {"\"machine\"", "\"cores\"", "\"cpu\"", "\"compiler\"", "\"summary\"", "\"median\"", "\"points_total\": 24"})
         EXPECT_NE(json.find(key), std::string::npos) << key;
 }
 
@@ -193,13 +200,13 @@ TEST(StudyScenarios, FiveTeschnerScenesHaveThePapersSizesAndRealContacts)
     for (int i = 0; i < 5; ++i) {
         const auto sc = study::teschner_scenario(i);
         EXPECT_EQ(sc.mesh.num_objects(), sc.spec.objects) << sc.spec.name;
-        EXPECT_NEAR(std::log(double(sc.mesh.num_tets()) / sc.spec.tets), 0.0, std::log(1.5)) << sc.spec.name << " tets "
-                                                                                          << sc.mesh.num_tets();
+        EXPECT_NEAR(std::log(double(sc.mesh.num_tets()) / sc.spec.tets), 0.0, std::log(1.5))
+            << sc.spec.name << " tets " << sc.mesh.num_tets();
         EXPECT_NEAR(std::log(double(sc.mesh.num_vertices()) / sc.spec.vertices), 0.0, std::log(1.6))
             << sc.spec.name << " vertices " << sc.mesh.num_vertices();
-        if (i <= 2) {   // the oracle is quick on the small ones: objects overlap, contacts between objects
-            const auto contacts = brute_force_contacts(sc.mesh.positions, sc.mesh.tets, sc.mesh.vertex_object,
-                                                       sc.mesh.tet_object);
+        if (i <= 2) { // the oracle is quick on the small ones: objects overlap, contacts between objects
+            const auto contacts =
+                brute_force_contacts(sc.mesh.positions, sc.mesh.tets, sc.mesh.vertex_object, sc.mesh.tet_object);
             std::set<Index> objects_touched;
             for (const auto& c : contacts)
                 if (c.vertex_object != c.tet_object) {
@@ -207,7 +214,8 @@ TEST(StudyScenarios, FiveTeschnerScenesHaveThePapersSizesAndRealContacts)
                     objects_touched.insert(c.tet_object);
                 }
             EXPECT_GT(contacts.size(), 0u) << sc.spec.name;
-            EXPECT_EQ(static_cast<int>(objects_touched.size()), sc.spec.objects) << sc.spec.name;   // every object overlaps another
+            EXPECT_EQ(static_cast<int>(objects_touched.size()), sc.spec.objects)
+                << sc.spec.name; // every object overlaps another
         }
     }
     // Deterministic.

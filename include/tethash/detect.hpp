@@ -18,8 +18,8 @@
 #include "tethash/mesh.hpp"
 
 #include <cstdint>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,11 +29,11 @@ namespace tethash {
 /// A vertex lying inside (or on the boundary of) a tet it does not belong to.
 /// Plain data, 80 bytes; arrays of it are sorted by (vertex, tet).
 struct Contact {
-    Index vertex = -1;       ///< global vertex id
-    Index tet = -1;          ///< global tet id
-    Index vertex_object = 0; ///< object of the vertex
-    Index tet_object = 0;    ///< object of the tet
-    double bary[4] = {0, 0, 0, 0};   ///< barycentric coordinates of the vertex in the tet (sum 1, all ≥ 0 up to rounding)
+    Index vertex = -1;             ///< global vertex id
+    Index tet = -1;                ///< global tet id
+    Index vertex_object = 0;       ///< object of the vertex
+    Index tet_object = 0;          ///< object of the tet
+    double bary[4] = {0, 0, 0, 0}; ///< barycentric coordinates of the vertex in the tet (sum 1, all ≥ 0 up to rounding)
     /// Penetration depth (length units, ≥ 0) and unit direction pointing out of the penetrated object;
     /// NaN unless penetration was requested (see penetration.hpp).
     double depth = std::numeric_limits<double>::quiet_NaN();
@@ -42,8 +42,8 @@ struct Contact {
 
 /// Hash function of the infinite grid's cells onto the table.
 enum class HashFunction {
-    teschner,  ///< (x·73856093 xor y·19349663 xor z·83492791) mod n  (the 2003 paper)
-    column,    ///< mix(x, y) + z: cells of one z-run land in consecutive buckets (one lookup per column)
+    teschner, ///< (x·73856093 xor y·19349663 xor z·83492791) mod n  (the 2003 paper)
+    column,   ///< mix(x, y) + z: cells of one z-run land in consecutive buckets (one lookup per column)
 };
 /// "teschner" / "column"; throws Error for anything else.
 HashFunction parse_hash_function(const std::string& name);
@@ -59,10 +59,10 @@ struct DetectParams {
     /// Grid cell edge length l. ≤ 0 is invalid when `cell_size_mode == absolute`.
     enum class CellSizeMode { auto_mean_edge, absolute, factor_of_mean_edge };
     CellSizeMode cell_size_mode = CellSizeMode::auto_mean_edge;
-    double cell_size = 1.0;        ///< absolute length, or the factor for factor_of_mean_edge
-    std::int64_t table_size = 0;   ///< number of buckets; 0 = automatic from the vertex count
+    double cell_size = 1.0;      ///< absolute length, or the factor for factor_of_mean_edge
+    std::int64_t table_size = 0; ///< number of buckets; 0 = automatic from the vertex count
     HashFunction hash = HashFunction::column;
-    int threads = 0;               ///< 0 = OpenMP default; 1 = serial
+    int threads = 0; ///< 0 = OpenMP default; 1 = serial
     /// Candidate reuse between calls (moving scenes, as the neighbour lists of molecular dynamics). With a skin
     /// s > 0 a full detection collects each tet's candidates with its box inflated by s and keeps them; a later
     /// call whose moving vertices all moved less than s/2 per axis since that detection only re-runs the exact
@@ -70,30 +70,30 @@ struct DetectParams {
     /// finite. Costs 24 bytes per vertex plus 4 bytes per kept candidate (see docs/detection.md).
     enum class SkinMode { absolute, factor_of_cell_size };
     SkinMode skin_mode = SkinMode::absolute;
-    double skin = 0;               ///< a length, or the factor of the cell size for factor_of_cell_size
+    double skin = 0; ///< a length, or the factor of the cell size for factor_of_cell_size
 };
 
 /// Statistics of one detect() call. Times in milliseconds.
 struct DetectStats {
     double ms_total = 0, ms_vertices = 0, ms_tets = 0, ms_inside = 0, ms_sort = 0;
-    double cell_size = 0;                  ///< l actually used
-    std::int64_t table_size = 0;           ///< n actually used
+    double cell_size = 0;        ///< l actually used
+    std::int64_t table_size = 0; ///< n actually used
     int threads = 1;
     std::int64_t vertices = 0, tets = 0;
-    std::int64_t cells_visited = 0;        ///< grid cells enumerated from tet boxes
-    std::int64_t entries_scanned = 0;      ///< bucket entries looked at
-    std::int64_t hash_collisions = 0;      ///< scanned entries whose cell differs from the visited cell
-    std::int64_t box_rejections = 0;       ///< candidates rejected by the tet's bounding box
-    std::int64_t own_vertex_skips = 0;     ///< candidates that were one of the tet's own vertices
-    std::int64_t inside_tests = 0;         ///< barycentric / orientation tests made
-    std::int64_t exact_fallbacks = 0;      ///< tests the floating-point filter could not decide
-    std::int64_t degenerate_tets = 0;      ///< zero-volume tets skipped
+    std::int64_t cells_visited = 0;    ///< grid cells enumerated from tet boxes
+    std::int64_t entries_scanned = 0;  ///< bucket entries looked at
+    std::int64_t hash_collisions = 0;  ///< scanned entries whose cell differs from the visited cell
+    std::int64_t box_rejections = 0;   ///< candidates rejected by the tet's bounding box
+    std::int64_t own_vertex_skips = 0; ///< candidates that were one of the tet's own vertices
+    std::int64_t inside_tests = 0;     ///< barycentric / orientation tests made
+    std::int64_t exact_fallbacks = 0;  ///< tests the floating-point filter could not decide
+    std::int64_t degenerate_tets = 0;  ///< zero-volume tets skipped
     std::int64_t contacts = 0;
-    double table_load = 0;                 ///< vertices / table size
-    std::int64_t memory_bytes = 0;         ///< detector working memory
-    double skin = 0;                       ///< skin actually used (length; 0 = no candidate reuse)
-    int reused = 0;                        ///< 1: stages 1-2 skipped, the kept candidates were tested (skin > 0)
-    std::int64_t cached_candidates = 0;    ///< candidates kept for reuse (skin > 0; 0 otherwise)
+    double table_load = 0;              ///< vertices / table size
+    std::int64_t memory_bytes = 0;      ///< detector working memory
+    double skin = 0;                    ///< skin actually used (length; 0 = no candidate reuse)
+    int reused = 0;                     ///< 1: stages 1-2 skipped, the kept candidates were tested (skin > 0)
+    std::int64_t cached_candidates = 0; ///< candidates kept for reuse (skin > 0; 0 otherwise)
 };
 
 class DetectorImpl;
@@ -101,7 +101,7 @@ class DetectorImpl;
 /// Owns every buffer and reuses it across calls; after the first call on a scene, detect() does not allocate.
 /// Not thread-safe itself (one detect() at a time per Detector); parallel inside.
 class Detector {
-public:
+  public:
     Detector();
     explicit Detector(const DetectParams& params);
     ~Detector();
@@ -117,9 +117,8 @@ public:
     /// Sets the topology once. `tets` is m × 4; `vertex_object`/`tet_object` give object ids (empty: all 0);
     /// `objects[k]` gives the options of object k (missing: defaults). The number of vertices is fixed here.
     /// Throws Error on indices out of range or repeated within a tet, or object ids out of range.
-    void set_topology(const TetsRef& tets, Index num_vertices,
-                      std::span<const Index> vertex_object = {}, std::span<const Index> tet_object = {},
-                      std::span<const ObjectOptions> objects = {});
+    void set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object = {},
+                      std::span<const Index> tet_object = {}, std::span<const ObjectOptions> objects = {});
     /// Convenience: topology and object ids of a TetMesh.
     void set_topology(const TetMesh& mesh, std::span<const ObjectOptions> objects = {});
 
@@ -130,7 +129,7 @@ public:
     /// The contacts of the last detect() call (mutable so that penetration can fill depth and direction).
     std::vector<Contact>& contacts();
 
-private:
+  private:
     std::unique_ptr<DetectorImpl> m_impl;
 };
 

@@ -11,13 +11,13 @@ namespace tethash {
 
 /// Bad input. The message names what is wrong and where (file and line, key, parameter and value, element id).
 class Error : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 
 /// A failure while running on valid input (for example a simulation that diverged).
 class RunFailure : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 

@@ -21,7 +21,7 @@
 namespace tethash {
 
 /// Largest allowed |cell coordinate| (exclusive).
-inline constexpr double max_cell_coordinate = 1073741824.0;   // 2^30
+inline constexpr double max_cell_coordinate = 1073741824.0; // 2^30
 /// Largest allowed table size.
 inline constexpr std::int64_t max_table_size = std::int64_t{1} << 27;
 
@@ -29,7 +29,7 @@ inline constexpr std::int64_t max_table_size = std::int64_t{1} << 27;
 /// the library call that a build without SSE4.1 makes for it (measured: 8 % of all instructions of a detection).
 inline std::int32_t floor_to_int(double x)
 {
-    const auto i = static_cast<std::int32_t>(x);   // truncation toward zero, exact in range
+    const auto i = static_cast<std::int32_t>(x); // truncation toward zero, exact in range
     return i - (x < static_cast<double>(i));
 }
 
@@ -54,14 +54,13 @@ inline std::uint32_t cell_key(std::int32_t x, std::int32_t y, std::int32_t z)
     return column_key(x, y) | ((static_cast<std::uint32_t>(z) & 0x3ffu) << 22);
 }
 inline constexpr std::uint32_t key_column_mask = 0x3fffffu;
-inline constexpr std::int64_t key_exact_xy = 2048 - 2 * 257 - 1;   ///< cells per axis in x and y (1533)
-inline constexpr std::int64_t key_exact_z = 1024 - 2 * 257 - 1;    ///< cells in z (509)
+inline constexpr std::int64_t key_exact_xy = 2048 - 2 * 257 - 1; ///< cells per axis in x and y (1533)
+inline constexpr std::int64_t key_exact_z = 1024 - 2 * 257 - 1;  ///< cells in z (509)
 
 /// 64-bit mix of a column (x, y).
 inline std::uint64_t column_mix(std::int32_t x, std::int32_t y)
 {
-    std::uint64_t h = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) |
-                      static_cast<std::uint32_t>(y);
+    std::uint64_t h = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
     h ^= h >> 33;
     h *= 0xff51afd7ed558ccdULL;
     h ^= h >> 33;
@@ -73,7 +72,7 @@ inline std::uint64_t column_mix(std::int32_t x, std::int32_t y)
 /// Reduces hashes modulo the table size n (mask for powers of two).
 struct TableModulus {
     std::uint64_t n = 1;
-    std::uint64_t mask = 0;   ///< n − 1 when n is a power of two, else 0
+    std::uint64_t mask = 0; ///< n − 1 when n is a power of two, else 0
     bool pow2 = true;
     explicit TableModulus(std::uint64_t size = 1) : n(size), mask(size - 1), pow2((size & (size - 1)) == 0) {}
     std::uint64_t reduce(std::uint64_t h) const { return pow2 ? (h & mask) : (h % n); }
@@ -100,7 +99,7 @@ std::int64_t next_prime(std::int64_t n);
 
 /// Stage 1: the vertex table. Keeps its buffers across builds.
 class VertexTable {
-public:
+  public:
     /// Rebuilds the table from the vertices `ids` (or all rows of `positions` when `ids` is null, count
     /// = positions.rows()). `origin` is subtracted before the float conversion. Returns false when a
     /// coordinate is non-finite or a cell coordinate is out of range (the caller diagnoses and throws).
@@ -125,17 +124,17 @@ public:
 
     // Structure of arrays in bucket order, padded by 8 entries at the end (padding never matches: NaN
     // coordinates; never read beyond) and then one spare entry per thread of a team build. 20 bytes per entry.
-    std::vector<float> x, y, z;          ///< coordinates relative to the origin, rounded to float
-    std::vector<std::int32_t> id;        ///< vertex id
-    std::vector<std::uint32_t> key;      ///< cell_key() of the entry's cell
-    std::vector<std::int32_t> start;     ///< n + 1 offsets
+    std::vector<float> x, y, z;      ///< coordinates relative to the origin, rounded to float
+    std::vector<std::int32_t> id;    ///< vertex id
+    std::vector<std::uint32_t> key;  ///< cell_key() of the entry's cell
+    std::vector<std::int32_t> start; ///< n + 1 offsets
 
-private:
+  private:
     TableModulus m_mod;
     Index m_count = 0;
-    std::vector<std::uint32_t> m_bucket;   ///< per input vertex
-    std::vector<std::uint32_t> m_key;      ///< per input vertex
-    std::vector<std::int32_t> m_cursor;    ///< team build: scatter cursor per bucket, then one spare slot per thread
+    std::vector<std::uint32_t> m_bucket; ///< per input vertex
+    std::vector<std::uint32_t> m_key;    ///< per input vertex
+    std::vector<std::int32_t> m_cursor;  ///< team build: scatter cursor per bucket, then one spare slot per thread
     int m_bad = 0;
 };
 

@@ -17,22 +17,23 @@
 namespace tethash {
 
 using Index = std::int32_t;
-using Positions = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;   ///< n × 3
-using Tets = Eigen::Matrix<Index, Eigen::Dynamic, 4, Eigen::RowMajor>;         ///< m × 4
-using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;    ///< k × 3
-using Edges = Eigen::Matrix<Index, Eigen::Dynamic, 2, Eigen::RowMajor>;        ///< e × 2
+using Positions = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>; ///< n × 3
+using Tets = Eigen::Matrix<Index, Eigen::Dynamic, 4, Eigen::RowMajor>;       ///< m × 4
+using Triangles = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;  ///< k × 3
+using Edges = Eigen::Matrix<Index, Eigen::Dynamic, 2, Eigen::RowMajor>;      ///< e × 2
 using PositionsRef = Eigen::Ref<const Positions>;
 using TetsRef = Eigen::Ref<const Tets>;
 
 /// One or several tetrahedral objects.
 struct TetMesh {
-    Positions positions;               ///< n × 3, current positions
-    Positions rest_positions;          ///< n × 3, rest state; empty means "same as positions"
-    Tets tets;                         ///< m × 4 vertex indices, 0-based
-    std::vector<Index> vertex_object;  ///< n object ids (empty: all 0)
-    std::vector<Index> tet_object;     ///< m object ids (empty: all 0)
-    std::vector<Index> tet_label;      ///< m labels from the file (Gmsh physical tag, Medit ref, TetGen attribute); empty if none
-    std::vector<Index> vertex_label;   ///< n labels from the file (Medit ref, TetGen marker); empty if none
+    Positions positions;              ///< n × 3, current positions
+    Positions rest_positions;         ///< n × 3, rest state; empty means "same as positions"
+    Tets tets;                        ///< m × 4 vertex indices, 0-based
+    std::vector<Index> vertex_object; ///< n object ids (empty: all 0)
+    std::vector<Index> tet_object;    ///< m object ids (empty: all 0)
+    std::vector<Index>
+        tet_label; ///< m labels from the file (Gmsh physical tag, Medit ref, TetGen attribute); empty if none
+    std::vector<Index> vertex_label; ///< n labels from the file (Medit ref, TetGen marker); empty if none
 
     Index num_vertices() const { return static_cast<Index>(positions.rows()); }
     Index num_tets() const { return static_cast<Index>(tets.rows()); }
@@ -53,17 +54,17 @@ double signed_volume(const PositionsRef& positions, const std::array<Index, 4>& 
 
 /// What validation found. Counts plus the first few offending ids of each kind.
 struct ValidationReport {
-    std::int64_t index_out_of_range = 0;   ///< tets with an index < 0 or ≥ n
-    std::int64_t repeated_index = 0;       ///< tets with a vertex twice
-    std::int64_t non_finite = 0;           ///< vertices with NaN/Inf coordinates
-    std::int64_t degenerate_tets = 0;      ///< |volume| ≤ eps · (mean edge)^3 (zero volume)
-    std::int64_t inverted_tets = 0;        ///< volume < 0 and not degenerate
+    std::int64_t index_out_of_range = 0; ///< tets with an index < 0 or ≥ n
+    std::int64_t repeated_index = 0;     ///< tets with a vertex twice
+    std::int64_t non_finite = 0;         ///< vertices with NaN/Inf coordinates
+    std::int64_t degenerate_tets = 0;    ///< |volume| ≤ eps · (mean edge)^3 (zero volume)
+    std::int64_t inverted_tets = 0;      ///< volume < 0 and not degenerate
     std::int64_t unreferenced_vertices = 0;
-    std::int64_t non_manifold_faces = 0;   ///< faces shared by more than two tets
-    std::vector<Index> first_bad_tets;     ///< up to 10 tet ids with any problem
-    std::vector<Index> first_bad_vertices; ///< up to 10 vertex ids with any problem
-    bool ok() const;                       ///< no fatal problem (range, repeat, non-finite)
-    std::vector<std::string> problems() const;   ///< human-readable lines, one per kind found
+    std::int64_t non_manifold_faces = 0;       ///< faces shared by more than two tets
+    std::vector<Index> first_bad_tets;         ///< up to 10 tet ids with any problem
+    std::vector<Index> first_bad_vertices;     ///< up to 10 vertex ids with any problem
+    bool ok() const;                           ///< no fatal problem (range, repeat, non-finite)
+    std::vector<std::string> problems() const; ///< human-readable lines, one per kind found
 };
 
 /// Full validation; never throws on bad content (only reports).

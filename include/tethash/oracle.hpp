@@ -28,7 +28,6 @@ struct OracleStats {
 std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const TetsRef& tets,
                                           std::span<const Index> vertex_object = {},
                                           std::span<const Index> tet_object = {},
-                                          std::span<const ObjectOptions> objects = {},
-                                          OracleStats* stats = nullptr);
+                                          std::span<const ObjectOptions> objects = {}, OracleStats* stats = nullptr);
 
 } // namespace tethash

@@ -26,19 +26,19 @@
 namespace tethash {
 
 struct PenetrationStats {
-    std::int64_t pairs = 0;          ///< distinct (vertex, penetrated object) pairs
-    std::int64_t border = 0;         ///< pairs valued from intersected edges (step 1)
-    std::int64_t propagated = 0;     ///< pairs valued by propagation (step 2)
-    std::int64_t fallback = 0;       ///< pairs valued by the closest-point fallback (step 3)
-    std::int64_t intersections = 0;  ///< edge/boundary intersections found
-    double ms = 0;                   ///< wall time of compute()
+    std::int64_t pairs = 0;         ///< distinct (vertex, penetrated object) pairs
+    std::int64_t border = 0;        ///< pairs valued from intersected edges (step 1)
+    std::int64_t propagated = 0;    ///< pairs valued by propagation (step 2)
+    std::int64_t fallback = 0;      ///< pairs valued by the closest-point fallback (step 3)
+    std::int64_t intersections = 0; ///< edge/boundary intersections found
+    double ms = 0;                  ///< wall time of compute()
 };
 
 class PenetrationImpl;
 
 /// Keeps the per-object boundary surfaces and the vertex adjacency of a topology between calls.
 class Penetration {
-public:
+  public:
     Penetration();
     ~Penetration();
     Penetration(Penetration&&) noexcept;
@@ -59,7 +59,7 @@ public:
     /// surface of the penetrated object (closest point over all its boundary triangles). Size = contacts.size().
     std::vector<double> exact_depths(const PositionsRef& positions, std::span<const Contact> contacts) const;
 
-private:
+  private:
     std::unique_ptr<PenetrationImpl> m_impl;
 };
 

@@ -22,9 +22,9 @@ inline constexpr double orient3d_error_bound = 8.0 * epsilon;
 
 /// Result of an orientation evaluation: the exact sign and an approximation of the value.
 struct Orientation {
-    int sign = 0;        ///< −1, 0 or +1: the sign of the exact determinant
-    double value = 0;    ///< floating-point approximation (0 exactly when sign == 0)
-    bool exact = false;  ///< true when the filter could not decide and exact arithmetic was used
+    int sign = 0;       ///< −1, 0 or +1: the sign of the exact determinant
+    double value = 0;   ///< floating-point approximation (0 exactly when sign == 0)
+    bool exact = false; ///< true when the filter could not decide and exact arithmetic was used
 };
 
 /// Exact orientation with filter. Points are 3 doubles each.
@@ -36,10 +36,10 @@ double orient3d_fast(const double* a, const double* b, const double* c, const do
 
 /// Closed inside test of point p in tet (a, b, c, d): exact.
 struct InsideResult {
-    bool degenerate = false; ///< the tet has zero volume (exact): never contains anything
-    bool inside = false;     ///< p lies in the closed tet (on faces, edges, corners included)
-    int exact_evaluations = 0;  ///< how many of the orientations needed exact arithmetic
-    double bary[4] = {0, 0, 0, 0};  ///< barycentric coordinates (valid when inside); exact zeros where p is on a face
+    bool degenerate = false;       ///< the tet has zero volume (exact): never contains anything
+    bool inside = false;           ///< p lies in the closed tet (on faces, edges, corners included)
+    int exact_evaluations = 0;     ///< how many of the orientations needed exact arithmetic
+    double bary[4] = {0, 0, 0, 0}; ///< barycentric coordinates (valid when inside); exact zeros where p is on a face
 };
 InsideResult inside_tet(const double* p, const double* a, const double* b, const double* c, const double* d);
 

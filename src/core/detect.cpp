@@ -34,8 +34,10 @@ HashFunction parse_hash_function(const std::string& name)
 const char* to_string(HashFunction h)
 {
     switch (h) {
-    case HashFunction::teschner: return "teschner";
-    case HashFunction::column: return "column";
+    case HashFunction::teschner:
+        return "teschner";
+    case HashFunction::column:
+        return "column";
     }
     return "?";
 }
@@ -108,8 +110,8 @@ void check_positions(const PositionsRef& positions, Index num_vertices)
     for (Eigen::Index v = 0; v < positions.rows(); ++v)
         if (!std::isfinite(positions(v, 0)) || !std::isfinite(positions(v, 1)) || !std::isfinite(positions(v, 2))) {
             std::ostringstream s;
-            s << "vertex " << v << " has a non-finite position (" << positions(v, 0) << ", " << positions(v, 1)
-              << ", " << positions(v, 2) << ")";
+            s << "vertex " << v << " has a non-finite position (" << positions(v, 0) << ", " << positions(v, 1) << ", "
+              << positions(v, 2) << ")";
             throw Error(s.str());
         }
 }
@@ -118,8 +120,10 @@ ObjectFlags object_flags(std::span<const Index> vertex_object, std::span<const I
                          std::span<const ObjectOptions> objects)
 {
     Index count = 1;
-    for (Index o : vertex_object) count = std::max(count, o + 1);
-    for (Index o : tet_object) count = std::max(count, o + 1);
+    for (Index o : vertex_object)
+        count = std::max(count, o + 1);
+    for (Index o : tet_object)
+        count = std::max(count, o + 1);
     ObjectFlags f;
     f.self_collision.assign(static_cast<std::size_t>(count), 1);
     f.is_static.assign(static_cast<std::size_t>(count), 0);
@@ -137,7 +141,10 @@ ObjectFlags object_flags(std::span<const Index> vertex_object, std::span<const I
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+double ms_since(Clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
 
 /// A contact before the merge: 40 bytes.
 struct RawContact {
@@ -152,8 +159,8 @@ struct CandidateRun {
 };
 
 struct Counters {
-    std::int64_t cells = 0, scanned = 0, collisions = 0, box_rejections = 0, own = 0, inside_tests = 0,
-                 exact = 0, degenerate = 0;
+    std::int64_t cells = 0, scanned = 0, collisions = 0, box_rejections = 0, own = 0, inside_tests = 0, exact = 0,
+                 degenerate = 0;
     void add(const Counters& o)
     {
         cells += o.cells;
@@ -168,14 +175,14 @@ struct Counters {
 };
 
 struct alignas(64) ThreadState {
-    std::vector<Index> candidates;      // grown only, never shrunk; `used` entries valid
+    std::vector<Index> candidates; // grown only, never shrunk; `used` entries valid
     std::size_t used = 0;
-    std::vector<double> values;         // stage 3: 4 plane values per candidate of a run
-    std::vector<std::int8_t> codes;     // stage 3: filter outcome per candidate of a run
-    std::vector<CandidateRun> runs;     // grown only; `num_runs` entries valid
+    std::vector<double> values;     // stage 3: 4 plane values per candidate of a run
+    std::vector<std::int8_t> codes; // stage 3: filter outcome per candidate of a run
+    std::vector<CandidateRun> runs; // grown only; `num_runs` entries valid
     std::size_t num_runs = 0;
     std::vector<RawContact> contacts;
-    std::vector<RawContact> sorted;         // radix sort buffer
+    std::vector<RawContact> sorted; // radix sort buffer
     Counters counters;
     double ms_tets = 0, ms_inside = 0, ms_sort = 0;
     bool too_many_cells = false;
@@ -207,7 +214,7 @@ constexpr std::int64_t max_cells_per_tet = std::int64_t{1} << 24;
 } // namespace
 
 class DetectorImpl {
-public:
+  public:
     DetectParams params;
     // topology
     Index num_vertices = 0;
@@ -220,22 +227,22 @@ public:
     // per-scene state fixed at the first detect() after set_topology/set_params
     bool prepared = false;
     double cell_size = 0;
-    double inv_cell = 1;   // 1 / cell_size, the one factor both the vertex table and the tet boxes use
+    double inv_cell = 1; // 1 / cell_size, the one factor both the vertex table and the tet boxes use
     double origin[3] = {0, 0, 0};
     std::int64_t table_sizes[2] = {1, 1};
-    VertexTable tables[2];   // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
-    double skin = 0;         // candidate reuse: tet boxes inflated by skin (length; 0 = off)
-    double reuse_limit = 0;  // largest per-axis displacement that still allows reuse (just below skin / 2)
+    VertexTable tables[2];  // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
+    double skin = 0;        // candidate reuse: tet boxes inflated by skin (length; 0 = off)
+    double reuse_limit = 0; // largest per-axis displacement that still allows reuse (just below skin / 2)
     // candidate cache (skin > 0): the kept candidates are the threads' candidate runs of the last full detection
     bool cache_valid = false;
     int cache_threads = 0;
-    std::vector<double> reference;   // positions of the moving vertices at the last full detection (dynamic order)
-    std::vector<ChunkRuns> chunks;   // per chunk of chunk_tets tets: the thread holding its runs and which
-    std::vector<std::int64_t> last_chunk;   // keep_for_reuse: per thread, its last chunk so far
+    std::vector<double> reference;        // positions of the moving vertices at the last full detection (dynamic order)
+    std::vector<ChunkRuns> chunks;        // per chunk of chunk_tets tets: the thread holding its runs and which
+    std::vector<std::int64_t> last_chunk; // keep_for_reuse: per thread, its last chunk so far
     // buffers
     std::vector<ThreadState> threads;
     std::vector<Contact> contacts;
-    std::vector<std::size_t> merge_pos;   // merge: next contact of each thread's run
+    std::vector<std::size_t> merge_pos; // merge: next contact of each thread's run
 
     void prepare(const PositionsRef& positions);
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
@@ -253,7 +260,9 @@ void DetectorImpl::prepare(const PositionsRef& positions)
     detail::check_positions(positions, num_vertices);
     const Eigen::Map<const Tets> tet_map(tets.data(), static_cast<Eigen::Index>(tets.size() / 4), 4);
     switch (params.cell_size_mode) {
-    case DetectParams::CellSizeMode::absolute: cell_size = params.cell_size; break;
+    case DetectParams::CellSizeMode::absolute:
+        cell_size = params.cell_size;
+        break;
     case DetectParams::CellSizeMode::auto_mean_edge:
     case DetectParams::CellSizeMode::factor_of_mean_edge: {
         const double mean = mean_edge_length(positions, tet_map);
@@ -278,7 +287,8 @@ void DetectorImpl::prepare(const PositionsRef& positions)
     cache_valid = false;
     if (num_vertices > 0) {
         const Eigen::RowVector3d lo = positions.colwise().minCoeff(), hi = positions.colwise().maxCoeff();
-        for (int a = 0; a < 3; ++a) origin[a] = 0.5 * (lo(a) + hi(a));
+        for (int a = 0; a < 3; ++a)
+            origin[a] = 0.5 * (lo(a) + hi(a));
     }
     const std::int64_t counts[2] = {static_cast<std::int64_t>(dynamic_ids.size()),
                                     static_cast<std::int64_t>(static_ids.size())};
@@ -293,7 +303,7 @@ void DetectorImpl::prepare(const PositionsRef& positions)
 
 void DetectorImpl::diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const
 {
-    detail::check_positions(positions, num_vertices);   // non-finite first
+    detail::check_positions(positions, num_vertices); // non-finite first
     for (Index i = 0; i < count; ++i) {
         const Index v = ids ? ids[i] : i;
         for (int a = 0; a < 3; ++a)
@@ -310,16 +320,16 @@ void DetectorImpl::diagnose_build_failure(const PositionsRef& positions, const I
 std::int64_t DetectorImpl::memory_bytes() const
 {
     std::int64_t m = static_cast<std::int64_t>(tets.capacity() + vertex_object.capacity() + tet_object.capacity() +
-                                               dynamic_ids.capacity() + static_ids.capacity()) * 4;
+                                               dynamic_ids.capacity() + static_ids.capacity()) *
+                     4;
     m += tables[0].memory_bytes() + tables[1].memory_bytes();
     m += static_cast<std::int64_t>(reference.capacity() * sizeof(double) + chunks.capacity() * sizeof(ChunkRuns) +
                                    last_chunk.capacity() * sizeof(std::int64_t));
     for (const ThreadState& ts : threads)
-        m += static_cast<std::int64_t>(ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() +
-                                       ts.values.capacity() * sizeof(double) +
-                                       ts.runs.capacity() * sizeof(CandidateRun) +
-                                       ts.contacts.capacity() * sizeof(RawContact) +
-                                       ts.sorted.capacity() * sizeof(RawContact) + sizeof(ThreadState));
+        m += static_cast<std::int64_t>(
+            ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() + ts.values.capacity() * sizeof(double) +
+            ts.runs.capacity() * sizeof(CandidateRun) + ts.contacts.capacity() * sizeof(RawContact) +
+            ts.sorted.capacity() * sizeof(RawContact) + sizeof(ThreadState));
     return m;
 }
 
@@ -351,7 +361,8 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         q.lo[k] = static_cast<float>(lo - origin[k]);
         q.hi[k] = static_cast<float>(hi - origin[k]);
     }
-    for (int k = 0; k < 4; ++k) q.own[k] = tv[k];
+    for (int k = 0; k < 4; ++k)
+        q.own[k] = tv[k];
     const std::int64_t nx = std::int64_t{c1[0]} - c0[0] + 1, ny = std::int64_t{c1[1]} - c0[1] + 1,
                        nz = std::int64_t{c1[2]} - c0[2] + 1;
     const bool column = params.hash == HashFunction::column;
@@ -384,10 +395,10 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         std::size_t total = 0;
         auto flush = [&]() {
             if (nr == 0) return;
-            const std::size_t need = ts.used + total + 8;   // the AVX2 scan stores 8 ids at a time
+            const std::size_t need = ts.used + total + 8; // the AVX2 scan stores 8 ids at a time
             if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
-            ts.used += static_cast<std::size_t>(
-                detail::scan_ranges(table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats, exact, inv_cell));
+            ts.used += static_cast<std::size_t>(detail::scan_ranges(
+                table, ranges, nr, q, ts.candidates.data() + ts.used, sc, with_stats, exact, inv_cell));
             nr = 0;
             total = 0;
         };
@@ -491,7 +502,7 @@ void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::
         const double* C = P + 3 * static_cast<std::size_t>(tv[2]);
         const double* D = P + 3 * static_cast<std::size_t>(tv[3]);
         const Index* cand = candidates + run.begin;
-        const std::int32_t count = run.end - run.begin;   // > 0; the self-collision rule was applied in stage 2
+        const std::int32_t count = run.end - run.begin; // > 0; the self-collision rule was applied in stage 2
         // Face planes with the tet's orientation folded in (AVX2: four faces in four lanes); the orientation's
         // exact sign comes from face 3's plane at D.
         detail::FacePlanes f;
@@ -518,10 +529,18 @@ void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::
                     if (!(code & (1 << i))) continue;
                     predicates::Orientation e;
                     switch (i) {
-                    case 0: e = predicates::orient3d_exact(p, B, C, D); break;
-                    case 1: e = predicates::orient3d_exact(A, p, C, D); break;
-                    case 2: e = predicates::orient3d_exact(A, B, p, D); break;
-                    default: e = predicates::orient3d_exact(A, B, C, p); break;
+                    case 0:
+                        e = predicates::orient3d_exact(p, B, C, D);
+                        break;
+                    case 1:
+                        e = predicates::orient3d_exact(A, p, C, D);
+                        break;
+                    case 2:
+                        e = predicates::orient3d_exact(A, B, p, D);
+                        break;
+                    default:
+                        e = predicates::orient3d_exact(A, B, C, p);
+                        break;
                     }
                     ++ts.counters.exact;
                     if (e.sign * tet_sign < 0) outside = true;
@@ -533,7 +552,8 @@ void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::
             RawContact rc;
             rc.vertex = v;
             rc.tet = t;
-            for (int i = 0; i < 4; ++i) rc.bary[i] = val[i] == 0.0 ? 0.0 : val[i] / sum;
+            for (int i = 0; i < 4; ++i)
+                rc.bary[i] = val[i] == 0.0 ? 0.0 : val[i] / sum;
             ts.contacts.push_back(rc);
         }
     }
@@ -556,8 +576,9 @@ bool DetectorImpl::moved_less_than_limit(const double* P, int T) const
         if (far) continue;
         const std::int64_t i0 = b * block, i1 = std::min(n, i0 + block);
         int bad = 0;
-        if (!any_static) {   // all vertices move: one contiguous pass over both arrays
-            for (std::int64_t i = 3 * i0; i < 3 * i1; ++i) bad |= !(std::fabs(P[i] - R[i]) < h);
+        if (!any_static) { // all vertices move: one contiguous pass over both arrays
+            for (std::int64_t i = 3 * i0; i < 3 * i1; ++i)
+                bad |= !(std::fabs(P[i] - R[i]) < h);
         } else {
             for (std::int64_t i = i0; i < i1; ++i) {
                 const double* p = P + 3 * static_cast<std::size_t>(ids[i]);
@@ -577,11 +598,13 @@ void DetectorImpl::keep_for_reuse(const double* P, Index m)
 {
     const std::size_t n = dynamic_ids.size();
     reference.resize(3 * n);
-    if (!any_static) std::copy(P, P + 3 * n, reference.data());
+    if (!any_static)
+        std::copy(P, P + 3 * n, reference.data());
     else
         for (std::size_t i = 0; i < n; ++i)
             for (int a = 0; a < 3; ++a)
-                reference[3 * i + static_cast<std::size_t>(a)] = P[3 * static_cast<std::size_t>(dynamic_ids[i]) + static_cast<std::size_t>(a)];
+                reference[3 * i + static_cast<std::size_t>(a)] =
+                    P[3 * static_cast<std::size_t>(dynamic_ids[i]) + static_cast<std::size_t>(a)];
     const std::size_t num_chunks = static_cast<std::size_t>((m + chunk_tets - 1) / chunk_tets);
     last_chunk.assign(threads.size(), -1);
     for (std::size_t k = 0; k < num_chunks; ++k) {
@@ -609,14 +632,16 @@ static void sort_own_contacts(ThreadState& ts, Index num_vertices)
     RawContact* dst = ts.sorted.data();
     for (int shift = 0; shift < 31 && (num_vertices - 1) >> shift; shift += 11) {
         std::int32_t count[2048] = {};
-        for (std::size_t i = 0; i < n; ++i) ++count[(src[i].vertex >> shift) & 2047];
+        for (std::size_t i = 0; i < n; ++i)
+            ++count[(src[i].vertex >> shift) & 2047];
         std::int32_t sum = 0;
         for (std::int32_t& c : count) {
             const std::int32_t k = c;
             c = sum;
             sum += k;
         }
-        for (std::size_t i = 0; i < n; ++i) dst[count[(src[i].vertex >> shift) & 2047]++] = src[i];
+        for (std::size_t i = 0; i < n; ++i)
+            dst[count[(src[i].vertex >> shift) & 2047]++] = src[i];
         std::swap(src, dst);
     }
     if (src != ts.contacts.data()) std::copy(src, src + n, ts.contacts.data());
@@ -677,9 +702,9 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
                     for (Index t = k * chunk_tets; t < std::min(m, (k + 1) * chunk_tets); ++t) {
                         const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
                         ts.counters.degenerate += predicates::orient3d(P + 3 * static_cast<std::size_t>(tv[0]),
-                                                                      P + 3 * static_cast<std::size_t>(tv[1]),
-                                                                      P + 3 * static_cast<std::size_t>(tv[2]),
-                                                                      P + 3 * static_cast<std::size_t>(tv[3]))
+                                                                       P + 3 * static_cast<std::size_t>(tv[1]),
+                                                                       P + 3 * static_cast<std::size_t>(tv[2]),
+                                                                       P + 3 * static_cast<std::size_t>(tv[3]))
                                                       .sign == 0;
                     }
             }
@@ -706,7 +731,7 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
             const int rank = detail::team_rank();
             ThreadState& ts = threads[static_cast<std::size_t>(rank)];
             bool ok = built;
-            if (team_build) {   // every thread gets the same answer
+            if (team_build) { // every thread gets the same answer
                 ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
                 if (rank == 0) {
                     built = ok;
@@ -718,8 +743,9 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
                 const bool keep = skin > 0;
 #pragma omp for schedule(monotonic : dynamic, chunk_tets) nowait
                 for (Index t = 0; t < m; ++t) {
-                    if (keep && t % chunk_tets == 0)   // a chunk starts: remember where its runs go
-                        chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank, static_cast<std::int32_t>(ts.num_runs), 0};
+                    if (keep && t % chunk_tets == 0) // a chunk starts: remember where its runs go
+                        chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank,
+                                                                            static_cast<std::int32_t>(ts.num_runs), 0};
                     stage_tets(ts, t, P, with_stats);
                 }
                 ts.ms_tets = ms_since(t0);
@@ -746,7 +772,8 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     const auto t_merge = Clock::now();
     {
         std::size_t total = 0;
-        for (const ThreadState& ts : threads) total += ts.contacts.size();
+        for (const ThreadState& ts : threads)
+            total += ts.contacts.size();
         contacts.resize(total);
         merge_pos.assign(threads.size(), 0);
         std::size_t* pos = merge_pos.data();
@@ -770,13 +797,15 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
             c.tet = rc.tet;
             c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
             c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
-            for (int k = 0; k < 4; ++k) c.bary[k] = rc.bary[k];
+            for (int k = 0; k < 4; ++k)
+                c.bary[k] = rc.bary[k];
             c.depth = std::numeric_limits<double>::quiet_NaN();
             c.direction[0] = c.direction[1] = c.direction[2] = 0;
         }
     }
     double ms_sort = ms_since(t_merge);
-    for (const ThreadState& ts : threads) ms_sort_own = std::max(ms_sort_own, ts.ms_sort);
+    for (const ThreadState& ts : threads)
+        ms_sort_own = std::max(ms_sort_own, ts.ms_sort);
 
     if (stats) {
         Counters sum;
@@ -808,7 +837,8 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         s.skin = skin;
         s.reused = reuse ? 1 : 0;
         if (skin > 0)
-            for (const ThreadState& ts : threads) s.cached_candidates += static_cast<std::int64_t>(ts.used);
+            for (const ThreadState& ts : threads)
+                s.cached_candidates += static_cast<std::int64_t>(ts.used);
         s.ms_total = ms_since(t_start);
     }
     return contacts;
@@ -858,7 +888,10 @@ void Detector::set_params(const DetectParams& params)
     m_impl->prepared = false;
 }
 
-const DetectParams& Detector::params() const { return m_impl->params; }
+const DetectParams& Detector::params() const
+{
+    return m_impl->params;
+}
 
 void Detector::set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
                             std::span<const Index> tet_object, std::span<const ObjectOptions> objects)
@@ -869,7 +902,8 @@ void Detector::set_topology(const TetsRef& tets, Index num_vertices, std::span<c
     d.num_vertices = num_vertices;
     d.tets.resize(4 * static_cast<std::size_t>(m));
     for (Index t = 0; t < m; ++t)
-        for (int k = 0; k < 4; ++k) d.tets[4 * static_cast<std::size_t>(t) + k] = tets(t, k);
+        for (int k = 0; k < 4; ++k)
+            d.tets[4 * static_cast<std::size_t>(t) + k] = tets(t, k);
     d.vertex_object.assign(vertex_object.begin(), vertex_object.end());
     if (d.vertex_object.empty()) d.vertex_object.assign(static_cast<std::size_t>(num_vertices), 0);
     d.tet_object.assign(tet_object.begin(), tet_object.end());
@@ -882,7 +916,7 @@ void Detector::set_topology(const TetsRef& tets, Index num_vertices, std::span<c
     d.static_ids.clear();
     for (Index v = 0; v < num_vertices; ++v)
         (d.flags.is_static[static_cast<std::size_t>(d.vertex_object[static_cast<std::size_t>(v)])] ? d.static_ids
-                                                                                                     : d.dynamic_ids)
+                                                                                                   : d.dynamic_ids)
             .push_back(v);
     d.prepared = false;
 }
@@ -897,6 +931,9 @@ const std::vector<Contact>& Detector::detect(const PositionsRef& positions, Dete
     return m_impl->detect(positions, stats);
 }
 
-std::vector<Contact>& Detector::contacts() { return m_impl->contacts; }
+std::vector<Contact>& Detector::contacts()
+{
+    return m_impl->contacts;
+}
 
 } // namespace tethash

@@ -16,8 +16,8 @@ void check_positions(const PositionsRef& positions, Index num_vertices);
 
 /// Per-object flags expanded to the number of objects in use (1 + largest id; ids ≥ objects.size() get defaults).
 struct ObjectFlags {
-    std::vector<unsigned char> self_collision;  ///< per object
-    std::vector<unsigned char> is_static;       ///< per object
+    std::vector<unsigned char> self_collision; ///< per object
+    std::vector<unsigned char> is_static;      ///< per object
 };
 ObjectFlags object_flags(std::span<const Index> vertex_object, std::span<const Index> tet_object,
                          std::span<const ObjectOptions> objects);

@@ -9,7 +9,6 @@
 #include <cstring>
 #include <limits>
 
-
 namespace tethash {
 
 std::int64_t next_prime(std::int64_t n)
@@ -31,7 +30,8 @@ std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices)
     const std::int64_t want = std::max<std::int64_t>(2 * vertices, 1);
     if (hash == HashFunction::teschner) return std::min(next_prime(want), max_table_size);
     std::int64_t n = 1;
-    while (n < want && n < max_table_size) n <<= 1;
+    while (n < want && n < max_table_size)
+        n <<= 1;
     return n;
 }
 
@@ -47,7 +47,10 @@ namespace {
 constexpr Index team_build_min_per_thread = 32768;
 /// Most threads the team build splits over (each spare entry and cursor slot is per thread).
 constexpr int team_build_max_parts = 16;
-int build_parts(Index count, int size) { return VertexTable::team_parts(count, size); }
+int build_parts(Index count, int size)
+{
+    return VertexTable::team_parts(count, size);
+}
 constexpr std::size_t padding = 8;
 } // namespace
 
@@ -61,7 +64,8 @@ void VertexTable::reserve(Index count, std::int64_t table_size, int threads)
 {
     const std::size_t padded = static_cast<std::size_t>(count) + padding + team_build_max_parts;
     if (x.size() != padded) {
-        for (auto* v : {&x, &y, &z}) v->assign(padded, std::numeric_limits<float>::quiet_NaN());
+        for (auto* v : {&x, &y, &z})
+            v->assign(padded, std::numeric_limits<float>::quiet_NaN());
         id.assign(padded, std::numeric_limits<std::int32_t>::min());
         key.assign(padded, 0);
     }
@@ -117,9 +121,9 @@ bool VertexTable::build_team(const double* positions, const Index* ids, Index co
             }
             const std::int32_t ix = floor_to_int(sx), iy = floor_to_int(sy), iz = floor_to_int(sz);
             m_key[static_cast<std::size_t>(i)] = cell_key(ix, iy, iz);
-            m_bucket[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(
-                hash == HashFunction::column ? mod.column_bucket(column_mix(ix, iy), iz)
-                                             : mod.reduce(teschner_hash(ix, iy, iz)));
+            m_bucket[static_cast<std::size_t>(i)] =
+                static_cast<std::uint32_t>(hash == HashFunction::column ? mod.column_bucket(column_mix(ix, iy), iz)
+                                                                        : mod.reduce(teschner_hash(ix, iy, iz)));
         }
         return bad;
     };
@@ -154,9 +158,12 @@ bool VertexTable::build_team(const double* positions, const Index* ids, Index co
             bad = cells(0, count);
             if (!bad) {
                 std::memset(s, 0, (static_cast<std::size_t>(table_size) + 1) * sizeof(std::int32_t));
-                for (Index i = 0; i < count; ++i) ++s[bucket[i] + 1];
-                for (std::int64_t b = 0; b < table_size; ++b) s[b + 1] += s[b];
-                for (Index i = 0; i < count; ++i) put(i, static_cast<std::size_t>(s[bucket[i]]++));
+                for (Index i = 0; i < count; ++i)
+                    ++s[bucket[i] + 1];
+                for (std::int64_t b = 0; b < table_size; ++b)
+                    s[b + 1] += s[b];
+                for (Index i = 0; i < count; ++i)
+                    put(i, static_cast<std::size_t>(s[bucket[i]]++));
                 // start[b] now holds the end of bucket b: shift right by one.
                 std::memmove(s + 1, s, static_cast<std::size_t>(table_size) * sizeof(std::int32_t));
                 s[0] = 0;
@@ -181,7 +188,8 @@ bool VertexTable::build_team(const double* positions, const Index* ids, Index co
         detail::team_split(table_size, rank, parts, b0, b1);
         const auto lo = static_cast<std::uint32_t>(b0), width = static_cast<std::uint32_t>(b1 - b0);
         std::int32_t* cur = m_cursor.data();
-        const std::uint32_t spare_cursor = static_cast<std::uint32_t>(table_size) + 16 * static_cast<std::uint32_t>(rank);
+        const std::uint32_t spare_cursor =
+            static_cast<std::uint32_t>(table_size) + 16 * static_cast<std::uint32_t>(rank);
         const std::size_t spare_entry = static_cast<std::size_t>(count) + padding + static_cast<std::size_t>(rank);
         std::memset(cur + b0, 0, static_cast<std::size_t>(b1 - b0) * sizeof(std::int32_t));
         std::int32_t below = 0;

@@ -42,7 +42,10 @@ std::vector<FaceKey> sorted_faces(const TetsRef& tets)
     return faces;
 }
 
-Eigen::Vector3d row(const PositionsRef& p, Index i) { return p.row(i).transpose(); }
+Eigen::Vector3d row(const PositionsRef& p, Index i)
+{
+    return p.row(i).transpose();
+}
 
 } // namespace
 
@@ -50,8 +53,10 @@ Index TetMesh::num_objects() const
 {
     if (positions.rows() == 0 && tets.rows() == 0) return 0;
     Index mx = 0;
-    for (Index o : vertex_object) mx = std::max(mx, o);
-    for (Index o : tet_object) mx = std::max(mx, o);
+    for (Index o : vertex_object)
+        mx = std::max(mx, o);
+    for (Index o : tet_object)
+        mx = std::max(mx, o);
     return mx + 1;
 }
 
@@ -91,7 +96,8 @@ void TetMesh::append(const TetMesh& other)
     const bool labels_t = !tet_label.empty() || !other.tet_label.empty();
     if (labels_t) {
         tet_label.resize(static_cast<std::size_t>(tets.rows() - other.tets.rows()), 0);
-        for (Index i = 0; i < other.num_tets(); ++i) tet_label.push_back(other.tet_label.empty() ? 0 : other.tet_label[i]);
+        for (Index i = 0; i < other.num_tets(); ++i)
+            tet_label.push_back(other.tet_label.empty() ? 0 : other.tet_label[i]);
     }
     const bool labels_v = !vertex_label.empty() || !other.vertex_label.empty();
     if (labels_v) {
@@ -122,9 +128,11 @@ LabelSplit split_objects_by_label(TetMesh& mesh, SharedLabelVertices shared, con
     };
     // Union-find over label indices (used by join only); a vertex records the first label seen.
     std::vector<std::size_t> parent(k);
-    for (std::size_t i = 0; i < k; ++i) parent[i] = i;
+    for (std::size_t i = 0; i < k; ++i)
+        parent[i] = i;
     auto find = [&](std::size_t i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        while (parent[i] != i)
+            i = parent[i] = parent[parent[i]];
         return i;
     };
     constexpr std::size_t none = static_cast<std::size_t>(-1);
@@ -139,15 +147,17 @@ LabelSplit split_objects_by_label(TetMesh& mesh, SharedLabelVertices shared, con
             } else if (vertex_label[v] != li) {
                 if (shared == SharedLabelVertices::error)
                     throw Error(what + ": vertex " + std::to_string(v) + " is in tets of label " +
-                                std::to_string(labels[vertex_label[v]]) + " and of label " + std::to_string(labels[li]) +
-                                " (tet " + std::to_string(t) + "): these labels are not separate bodies");
+                                std::to_string(labels[vertex_label[v]]) + " and of label " +
+                                std::to_string(labels[li]) + " (tet " + std::to_string(t) +
+                                "): these labels are not separate bodies");
                 vertex_shared[v] = 1;
                 const std::size_t a = find(vertex_label[v]), b = find(li);
                 if (a != b) parent[std::max(a, b)] = std::min(a, b);
             }
         }
     }
-    for (char c : vertex_shared) out.shared_vertices += c;
+    for (char c : vertex_shared)
+        out.shared_vertices += c;
     // Objects numbered by their smallest label (roots are the smallest index of their set).
     std::vector<Index> object_of_root(k, -1);
     for (std::size_t i = 0; i < k; ++i) {
@@ -160,7 +170,8 @@ LabelSplit split_objects_by_label(TetMesh& mesh, SharedLabelVertices shared, con
     }
     mesh.tet_object.resize(static_cast<std::size_t>(m));
     for (Index t = 0; t < m; ++t)
-        mesh.tet_object[static_cast<std::size_t>(t)] = object_of_root[find(label_index(mesh.tet_label[static_cast<std::size_t>(t)]))];
+        mesh.tet_object[static_cast<std::size_t>(t)] =
+            object_of_root[find(label_index(mesh.tet_label[static_cast<std::size_t>(t)]))];
     mesh.vertex_object.resize(static_cast<std::size_t>(n));
     for (Index v = 0; v < n; ++v) {
         const std::size_t li = vertex_label[static_cast<std::size_t>(v)];
@@ -190,8 +201,8 @@ void TetMesh::check_consistency(const std::string& what) const
             const Index v = tets(t, k);
             if (v < 0 || v >= n)
                 throw Error(what + ": tet " + std::to_string(t) + " refers to vertex " + std::to_string(v) +
-                            ", but there are " + std::to_string(n) + " vertices (valid: 0.." +
-                            std::to_string(n - 1) + ")");
+                            ", but there are " + std::to_string(n) + " vertices (valid: 0.." + std::to_string(n - 1) +
+                            ")");
         }
     for (std::size_t i = 0; i < vertex_object.size(); ++i)
         if (vertex_object[i] < 0)
@@ -199,7 +210,8 @@ void TetMesh::check_consistency(const std::string& what) const
                         std::to_string(vertex_object[i]));
     for (std::size_t i = 0; i < tet_object.size(); ++i)
         if (tet_object[i] < 0)
-            throw Error(what + ": tet " + std::to_string(i) + " has negative object id " + std::to_string(tet_object[i]));
+            throw Error(what + ": tet " + std::to_string(i) + " has negative object id " +
+                        std::to_string(tet_object[i]));
 }
 
 double signed_volume(const PositionsRef& p, const std::array<Index, 4>& t)
@@ -214,12 +226,16 @@ bool is_degenerate(const PositionsRef& p, const std::array<Index, 4>& t, double 
 {
     double longest = 0;
     for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (row(p, t[i]) - row(p, t[j])).norm());
+        for (int j = i + 1; j < 4; ++j)
+            longest = std::max(longest, (row(p, t[i]) - row(p, t[j])).norm());
     return std::abs(vol) <= 1e-12 * longest * longest * longest;
 }
 } // namespace
 
-bool ValidationReport::ok() const { return index_out_of_range == 0 && repeated_index == 0 && non_finite == 0; }
+bool ValidationReport::ok() const
+{
+    return index_out_of_range == 0 && repeated_index == 0 && non_finite == 0;
+}
 
 std::vector<std::string> ValidationReport::problems() const
 {
@@ -242,8 +258,7 @@ ValidationReport validate(const TetMesh& mesh)
     ValidationReport r;
     const Index n = mesh.num_vertices(), m = mesh.num_tets();
     auto note_tet = [&](Index t) {
-        if (r.first_bad_tets.size() < 10 &&
-            (r.first_bad_tets.empty() || r.first_bad_tets.back() != t))
+        if (r.first_bad_tets.size() < 10 && (r.first_bad_tets.empty() || r.first_bad_tets.back() != t))
             r.first_bad_tets.push_back(t);
     };
     auto note_vertex = [&](Index v) {
@@ -269,10 +284,12 @@ ValidationReport validate(const TetMesh& mesh)
             note_tet(t);
             continue;
         }
-        for (Index v : tet) used[v] = 1;
+        for (Index v : tet)
+            used[v] = 1;
         bool repeated = false;
         for (int i = 0; i < 4; ++i)
-            for (int j = i + 1; j < 4; ++j) repeated |= tet[i] == tet[j];
+            for (int j = i + 1; j < 4; ++j)
+                repeated |= tet[i] == tet[j];
         if (repeated) {
             ++r.repeated_index;
             note_tet(t);
@@ -296,11 +313,13 @@ ValidationReport validate(const TetMesh& mesh)
         }
     // Non-manifold faces among the tets whose indices are valid.
     Tets valid(static_cast<Eigen::Index>(good_tets.size()), 4);
-    for (std::size_t i = 0; i < good_tets.size(); ++i) valid.row(static_cast<Eigen::Index>(i)) = mesh.tets.row(good_tets[i]);
+    for (std::size_t i = 0; i < good_tets.size(); ++i)
+        valid.row(static_cast<Eigen::Index>(i)) = mesh.tets.row(good_tets[i]);
     const auto faces = sorted_faces(valid);
     for (std::size_t i = 0; i < faces.size();) {
         std::size_t j = i;
-        while (j < faces.size() && faces[j].sorted == faces[i].sorted) ++j;
+        while (j < faces.size() && faces[j].sorted == faces[i].sorted)
+            ++j;
         if (j - i > 2) {
             ++r.non_manifold_faces;
             note_tet(good_tets[static_cast<std::size_t>(faces[i].slot / 4)]);
@@ -317,7 +336,8 @@ std::int64_t reorient_inverted(TetMesh& mesh)
     for (Index t = 0; t < mesh.num_tets(); ++t) {
         const auto tet = tet_at(mesh.tets, t);
         bool ok = true;
-        for (Index v : tet) ok &= v >= 0 && v < n;
+        for (Index v : tet)
+            ok &= v >= 0 && v < n;
         if (!ok) continue;
         const double vol = signed_volume(mesh.positions, tet);
         if (vol < 0 && !is_degenerate(mesh.positions, tet, vol)) {
@@ -356,7 +376,8 @@ Triangles boundary_faces(const TetsRef& tets)
     std::vector<std::int64_t> boundary;
     for (std::size_t i = 0; i < faces.size();) {
         std::size_t j = i;
-        while (j < faces.size() && faces[j].sorted == faces[i].sorted) ++j;
+        while (j < faces.size() && faces[j].sorted == faces[i].sorted)
+            ++j;
         if (j - i == 1) boundary.push_back(faces[i].slot);
         i = j;
     }
@@ -365,7 +386,8 @@ Triangles boundary_faces(const TetsRef& tets)
     for (std::size_t i = 0; i < boundary.size(); ++i) {
         const Index t = static_cast<Index>(boundary[i] / 4);
         const int f = static_cast<int>(boundary[i] % 4);
-        for (int k = 0; k < 3; ++k) out(static_cast<Eigen::Index>(i), k) = tets(t, kFace[f][k]);
+        for (int k = 0; k < 3; ++k)
+            out(static_cast<Eigen::Index>(i), k) = tets(t, kFace[f][k]);
     }
     return out;
 }
@@ -377,10 +399,13 @@ Adjacency build_csr(Index n, std::vector<std::pair<Index, Index>>& pairs)
     pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
     Adjacency a;
     a.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
-    for (const auto& [u, v] : pairs) ++a.offsets[static_cast<std::size_t>(u) + 1];
-    for (Index i = 0; i < n; ++i) a.offsets[i + 1] += a.offsets[i];
+    for (const auto& [u, v] : pairs)
+        ++a.offsets[static_cast<std::size_t>(u) + 1];
+    for (Index i = 0; i < n; ++i)
+        a.offsets[i + 1] += a.offsets[i];
     a.neighbours.reserve(pairs.size());
-    for (const auto& p : pairs) a.neighbours.push_back(p.second);
+    for (const auto& p : pairs)
+        a.neighbours.push_back(p.second);
     return a;
 }
 } // namespace
@@ -401,7 +426,8 @@ Adjacency vertex_tets(const TetsRef& tets, Index num_vertices)
     std::vector<std::pair<Index, Index>> pairs;
     pairs.reserve(static_cast<std::size_t>(tets.rows()) * 4);
     for (Index t = 0; t < tets.rows(); ++t)
-        for (int i = 0; i < 4; ++i) pairs.emplace_back(tets(t, i), t);
+        for (int i = 0; i < 4; ++i)
+            pairs.emplace_back(tets(t, i), t);
     return build_csr(num_vertices, pairs);
 }
 
@@ -443,7 +469,8 @@ TetQuality tet_quality(const PositionsRef& p, const std::array<Index, 4>& t)
 {
     TetQuality q;
     Eigen::Vector3d x[4];
-    for (int i = 0; i < 4; ++i) x[i] = row(p, t[i]);
+    for (int i = 0; i < 4; ++i)
+        x[i] = row(p, t[i]);
     // Outward face normals (for a positively oriented tet); face f is opposite vertex f.
     Eigen::Vector3d nrm[4];
     double area_sum = 0;
@@ -473,7 +500,8 @@ TetQuality tet_quality(const PositionsRef& p, const std::array<Index, 4>& t)
             q.max_dihedral_deg = std::max(q.max_dihedral_deg, angle);
         }
     const double inradius = area_sum > 0 ? 3.0 * vol / area_sum : 0.0;
-    q.aspect_ratio = inradius > 0 ? longest / (2.0 * std::sqrt(6.0) * inradius) : std::numeric_limits<double>::infinity();
+    q.aspect_ratio =
+        inradius > 0 ? longest / (2.0 * std::sqrt(6.0) * inradius) : std::numeric_limits<double>::infinity();
     return q;
 }
 

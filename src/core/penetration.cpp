@@ -19,11 +19,14 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 
 struct Face {
-    Index v[3];   ///< oriented by the caller at use: normal flipped away from `opp`
-    Index opp;    ///< the fourth vertex of the tet the face belongs to (inside)
+    Index v[3]; ///< oriented by the caller at use: normal flipped away from `opp`
+    Index opp;  ///< the fourth vertex of the tet the face belongs to (inside)
 };
 
-Vec3 pos(const PositionsRef& x, Index i) { return x.row(i).transpose(); }
+Vec3 pos(const PositionsRef& x, Index i)
+{
+    return x.row(i).transpose();
+}
 
 /// Outward unit normal of a boundary face at the current positions (away from the tet's fourth vertex).
 Vec3 outward_normal(const PositionsRef& x, const Face& f)
@@ -78,11 +81,11 @@ double segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3&
 
 /// Axis-aligned bounding-box tree over some boundary faces at fixed positions.
 class Bvh {
-public:
+  public:
     struct Node {
         Vec3 lo, hi;
-        Index left = -1, right = -1;   // children (inner) or −1
-        Index first = 0, count = 0;     // face range in m_order (leaf)
+        Index left = -1, right = -1; // children (inner) or −1
+        Index first = 0, count = 0;  // face range in m_order (leaf)
     };
 
     void build(const PositionsRef& x, const std::vector<Face>& faces)
@@ -106,8 +109,7 @@ public:
     bool empty() const { return m_nodes.empty(); }
 
     /// Visits faces whose box meets the segment's box.
-    template <class F>
-    void for_segment(const Vec3& p, const Vec3& q, F&& visit) const
+    template <class F> void for_segment(const Vec3& p, const Vec3& q, F&& visit) const
     {
         if (m_nodes.empty()) return;
         const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
@@ -118,7 +120,8 @@ public:
             const Node& n = m_nodes[static_cast<size_t>(stack[--top])];
             if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
             if (n.left < 0) {
-                for (Index k = n.first; k < n.first + n.count; ++k) visit(m_order[static_cast<size_t>(k)]);
+                for (Index k = n.first; k < n.first + n.count; ++k)
+                    visit(m_order[static_cast<size_t>(k)]);
             } else if (top < 126) {
                 stack[top++] = n.left;
                 stack[top++] = n.right;
@@ -171,7 +174,7 @@ public:
         return best;
     }
 
-private:
+  private:
     Index build_node(Index first, Index count)
     {
         const Index id = static_cast<Index>(m_nodes.size());
@@ -197,7 +200,9 @@ private:
         (chi - clo).maxCoeff(&axis);
         const Index mid = first + count / 2;
         std::nth_element(m_order.begin() + first, m_order.begin() + mid, m_order.begin() + first + count,
-                         [&](Index a, Index b) { return m_center[static_cast<size_t>(a)][axis] < m_center[static_cast<size_t>(b)][axis]; });
+                         [&](Index a, Index b) {
+                             return m_center[static_cast<size_t>(a)][axis] < m_center[static_cast<size_t>(b)][axis];
+                         });
         const Index l = build_node(first, mid - first);
         const Index r = build_node(mid, first + count - mid);
         m_nodes[static_cast<size_t>(id)].left = l;
@@ -214,12 +219,12 @@ private:
 } // namespace
 
 class PenetrationImpl {
-public:
+  public:
     Index n = 0;
     Index objects = 0;
     std::vector<Index> vertex_object;
     Adjacency adjacency;
-    std::vector<std::vector<Face>> faces;   // boundary faces per object
+    std::vector<std::vector<Face>> faces; // boundary faces per object
     bool ready = false;
 
     void set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj, std::span<const Index> tobj);
@@ -239,7 +244,8 @@ public:
     }
 };
 
-void PenetrationImpl::set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj, std::span<const Index> tobj)
+void PenetrationImpl::set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj,
+                          std::span<const Index> tobj)
 {
     const Index m = static_cast<Index>(tets.rows());
     if (num_vertices < 0) throw Error("penetration: negative vertex count");
@@ -247,18 +253,21 @@ void PenetrationImpl::set(const TetsRef& tets, Index num_vertices, std::span<con
         throw Error("penetration: vertex_object has " + std::to_string(vobj.size()) + " entries for " +
                     std::to_string(num_vertices) + " vertices");
     if (!tobj.empty() && static_cast<Index>(tobj.size()) != m)
-        throw Error("penetration: tet_object has " + std::to_string(tobj.size()) + " entries for " + std::to_string(m) + " tets");
+        throw Error("penetration: tet_object has " + std::to_string(tobj.size()) + " entries for " + std::to_string(m) +
+                    " tets");
     for (Index t = 0; t < m; ++t)
         for (int k = 0; k < 4; ++k)
             if (tets(t, k) < 0 || tets(t, k) >= num_vertices)
-                throw Error("penetration: tet " + std::to_string(t) + " has vertex index " + std::to_string(tets(t, k)) +
-                            " out of range [0, " + std::to_string(num_vertices) + ")");
+                throw Error("penetration: tet " + std::to_string(t) + " has vertex index " +
+                            std::to_string(tets(t, k)) + " out of range [0, " + std::to_string(num_vertices) + ")");
     n = num_vertices;
     vertex_object.assign(vobj.begin(), vobj.end());
     if (vertex_object.empty()) vertex_object.assign(static_cast<size_t>(n), 0);
     objects = 0;
-    for (Index o : vertex_object) objects = std::max(objects, o + 1);
-    for (Index o : tobj) objects = std::max(objects, o + 1);
+    for (Index o : vertex_object)
+        objects = std::max(objects, o + 1);
+    for (Index o : tobj)
+        objects = std::max(objects, o + 1);
     if (m > 0) objects = std::max<Index>(objects, 1);
     adjacency = vertex_adjacency(tets, n);
 
@@ -277,15 +286,18 @@ void PenetrationImpl::set(const TetsRef& tets, Index num_vertices, std::span<con
             std::sort(s.begin(), s.end());
             keys.push_back({s, t, f});
         }
-    std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.s < b.s || (a.s == b.s && a.tet < b.tet); });
+    std::sort(keys.begin(), keys.end(),
+              [](const Key& a, const Key& b) { return a.s < b.s || (a.s == b.s && a.tet < b.tet); });
     faces.assign(static_cast<size_t>(objects), {});
     for (size_t a = 0; a < keys.size();) {
         size_t b = a + 1;
-        while (b < keys.size() && keys[b].s == keys[a].s) ++b;
+        while (b < keys.size() && keys[b].s == keys[a].s)
+            ++b;
         if (b - a == 1) {
             const Key& k = keys[a];
             Face fc;
-            for (int j = 0; j < 3; ++j) fc.v[j] = tets(k.tet, kFace[k.face][j]);
+            for (int j = 0; j < 3; ++j)
+                fc.v[j] = tets(k.tet, kFace[k.face][j]);
             fc.opp = tets(k.tet, kFace[k.face][3]);
             const Index o = tobj.empty() ? 0 : tobj[static_cast<size_t>(k.tet)];
             faces[static_cast<size_t>(o)].push_back(fc);
@@ -308,9 +320,9 @@ bool PenetrationImpl::closest(const PositionsRef& x, const Bvh& tree, Index i, V
     const Vec3 p = pos(x, i);
     const Index obj = vertex_object[static_cast<size_t>(i)];
     // Faces of i's own neighbourhood are skipped: for self-collisions they would be at distance ~0.
-    const Index best = tree.closest(x, p, [&](const Face& f) {
-        return vertex_object[static_cast<size_t>(f.v[0])] != obj || !near_vertex(f, i);
-    }, point, d2);
+    const Index best = tree.closest(
+        x, p, [&](const Face& f) { return vertex_object[static_cast<size_t>(f.v[0])] != obj || !near_vertex(f, i); },
+        point, d2);
     if (best < 0) return false;
     dist = std::sqrt(d2);
     return true;
@@ -338,7 +350,8 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
     PenetrationImpl& s = *m_impl;
     if (!s.ready) throw Error("penetration: set_topology was not called");
     if (x.rows() != s.n)
-        throw Error("penetration: positions have " + std::to_string(x.rows()) + " rows, topology has " + std::to_string(s.n) + " vertices");
+        throw Error("penetration: positions have " + std::to_string(x.rows()) + " rows, topology has " +
+                    std::to_string(s.n) + " vertices");
     PenetrationStats st;
 
     // (vertex, penetrated object) pairs.
@@ -346,7 +359,7 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
         Index vertex, object;
         double depth = 0;
         Vec3 dir = Vec3::Zero();
-        int state = 0;   // 0 none, 1 valued (border), 2 valued (propagated), 3 fallback
+        int state = 0; // 0 none, 1 valued (border), 2 valued (propagated), 3 fallback
     };
     std::vector<Pair> pairs;
     std::unordered_map<std::int64_t, Index> slot;
@@ -377,7 +390,8 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
         const auto& faces = s.faces[static_cast<size_t>(p.object)];
         double wsum = 0, dsum = 0;
         Vec3 nsum = Vec3::Zero();
-        for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)]; a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
+        for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)];
+             a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
             const Index j = s.adjacency.neighbours[static_cast<size_t>(a)];
             if (find(j, p.object) >= 0) continue;
             const Vec3 xj = pos(x, j);
@@ -422,7 +436,8 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
             const Vec3 xi = pos(x, p.vertex);
             double msum = 0, dsum = 0;
             Vec3 rsum = Vec3::Zero();
-            for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)]; a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
+            for (Index a = s.adjacency.offsets[static_cast<size_t>(p.vertex)];
+                 a < s.adjacency.offsets[static_cast<size_t>(p.vertex) + 1]; ++a) {
                 const Index j = s.adjacency.neighbours[static_cast<size_t>(a)];
                 const Index qj = find(j, p.object);
                 if (qj < 0) continue;
@@ -469,7 +484,8 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
     for (size_t c = 0; c < contacts.size(); ++c) {
         const Pair& p = pairs[static_cast<size_t>(contact_slot[c])];
         contacts[c].depth = std::max(0.0, p.depth);
-        for (int k = 0; k < 3; ++k) contacts[c].direction[k] = p.dir[k];
+        for (int k = 0; k < 3; ++k)
+            contacts[c].direction[k] = p.dir[k];
     }
     st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (stats) *stats = st;

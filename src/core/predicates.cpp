@@ -8,8 +8,7 @@ namespace tethash::predicates {
 namespace {
 
 /// A nonoverlapping expansion, components in increasing magnitude, zeros eliminated.
-template <int N>
-struct Expansion {
+template <int N> struct Expansion {
     double c[N];
     int n = 0;
 };
@@ -22,7 +21,7 @@ inline void two_sum(double a, double b, double& s, double& e)
     e = (a - av) + (b - bv);
 }
 
-inline void fast_two_sum(double a, double b, double& s, double& e)   // requires |a| ≥ |b| or a == 0
+inline void fast_two_sum(double a, double b, double& s, double& e) // requires |a| ≥ |b| or a == 0
 {
     s = a + b;
     e = b - (s - a);
@@ -43,8 +42,7 @@ inline void two_product(double a, double b, double& p, double& e)
 }
 
 /// out = e + b (Shewchuk's grow_expansion_zeroelim).
-template <int N, int M>
-void grow(const Expansion<M>& e, double b, Expansion<N>& out)
+template <int N, int M> void grow(const Expansion<M>& e, double b, Expansion<N>& out)
 {
     double q = b;
     out.n = 0;
@@ -58,24 +56,24 @@ void grow(const Expansion<M>& e, double b, Expansion<N>& out)
 }
 
 /// out = e + f by repeated growth (O(mn); only on the rare exact path).
-template <int N, int M, int K>
-void add(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
+template <int N, int M, int K> void add(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
 {
     static_assert(N >= M + K);
     Expansion<N> tmp;
     out.n = 0;
-    for (int i = 0; i < e.n; ++i) out.c[out.n++] = e.c[i];
+    for (int i = 0; i < e.n; ++i)
+        out.c[out.n++] = e.c[i];
     for (int j = 0; j < f.n; ++j) {
         grow(out, f.c[j], tmp);
         out.n = tmp.n;
-        for (int i = 0; i < tmp.n; ++i) out.c[i] = tmp.c[i];
+        for (int i = 0; i < tmp.n; ++i)
+            out.c[i] = tmp.c[i];
     }
     if (out.n == 0) out.c[out.n++] = 0.0;
 }
 
 /// out = e · b (Shewchuk's scale_expansion_zeroelim).
-template <int N, int M>
-void scale(const Expansion<M>& e, double b, Expansion<N>& out)
+template <int N, int M> void scale(const Expansion<M>& e, double b, Expansion<N>& out)
 {
     static_assert(N >= 2 * M);
     out.n = 0;
@@ -94,8 +92,7 @@ void scale(const Expansion<M>& e, double b, Expansion<N>& out)
 }
 
 /// out = e · f.
-template <int N, int M, int K>
-void multiply(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
+template <int N, int M, int K> void multiply(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
 {
     static_assert(N >= 2 * M * K);
     out.n = 1;
@@ -105,7 +102,8 @@ void multiply(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
     for (int j = 0; j < f.n; ++j) {
         scale(e, f.c[j], part);
         tmp.n = 0;
-        for (int i = 0; i < out.n; ++i) tmp.c[tmp.n++] = out.c[i];
+        for (int i = 0; i < out.n; ++i)
+            tmp.c[tmp.n++] = out.c[i];
         for (int i = 0; i < part.n; ++i) {
             Expansion<N> g;
             grow(tmp, part.c[i], g);
@@ -115,25 +113,24 @@ void multiply(const Expansion<M>& e, const Expansion<K>& f, Expansion<N>& out)
     }
 }
 
-template <int M>
-Expansion<M> negate(Expansion<M> e)
+template <int M> Expansion<M> negate(Expansion<M> e)
 {
-    for (int i = 0; i < e.n; ++i) e.c[i] = -e.c[i];
+    for (int i = 0; i < e.n; ++i)
+        e.c[i] = -e.c[i];
     return e;
 }
 
-template <int M>
-int sign_of(const Expansion<M>& e)
+template <int M> int sign_of(const Expansion<M>& e)
 {
     const double top = e.c[e.n - 1];
     return (top > 0) - (top < 0);
 }
 
-template <int M>
-double estimate(const Expansion<M>& e)
+template <int M> double estimate(const Expansion<M>& e)
 {
     double s = 0;
-    for (int i = 0; i < e.n; ++i) s += e.c[i];
+    for (int i = 0; i < e.n; ++i)
+        s += e.c[i];
     return s;
 }
 
@@ -229,7 +226,8 @@ InsideResult inside_tet(const double* p, const double* a, const double* b, const
         sum += fi.value;
     }
     r.inside = true;
-    for (int i = 0; i < 4; ++i) r.bary[i] = f[i].sign == 0 ? 0.0 : f[i].value / sum;
+    for (int i = 0; i < 4; ++i)
+        r.bary[i] = f[i].sign == 0 ? 0.0 : f[i].value / sum;
     return r;
 }
 

@@ -47,8 +47,8 @@ std::int32_t scan_scalar(const VertexTable& t, std::int32_t begin, std::int32_t 
 
 #ifdef TETHASH_X86
 __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const VertexTable& t, const ScanRange* ranges,
-                                                                      std::int32_t count, const ScanQuery& q,
-                                                                      Index* out, ScanCounters& c)
+                                                                     std::int32_t count, const ScanQuery& q, Index* out,
+                                                                     ScanCounters& c)
 {
     const __m256 lx = _mm256_set1_ps(q.lo[0]), ly = _mm256_set1_ps(q.lo[1]), lz = _mm256_set1_ps(q.lo[2]);
     const __m256 hx = _mm256_set1_ps(q.hi[0]), hy = _mm256_set1_ps(q.hi[1]), hz = _mm256_set1_ps(q.hi[2]);
@@ -65,39 +65,40 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2(const Verte
     std::int32_t n = 0;
     std::int64_t coll = 0, boxr = 0, own = 0;
     for (std::int32_t r = 0; r < count; ++r) {
-    const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
-    const __m256i qk = _mm256_set1_epi32(static_cast<int>(column_key(ranges[r].cx, ranges[r].cy)));
-    const __m256i z0 = _mm256_set1_epi32(q.z0), zs = _mm256_set1_epi32(q.z1 - q.z0 + 1);
-    c.scanned += end - begin;
-    for (std::int32_t i = begin; i < end; i += 8) {
-        const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
-        const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
-        const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
-        const __m256i cell = _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk),
-                                              _mm256_cmpgt_epi32(zs, dz));
-        const int mv = _mm256_movemask_ps(_mm256_castsi256_ps(valid));
-        const int mc = _mm256_movemask_ps(_mm256_castsi256_ps(cell)) & mv;
-        coll += __builtin_popcount(mv & ~mc);
-        if (!mc) continue;
-        const __m256 x = _mm256_loadu_ps(X + i), y = _mm256_loadu_ps(Y + i), z = _mm256_loadu_ps(Z + i);
-        const __m256 inx = _mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ));
-        const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
-        const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
-        const int mb = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(inx, iny), inz)) & mc;
-        boxr += __builtin_popcount(mc & ~mb);
-        if (!mb) continue;
-        const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
-        const __m256i isown = _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
-                                              _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
-        const int mo = _mm256_movemask_ps(_mm256_castsi256_ps(isown)) & mb;
-        own += __builtin_popcount(mo);
-        int keep = mb & ~mo;
-        while (keep) {
-            const int k = __builtin_ctz(static_cast<unsigned>(keep));
-            out[n++] = ID[i + k];
-            keep &= keep - 1;
+        const std::int32_t begin = ranges[r].begin, end = ranges[r].end;
+        const __m256i qk = _mm256_set1_epi32(static_cast<int>(column_key(ranges[r].cx, ranges[r].cy)));
+        const __m256i z0 = _mm256_set1_epi32(q.z0), zs = _mm256_set1_epi32(q.z1 - q.z0 + 1);
+        c.scanned += end - begin;
+        for (std::int32_t i = begin; i < end; i += 8) {
+            const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - i), iota);
+            const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
+            const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
+            const __m256i cell =
+                _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk), _mm256_cmpgt_epi32(zs, dz));
+            const int mv = _mm256_movemask_ps(_mm256_castsi256_ps(valid));
+            const int mc = _mm256_movemask_ps(_mm256_castsi256_ps(cell)) & mv;
+            coll += __builtin_popcount(mv & ~mc);
+            if (!mc) continue;
+            const __m256 x = _mm256_loadu_ps(X + i), y = _mm256_loadu_ps(Y + i), z = _mm256_loadu_ps(Z + i);
+            const __m256 inx = _mm256_and_ps(_mm256_cmp_ps(x, lx, _CMP_GE_OQ), _mm256_cmp_ps(x, hx, _CMP_LE_OQ));
+            const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
+            const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
+            const int mb = _mm256_movemask_ps(_mm256_and_ps(_mm256_and_ps(inx, iny), inz)) & mc;
+            boxr += __builtin_popcount(mc & ~mb);
+            if (!mb) continue;
+            const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
+            const __m256i isown =
+                _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
+                                _mm256_or_si256(_mm256_cmpeq_epi32(ids, o2), _mm256_cmpeq_epi32(ids, o3)));
+            const int mo = _mm256_movemask_ps(_mm256_castsi256_ps(isown)) & mb;
+            own += __builtin_popcount(mo);
+            int keep = mb & ~mo;
+            while (keep) {
+                const int k = __builtin_ctz(static_cast<unsigned>(keep));
+                out[n++] = ID[i + k];
+                keep &= keep - 1;
+            }
         }
-    }
     }
     c.collisions += coll;
     c.box_rejections += boxr;
@@ -125,10 +126,9 @@ constexpr PackTable pack_table;
 // The lean kernel, branch-free per 8 entries: box, cell (column of the range, z-run of the query) and own-vertex
 // tests as lane masks, one movemask, survivors left-packed by a permutation from pack_table and stored 8 at a time
 // (`out` has 8 ids of slack). No statistics.
-__attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const VertexTable& t,
-                                                                           const ScanRange* ranges,
-                                                                           std::int32_t count, const ScanQuery& q,
-                                                                           Index* out, ScanCounters&)
+__attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const VertexTable& t, const ScanRange* ranges,
+                                                                          std::int32_t count, const ScanQuery& q,
+                                                                          Index* out, ScanCounters&)
 {
     const __m256 lx = _mm256_set1_ps(q.lo[0]), ly = _mm256_set1_ps(q.lo[1]), lz = _mm256_set1_ps(q.lo[2]);
     const __m256 hx = _mm256_set1_ps(q.hi[0]), hy = _mm256_set1_ps(q.hi[1]), hz = _mm256_set1_ps(q.hi[2]);
@@ -157,8 +157,8 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
             const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
             const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
             const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
-            const __m256i cell = _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk),
-                                                  _mm256_cmpgt_epi32(zs, dz));
+            const __m256i cell =
+                _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk), _mm256_cmpgt_epi32(zs, dz));
             const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
             const __m256i isown =
                 _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
@@ -167,7 +167,8 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
                 isown, _mm256_and_si256(_mm256_and_si256(valid, cell),
                                         _mm256_castps_si256(_mm256_and_ps(_mm256_and_ps(inx, iny), inz))));
             const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(keep)));
-            const __m256i perm = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(pack_table.idx + m)));
+            const __m256i perm =
+                _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(pack_table.idx + m)));
             _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + n), _mm256_permutevar8x32_epi32(ids, perm));
             n += __builtin_popcount(m);
             i += 8;
@@ -211,10 +212,11 @@ __attribute__((target("avx2"))) void filter_avx2(const FacePlanes& f, const doub
         const __m256d dx = _mm256_sub_pd(_mm256_broadcast_sd(p), rx);
         const __m256d dy = _mm256_sub_pd(_mm256_broadcast_sd(p + 1), ry);
         const __m256d dz = _mm256_sub_pd(_mm256_broadcast_sd(p + 2), rz);
-        const __m256d v = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
-        const __m256d perm = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_andnot_pd(sign, dx), mx),
-                                                         _mm256_mul_pd(_mm256_andnot_pd(sign, dy), my)),
-                                           _mm256_mul_pd(_mm256_andnot_pd(sign, dz), mz));
+        const __m256d v =
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
+        const __m256d perm = _mm256_add_pd(
+            _mm256_add_pd(_mm256_mul_pd(_mm256_andnot_pd(sign, dx), mx), _mm256_mul_pd(_mm256_andnot_pd(sign, dy), my)),
+            _mm256_mul_pd(_mm256_andnot_pd(sign, dz), mz));
         const __m256d bound = _mm256_mul_pd(E, perm);
         _mm256_storeu_pd(val + 4 * j, v);
         const int out = _mm256_movemask_pd(_mm256_cmp_pd(v, _mm256_xor_pd(bound, sign), _CMP_LT_OQ));
@@ -277,8 +279,8 @@ __attribute__((target("avx2"))) void faces_avx2(const double* A, const double* B
 
 using FilterFn = void (*)(const FacePlanes&, const double*, const Index*, std::int32_t, double*, std::int8_t*);
 
-std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count,
-                                const ScanQuery& q, Index* out, ScanCounters& c)
+std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
+                                Index* out, ScanCounters& c)
 {
     std::int32_t n = 0;
     ScanQuery qq = q;
@@ -303,7 +305,8 @@ std::int32_t scan_ranges_exact(const VertexTable& t, const ScanRange* ranges, st
             const Index v = t.id[i];
             const double* p = P + 3 * static_cast<std::size_t>(v);
             const std::int32_t cz = floor_to_int(p[2] * inv_cell);
-            if (floor_to_int(p[0] * inv_cell) != R.cx || floor_to_int(p[1] * inv_cell) != R.cy || cz < q.z0 || cz > q.z1) {
+            if (floor_to_int(p[0] * inv_cell) != R.cx || floor_to_int(p[1] * inv_cell) != R.cy || cz < q.z0 ||
+                cz > q.z1) {
                 ++c.collisions;
                 continue;
             }
@@ -344,9 +347,9 @@ const ScanFn chosen_lean = chosen;
 #endif
 const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 #ifdef TETHASH_X86
-                                                     : filter_avx2;
+                                                            : filter_avx2;
 #else
-                                                     : filter_scalar;
+                                                            : filter_scalar;
 #endif
 
 } // namespace
@@ -375,8 +378,10 @@ void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, 
 int face_planes(const double* A, const double* B, const double* C, const double* D, FacePlanes& f, bool& exact)
 {
 #ifdef TETHASH_X86
-    if (chosen_filter == filter_avx2) faces_avx2(A, B, C, D, f);
-    else faces_scalar(A, B, C, D, f);
+    if (chosen_filter == filter_avx2)
+        faces_avx2(A, B, C, D, f);
+    else
+        faces_scalar(A, B, C, D, f);
 #else
     faces_scalar(A, B, C, D, f);
 #endif
@@ -387,8 +392,10 @@ int face_planes(const double* A, const double* B, const double* C, const double*
                          (std::fabs(dx) * f.mx[3] + std::fabs(dy) * f.my[3] + std::fabs(dz) * f.mz[3]);
     int s;
     exact = false;
-    if (det > bound) s = 1;
-    else if (det < -bound) s = -1;
+    if (det > bound)
+        s = 1;
+    else if (det < -bound)
+        s = -1;
     else {
         s = predicates::orient3d_exact(A, B, C, D).sign;
         exact = true;
@@ -402,6 +409,9 @@ int face_planes(const double* A, const double* B, const double* C, const double*
     return s;
 }
 
-const char* scan_kernel_name() { return chosen == scan_ranges_scalar ? "scalar" : "avx2"; }
+const char* scan_kernel_name()
+{
+    return chosen == scan_ranges_scalar ? "scalar" : "avx2";
+}
 
 } // namespace tethash::detail

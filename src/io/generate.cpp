@@ -36,7 +36,7 @@ double smooth_min(double a, double b, double k)
 // Bunny-like blob: body, head, two ears, tail, front paws, smoothly joined.
 constexpr double kBlobBlend = 0.06;
 struct Ball {
-    Vec3 a, b;   ///< segment ends (a == b: a sphere)
+    Vec3 a, b; ///< segment ends (a == b: a sphere)
     double r;
 };
 const std::vector<Ball>& blob_parts()
@@ -56,7 +56,8 @@ const std::vector<Ball>& blob_parts()
 double sd_blob(const Vec3& p)
 {
     double d = 1e30;
-    for (const Ball& b : blob_parts()) d = smooth_min(d, sd_capsule(p, b.a, b.b, b.r), kBlobBlend);
+    for (const Ball& b : blob_parts())
+        d = smooth_min(d, sd_capsule(p, b.a, b.b, b.r), kBlobBlend);
     return d;
 }
 std::pair<Vec3, Vec3> blob_box()
@@ -72,8 +73,8 @@ std::pair<Vec3, Vec3> blob_box()
 
 struct Shape {
     ShapeInfo info;
-    Vec3 natural_min;                          ///< natural bounding box (scale 1)
-    std::function<double(const Vec3&)> sdf;    ///< in natural coordinates
+    Vec3 natural_min;                       ///< natural bounding box (scale 1)
+    std::function<double(const Vec3&)> sdf; ///< in natural coordinates
 };
 
 const std::vector<Shape>& shapes()
@@ -119,7 +120,8 @@ const Shape& find_shape(const std::string& name)
     for (const Shape& s : shapes())
         if (s.info.name == name) return s;
     std::string known;
-    for (const Shape& s : shapes()) known += (known.empty() ? "" : ", ") + s.info.name;
+    for (const Shape& s : shapes())
+        known += (known.empty() ? "" : ", ") + s.info.name;
     throw Error("unknown shape '" + name + "' (known: " + known + ")");
 }
 
@@ -129,7 +131,8 @@ const std::vector<ShapeInfo>& shape_catalog()
 {
     static const std::vector<ShapeInfo> infos = [] {
         std::vector<ShapeInfo> v;
-        for (const Shape& s : shapes()) v.push_back(s.info);
+        for (const Shape& s : shapes())
+            v.push_back(s.info);
         return v;
     }();
     return infos;
@@ -138,11 +141,15 @@ const std::vector<ShapeInfo>& shape_catalog()
 std::vector<std::string> generate_shapes()
 {
     std::vector<std::string> names;
-    for (const ShapeInfo& s : shape_catalog()) names.push_back(s.name);
+    for (const ShapeInfo& s : shape_catalog())
+        names.push_back(s.name);
     return names;
 }
 
-Eigen::Vector3d shape_natural_size(const std::string& shape) { return find_shape(shape).info.natural_size; }
+Eigen::Vector3d shape_natural_size(const std::string& shape)
+{
+    return find_shape(shape).info.natural_size;
+}
 
 TetMesh generate(const GenerateParams& params)
 {
@@ -158,12 +165,12 @@ TetMesh generate(const GenerateParams& params)
     const Vec3 nat = shape.info.natural_size;
     const Vec3 ext = (natural ? nat : params.size) * params.scale;
     const Vec3 nat_centre = shape.natural_min + 0.5 * nat;
-    const Vec3 to_nat = nat.cwiseQuotient(ext);         // natural units per output unit, per axis
+    const Vec3 to_nat = nat.cwiseQuotient(ext); // natural units per output unit, per axis
     const double dist_scale = ext.cwiseQuotient(nat).minCoeff();
     std::function<double(const Vec3&)> sdf;
     std::function<Vec3(const Vec3&, const Vec3&)> project;
     if (params.shape == "box" || params.shape == "bar") {
-        const Vec3 half = 0.5 * ext;                      // exact distance for boxes of any size
+        const Vec3 half = 0.5 * ext; // exact distance for boxes of any size
         sdf = [half](const Vec3& p) { return sd_box(p, half); };
         // Boundary vertices sit h/8 inside or 3h/8 outside a face (see make_lattice): put every
         // coordinate that close to a face onto it, so edges and corners get vertices too.

@@ -27,56 +27,100 @@ using detail::TextReader;
 int nodes_per_element(std::int64_t type)
 {
     switch (type) {
-    case 1: return 2;    // 2-node line
-    case 2: return 3;    // 3-node triangle
-    case 3: return 4;    // 4-node quadrangle
-    case 4: return 4;    // 4-node tetrahedron
-    case 5: return 8;    // 8-node hexahedron
-    case 6: return 6;    // 6-node prism
-    case 7: return 5;    // 5-node pyramid
-    case 8: return 3;    // 3-node line
-    case 9: return 6;    // 6-node triangle
-    case 10: return 9;   // 9-node quadrangle
-    case 11: return 10;  // 10-node tetrahedron
-    case 12: return 27;  // 27-node hexahedron
-    case 13: return 18;  // 18-node prism
-    case 14: return 14;  // 14-node pyramid
-    case 15: return 1;   // 1-node point
-    case 16: return 8;   // 8-node quadrangle
-    case 17: return 20;  // 20-node hexahedron
-    case 18: return 15;  // 15-node prism
-    case 19: return 13;  // 13-node pyramid
-    case 20: return 9;   // 9-node incomplete triangle
-    case 21: return 10;  // 10-node triangle
-    case 22: return 12;  // 12-node incomplete triangle
-    case 23: return 15;  // 15-node triangle
-    case 24: return 15;  // 15-node incomplete triangle
-    case 25: return 21;  // 21-node triangle
-    case 26: return 4;   // 4-node line
-    case 27: return 5;   // 5-node line
-    case 28: return 6;   // 6-node line
-    case 29: return 20;  // 20-node tetrahedron
-    case 30: return 35;  // 35-node tetrahedron
-    case 31: return 56;  // 56-node tetrahedron
-    case 92: return 64;  // 64-node hexahedron
-    case 93: return 125; // 125-node hexahedron
-    default: return 0;
+    case 1:
+        return 2; // 2-node line
+    case 2:
+        return 3; // 3-node triangle
+    case 3:
+        return 4; // 4-node quadrangle
+    case 4:
+        return 4; // 4-node tetrahedron
+    case 5:
+        return 8; // 8-node hexahedron
+    case 6:
+        return 6; // 6-node prism
+    case 7:
+        return 5; // 5-node pyramid
+    case 8:
+        return 3; // 3-node line
+    case 9:
+        return 6; // 6-node triangle
+    case 10:
+        return 9; // 9-node quadrangle
+    case 11:
+        return 10; // 10-node tetrahedron
+    case 12:
+        return 27; // 27-node hexahedron
+    case 13:
+        return 18; // 18-node prism
+    case 14:
+        return 14; // 14-node pyramid
+    case 15:
+        return 1; // 1-node point
+    case 16:
+        return 8; // 8-node quadrangle
+    case 17:
+        return 20; // 20-node hexahedron
+    case 18:
+        return 15; // 15-node prism
+    case 19:
+        return 13; // 13-node pyramid
+    case 20:
+        return 9; // 9-node incomplete triangle
+    case 21:
+        return 10; // 10-node triangle
+    case 22:
+        return 12; // 12-node incomplete triangle
+    case 23:
+        return 15; // 15-node triangle
+    case 24:
+        return 15; // 15-node incomplete triangle
+    case 25:
+        return 21; // 21-node triangle
+    case 26:
+        return 4; // 4-node line
+    case 27:
+        return 5; // 5-node line
+    case 28:
+        return 6; // 6-node line
+    case 29:
+        return 20; // 20-node tetrahedron
+    case 30:
+        return 35; // 35-node tetrahedron
+    case 31:
+        return 56; // 56-node tetrahedron
+    case 92:
+        return 64; // 64-node hexahedron
+    case 93:
+        return 125; // 125-node hexahedron
+    default:
+        return 0;
     }
 }
 
 std::string element_type_name(std::int64_t type)
 {
     switch (type) {
-    case 1: return "2-node line";
-    case 2: return "3-node triangle";
-    case 3: return "4-node quadrangle";
-    case 5: return "8-node hexahedron";
-    case 6: return "6-node prism";
-    case 7: return "5-node pyramid";
-    case 8: return "3-node line";
-    case 9: return "6-node triangle";
-    case 11: return "10-node tetrahedron";
-    case 15: return "point";
+    case 1:
+        return "2-node line";
+    case 2:
+        return "3-node triangle";
+    case 3:
+        return "4-node quadrangle";
+    case 5:
+        return "8-node hexahedron";
+    case 6:
+        return "6-node prism";
+    case 7:
+        return "5-node pyramid";
+    case 8:
+        return "3-node line";
+    case 9:
+        return "6-node triangle";
+    case 11:
+        return "10-node tetrahedron";
+    case 15:
+        return "point";
     default: {
         const int n = nodes_per_element(type);
         return n ? std::to_string(n) + "-node element" : "unknown element";
@@ -86,7 +130,7 @@ std::string element_type_name(std::int64_t type)
 
 /// Node tag -> 0-based index, dense when the tags are compact, hashed otherwise.
 class NodeMap {
-public:
+  public:
     /// Builds the map; returns a tag that appears twice, or -1.
     std::int64_t build(const std::vector<std::int64_t>& tags)
     {
@@ -120,7 +164,7 @@ public:
         return it == m_sparse.end() ? -1 : it->second;
     }
 
-private:
+  private:
     bool m_use_dense = true;
     std::vector<Index> m_dense;
     std::unordered_map<std::int64_t, Index> m_sparse;
@@ -130,7 +174,7 @@ constexpr std::int64_t k_max_int32 = std::numeric_limits<std::int32_t>::max();
 constexpr std::int64_t k_max_count = std::numeric_limits<std::int64_t>::max() / 2;
 
 class MshReader {
-public:
+  public:
     MshReader(const std::string& path, ReadNotes* notes) : m_r(path), m_notes(notes) {}
 
     TetMesh read()
@@ -146,12 +190,18 @@ public:
             m_r.skip_rest_of_line();
             if (name == "Nodes") {
                 if (m_have_nodes) m_r.fail_message("a second $Nodes section (only one is supported)");
-                if (m_version == 41) read_nodes41(); else read_nodes22();
+                if (m_version == 41)
+                    read_nodes41();
+                else
+                    read_nodes22();
                 m_have_nodes = true;
             } else if (name == "Elements") {
                 if (!m_have_nodes) m_r.fail("$Nodes before $Elements", "$Elements");
                 if (m_have_elements) m_r.fail_message("a second $Elements section (only one is supported)");
-                if (m_version == 41) read_elements41(); else read_elements22();
+                if (m_version == 41)
+                    read_elements41();
+                else
+                    read_elements22();
                 m_have_elements = true;
             } else if (name == "Entities" && m_version == 41) {
                 read_entities41();
@@ -170,16 +220,19 @@ public:
         return finish();
     }
 
-private:
+  private:
     bool binary() const { return m_binary; }
 
     void read_format()
     {
         const std::string_view v = m_r.next("a version number");
         const std::string version(v);
-        if (version == "4.1") m_version = 41;
-        else if (version == "2.2" || version == "2.1" || version == "2.0" || version == "2") m_version = 22;
-        else m_r.fail("MSH version 2.2 or 4.1", "version " + TextReader::describe(v));
+        if (version == "4.1")
+            m_version = 41;
+        else if (version == "2.2" || version == "2.1" || version == "2.0" || version == "2")
+            m_version = 22;
+        else
+            m_r.fail("MSH version 2.2 or 4.1", "version " + TextReader::describe(v));
         m_binary = m_r.next_int_in("file type (0 ASCII, 1 binary)", 0, 1) == 1;
         m_size_t = static_cast<std::size_t>(m_r.next_int_in("data size", 0, 64));
         if (m_version == 41 && m_size_t != 4 && m_size_t != 8)
@@ -189,7 +242,8 @@ private:
         if (m_binary) {
             const std::size_t at = m_r.offset();
             const auto one = m_r.read_binary<std::uint32_t>("the integer 1 (byte-order check)");
-            if (one == 0x01000000u) m_r.set_swap_bytes(true);
+            if (one == 0x01000000u)
+                m_r.set_swap_bytes(true);
             else if (one != 1u)
                 m_r.fail_at_byte(at, "expected the integer 1 (byte-order check), found " + std::to_string(one));
         }
@@ -222,8 +276,7 @@ private:
         if (count > 0 && static_cast<std::uint64_t>(count) > left / bytes_each)
             m_r.fail_at_byte(m_r.offset(), "expected " + std::to_string(count) + " " + what + " (" +
                                                std::to_string(static_cast<std::uint64_t>(count) * bytes_each) +
-                                               " bytes), found end of file after " + std::to_string(left) +
-                                               " bytes");
+                                               " bytes), found end of file after " + std::to_string(left) + " bytes");
     }
 
     /// One coordinate of node `tag`.
@@ -252,8 +305,9 @@ private:
     {
         const std::string_view tok = m_r.peek();
         if (tok != marker) {
-            if (binary()) m_r.fail_at_byte(m_r.offset(), "expected " + std::string(marker) + ", found " +
-                                                             TextReader::describe(tok.substr(0, 16)));
+            if (binary())
+                m_r.fail_at_byte(m_r.offset(), "expected " + std::string(marker) + ", found " +
+                                                   TextReader::describe(tok.substr(0, 16)));
             m_r.next(marker);
             m_r.fail(marker, TextReader::describe(tok));
         }
@@ -277,8 +331,10 @@ private:
             for (std::int64_t i = 0; i < counts[static_cast<std::size_t>(d)]; ++i) {
                 const std::int64_t tag = read_int("an entity tag");
                 for (int k = 0; k < (d == 0 ? 3 : 6); ++k) {
-                    if (binary()) m_r.read_binary<double>("a bounding box value");
-                    else m_r.next_double_any("a bounding box value of entity " + std::to_string(tag));
+                    if (binary())
+                        m_r.read_binary<double>("a bounding box value");
+                    else
+                        m_r.next_double_any("a bounding box value of entity " + std::to_string(tag));
                 }
                 const std::int64_t nphys = read_size("the number of physical tags of entity " + std::to_string(tag));
                 check_room(nphys, 4, "physical tags");
@@ -287,9 +343,11 @@ private:
                     if (k == 0) m_entity_physical[d].emplace(tag, p);
                 }
                 if (d > 0) {
-                    const std::int64_t nb = read_size("the number of bounding entities of entity " + std::to_string(tag));
+                    const std::int64_t nb =
+                        read_size("the number of bounding entities of entity " + std::to_string(tag));
                     check_room(nb, 4, "bounding entity tags");
-                    for (std::int64_t k = 0; k < nb; ++k) read_int("a bounding entity tag");
+                    for (std::int64_t k = 0; k < nb; ++k)
+                        read_int("a bounding entity tag");
                 }
             }
         }
@@ -310,32 +368,40 @@ private:
         std::int64_t seen = 0;
         std::vector<std::int64_t> block_tags;
         for (std::int64_t b = 0; b < blocks; ++b) {
-            const std::int64_t dim = binary() ? read_int("an entity dimension") : m_r.next_int_in("an entity dimension", 0, 3);
-            if (dim < 0 || dim > 3) m_r.fail_at_byte(m_r.offset() - 4, "expected an entity dimension 0..3, found " + std::to_string(dim));
+            const std::int64_t dim =
+                binary() ? read_int("an entity dimension") : m_r.next_int_in("an entity dimension", 0, 3);
+            if (dim < 0 || dim > 3)
+                m_r.fail_at_byte(m_r.offset() - 4, "expected an entity dimension 0..3, found " + std::to_string(dim));
             read_int("an entity tag");
             const std::int64_t parametric = read_int("the parametric flag (0 or 1)");
             if (parametric != 0 && parametric != 1) {
-                if (binary()) m_r.fail_at_byte(m_r.offset() - 4, "expected the parametric flag 0 or 1, found " + std::to_string(parametric));
+                if (binary())
+                    m_r.fail_at_byte(m_r.offset() - 4,
+                                     "expected the parametric flag 0 or 1, found " + std::to_string(parametric));
                 m_r.fail("the parametric flag 0 or 1", std::to_string(parametric));
             }
             const std::int64_t count = read_size("the number of nodes in the block");
             if (count > total - seen) {
-                const std::string msg = "expected at most " + std::to_string(total - seen) +
-                                        " nodes in node block " + std::to_string(b + 1) + " (the $Nodes header says " +
-                                        std::to_string(total) + " in all), found " + std::to_string(count);
+                const std::string msg = "expected at most " + std::to_string(total - seen) + " nodes in node block " +
+                                        std::to_string(b + 1) + " (the $Nodes header says " + std::to_string(total) +
+                                        " in all), found " + std::to_string(count);
                 if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
                 m_r.fail_message(msg);
             }
             const int extra = parametric ? static_cast<int>(dim) : 0;
             check_room(count, m_size_t + (3 + static_cast<std::size_t>(extra)) * sizeof(double), "nodes");
             block_tags.clear();
-            for (std::int64_t i = 0; i < count; ++i) block_tags.push_back(read_size("a node tag"));
+            for (std::int64_t i = 0; i < count; ++i)
+                block_tags.push_back(read_size("a node tag"));
             for (std::int64_t i = 0; i < count; ++i) {
                 const std::int64_t tag = block_tags[static_cast<std::size_t>(i)];
-                for (int a = 0; a < 3; ++a) m_xyz.push_back(read_coord(tag, a));
+                for (int a = 0; a < 3; ++a)
+                    m_xyz.push_back(read_coord(tag, a));
                 for (int a = 0; a < extra; ++a) {
-                    if (binary()) m_r.read_binary<double>("a parametric coordinate");
-                    else m_r.next_double_any("a parametric coordinate of node " + std::to_string(tag));
+                    if (binary())
+                        m_r.read_binary<double>("a parametric coordinate");
+                    else
+                        m_r.next_double_any("a parametric coordinate of node " + std::to_string(tag));
                 }
                 m_node_tags.push_back(tag);
             }
@@ -365,10 +431,7 @@ private:
         return i;
     }
 
-    void skip_elements(std::int64_t type, std::int64_t count)
-    {
-        m_skipped[type] += count;
-    }
+    void skip_elements(std::int64_t type, std::int64_t count) { m_skipped[type] += count; }
 
     void read_elements41()
     {
@@ -399,7 +462,8 @@ private:
                     const std::int64_t etag = read_size("an element tag");
                     for (int k = 0; k < 4; ++k) {
                         const std::size_t at = m_r.offset();
-                        m_tets.push_back(node_index(read_size("a node tag of element " + std::to_string(etag)), etag, at));
+                        m_tets.push_back(
+                            node_index(read_size("a node tag of element " + std::to_string(etag)), etag, at));
                     }
                     m_labels.push_back(static_cast<Index>(label));
                 }
@@ -409,7 +473,8 @@ private:
                     m_r.skip_bytes(static_cast<std::size_t>(count) * static_cast<std::size_t>(1 + nn) * m_size_t,
                                    "elements of type " + std::to_string(type));
                 } else {
-                    for (std::int64_t e = 0; e < count * (1 + nn); ++e) read_size("an element or node tag");
+                    for (std::int64_t e = 0; e < count * (1 + nn); ++e)
+                        read_size("an element or node tag");
                 }
                 skip_elements(type, count);
             } else {
@@ -458,7 +523,8 @@ private:
         m_xyz.reserve(3 * reserve);
         for (std::int64_t i = 0; i < total; ++i) {
             const std::int64_t tag = read_int("a node tag");
-            for (int a = 0; a < 3; ++a) m_xyz.push_back(read_coord(tag, a));
+            for (int a = 0; a < 3; ++a)
+                m_xyz.push_back(read_coord(tag, a));
             m_node_tags.push_back(tag);
         }
         expect_end("$EndNodes");
@@ -481,7 +547,8 @@ private:
             }
             m_labels.push_back(static_cast<Index>(physical != 0 ? physical : elementary));
         } else {
-            for (int k = 0; k < nn; ++k) read_int("a node tag of element " + std::to_string(etag));
+            for (int k = 0; k < nn; ++k)
+                read_int("a node tag of element " + std::to_string(etag));
             skip_elements(type, 1);
         }
     }
@@ -494,9 +561,10 @@ private:
             for (std::int64_t e = 0; e < total; ++e) {
                 const std::int64_t etag = m_r.next_int("an element tag");
                 const std::int64_t type = m_r.next_int("the type of element " + std::to_string(etag));
-                const std::int64_t ntags = m_r.next_int_in("the number of tags of element " + std::to_string(etag), 0, 1000);
+                const std::int64_t ntags =
+                    m_r.next_int_in("the number of tags of element " + std::to_string(etag), 0, 1000);
                 if (nodes_per_element(type) == 0) {
-                    m_r.skip_rest_of_line();   // unknown type: an ASCII element is one line
+                    m_r.skip_rest_of_line(); // unknown type: an ASCII element is one line
                     skip_elements(type, 1);
                     continue;
                 }
@@ -529,7 +597,8 @@ private:
             // Some writers (meshio) add headers of empty groups after the last element.
             auto at_end_marker = [this] {
                 std::string_view rest = m_r.rest();
-                while (!rest.empty() && (rest.front() == '\n' || rest.front() == '\r')) rest.remove_prefix(1);
+                while (!rest.empty() && (rest.front() == '\n' || rest.front() == '\r'))
+                    rest.remove_prefix(1);
                 return rest.rfind("$End", 0) == 0;
             };
             while (m_r.size() - m_r.offset() >= 12 && !at_end_marker()) {
@@ -589,7 +658,8 @@ struct MshOut {
     std::string s;
     void size(std::uint64_t v, char sep = ' ')
     {
-        if (binary) raw(v);
+        if (binary)
+            raw(v);
         else {
             detail::append_int(s, static_cast<std::int64_t>(v));
             s += sep;
@@ -597,7 +667,8 @@ struct MshOut {
     }
     void integer(std::int32_t v, char sep = ' ')
     {
-        if (binary) raw(v);
+        if (binary)
+            raw(v);
         else {
             detail::append_int(s, v);
             s += sep;
@@ -605,14 +676,14 @@ struct MshOut {
     }
     void real(double v, char sep = ' ')
     {
-        if (binary) raw(v);
+        if (binary)
+            raw(v);
         else {
             detail::append_double(s, v);
             s += sep;
         }
     }
-    template <class T>
-    void raw(T v)
+    template <class T> void raw(T v)
     {
         char b[sizeof(T)];
         std::memcpy(b, &v, sizeof(T));
@@ -651,7 +722,7 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
         if (fresh) keys.push_back(key);
         tet_entity[static_cast<std::size_t>(t)] = it->second;
     }
-    if (keys.empty()) keys.push_back({0, 0});   // a mesh with no tets still needs an entity for its nodes
+    if (keys.empty()) keys.push_back({0, 0}); // a mesh with no tets still needs an entity for its nodes
     const auto num_entities = static_cast<Index>(keys.size());
 
     // Nodes belong to the entity of the first tet that uses them (entity 1 if unused).
@@ -665,8 +736,7 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
         if (e == 0) e = 1;
 
     // Bounding box per entity.
-    std::vector<std::array<double, 6>> box(static_cast<std::size_t>(num_entities),
-                                           {0, 0, 0, 0, 0, 0});
+    std::vector<std::array<double, 6>> box(static_cast<std::size_t>(num_entities), {0, 0, 0, 0, 0, 0});
     std::vector<bool> box_set(static_cast<std::size_t>(num_entities), false);
     for (Index v = 0; v < n; ++v) {
         const auto e = static_cast<std::size_t>(node_entity[static_cast<std::size_t>(v)] - 1);
@@ -680,10 +750,11 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
 
     // Runs of consecutive nodes / tets with the same entity become blocks (file order = index order).
     auto runs = [](const std::vector<Index>& entity) {
-        std::vector<std::pair<std::size_t, std::size_t>> r;   // [begin, end)
+        std::vector<std::pair<std::size_t, std::size_t>> r; // [begin, end)
         for (std::size_t i = 0; i < entity.size();) {
             std::size_t j = i;
-            while (j < entity.size() && entity[j] == entity[i]) ++j;
+            while (j < entity.size() && entity[j] == entity[i])
+                ++j;
             r.push_back({i, j});
             i = j;
         }
@@ -693,7 +764,8 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
     const auto tet_runs = runs(tet_entity);
 
     MshOut o{binary, {}};
-    o.s.reserve(static_cast<std::size_t>(n) * (binary ? 32 : 64) + static_cast<std::size_t>(m) * (binary ? 40 : 48) + 1024);
+    o.s.reserve(static_cast<std::size_t>(n) * (binary ? 32 : 64) + static_cast<std::size_t>(m) * (binary ? 40 : 48) +
+                1024);
     o.s += "$MeshFormat\n4.1 ";
     o.s += binary ? "1 8\n" : "0 8\n";
     if (binary) {
@@ -707,14 +779,15 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
     o.size(static_cast<std::uint64_t>(num_entities), '\n');
     for (Index e = 0; e < num_entities; ++e) {
         o.integer(e + 1);
-        for (int k = 0; k < 6; ++k) o.real(box[static_cast<std::size_t>(e)][static_cast<std::size_t>(k)]);
+        for (int k = 0; k < 6; ++k)
+            o.real(box[static_cast<std::size_t>(e)][static_cast<std::size_t>(k)]);
         if (has_labels) {
             o.size(1);
             o.integer(keys[static_cast<std::size_t>(e)].second);
         } else {
             o.size(0);
         }
-        o.size(0, '\n');   // no bounding surfaces
+        o.size(0, '\n'); // no bounding surfaces
     }
     o.end_binary();
     o.s += "$EndEntities\n$Nodes\n";
@@ -727,7 +800,8 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
         o.integer(node_entity[b]);
         o.integer(0);
         o.size(e - b, '\n');
-        for (std::size_t v = b; v < e; ++v) o.size(v + 1, '\n');
+        for (std::size_t v = b; v < e; ++v)
+            o.size(v + 1, '\n');
         for (std::size_t v = b; v < e; ++v) {
             const auto vi = static_cast<Index>(v);
             o.real(mesh.positions(vi, 0));
@@ -749,7 +823,8 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
         for (std::size_t t = b; t < e; ++t) {
             const auto ti = static_cast<Index>(t);
             o.size(t + 1);
-            for (int k = 0; k < 4; ++k) o.size(static_cast<std::uint64_t>(mesh.tets(ti, k)) + 1, k == 3 ? '\n' : ' ');
+            for (int k = 0; k < 4; ++k)
+                o.size(static_cast<std::uint64_t>(mesh.tets(ti, k)) + 1, k == 3 ? '\n' : ' ');
         }
     }
     o.end_binary();

@@ -34,14 +34,29 @@ std::string lower(std::string_view s)
 int medit_entry_tokens(const std::string& keyword)
 {
     static const std::map<std::string, int> sizes = {
-        {"edges", 3},           {"triangles", 4},          {"quadrilaterals", 5},
-        {"hexahedra", 9},       {"prisms", 7},             {"pyramids", 6},
-        {"corners", 1},         {"requiredvertices", 1},   {"ridges", 1},
-        {"requirededges", 1},   {"requiredtriangles", 1},  {"requiredquadrilaterals", 1},
-        {"requiredtetrahedra", 1}, {"normals", 3},         {"tangents", 3},
-        {"normalatvertices", 2}, {"tangentatvertices", 2}, {"normalattrianglevertices", 3},
-        {"tetrahedrap2", 11},   {"trianglesp2", 7},        {"edgesp2", 4},
-        {"crack", 2},           {"equivalence", 2},
+        {"edges", 3},
+        {"triangles", 4},
+        {"quadrilaterals", 5},
+        {"hexahedra", 9},
+        {"prisms", 7},
+        {"pyramids", 6},
+        {"corners", 1},
+        {"requiredvertices", 1},
+        {"ridges", 1},
+        {"requirededges", 1},
+        {"requiredtriangles", 1},
+        {"requiredquadrilaterals", 1},
+        {"requiredtetrahedra", 1},
+        {"normals", 3},
+        {"tangents", 3},
+        {"normalatvertices", 2},
+        {"tangentatvertices", 2},
+        {"normalattrianglevertices", 3},
+        {"tetrahedrap2", 11},
+        {"trianglesp2", 7},
+        {"edgesp2", 4},
+        {"crack", 2},
+        {"equivalence", 2},
     };
     const auto it = sizes.find(keyword);
     return it == sizes.end() ? 0 : it->second;
@@ -61,7 +76,7 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
     }
     TetMesh mesh;
     bool have_dimension = false, have_vertices = false, have_tets = false;
-    std::vector<std::int64_t> tet_lines;   // lines of tets read before the vertices (checked at the end)
+    std::vector<std::int64_t> tet_lines; // lines of tets read before the vertices (checked at the end)
     std::map<std::string, std::int64_t> skipped;
     while (!r.at_end()) {
         const std::string_view tok = r.next("a keyword");
@@ -90,9 +105,9 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
                                TextReader::describe(t));
                     mesh.positions(static_cast<Index>(i), a) = v;
                 }
-                mesh.vertex_label[static_cast<std::size_t>(i)] = static_cast<Index>(
-                    r.next_int_in("the reference of vertex " + std::to_string(i + 1),
-                                  std::numeric_limits<std::int32_t>::min(), k_max_int32));
+                mesh.vertex_label[static_cast<std::size_t>(i)] =
+                    static_cast<Index>(r.next_int_in("the reference of vertex " + std::to_string(i + 1),
+                                                     std::numeric_limits<std::int32_t>::min(), k_max_int32));
             }
             have_vertices = true;
         } else if (key == "tetrahedra") {
@@ -107,8 +122,8 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
             if (!have_vertices) tet_lines.resize(static_cast<std::size_t>(m));
             for (std::int64_t t = 0; t < m; ++t) {
                 for (int k = 0; k < 4; ++k) {
-                    const std::int64_t v = r.next_int("vertex " + std::to_string(k + 1) + " of tetrahedron " +
-                                                      std::to_string(t + 1));
+                    const std::int64_t v =
+                        r.next_int("vertex " + std::to_string(k + 1) + " of tetrahedron " + std::to_string(t + 1));
                     if (have_vertices && (v < 1 || v > nv))
                         r.fail_message("tetrahedron " + std::to_string(t + 1) + ": vertex index " + std::to_string(v) +
                                        " is past the end (Vertices has 1.." + std::to_string(nv) + ")");
@@ -118,9 +133,9 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
                     mesh.tets(static_cast<Index>(t), k) = static_cast<Index>(v - 1);
                 }
                 if (!have_vertices) tet_lines[static_cast<std::size_t>(t)] = r.line();
-                mesh.tet_label[static_cast<std::size_t>(t)] = static_cast<Index>(
-                    r.next_int_in("the reference of tetrahedron " + std::to_string(t + 1),
-                                  std::numeric_limits<std::int32_t>::min(), k_max_int32));
+                mesh.tet_label[static_cast<std::size_t>(t)] =
+                    static_cast<Index>(r.next_int_in("the reference of tetrahedron " + std::to_string(t + 1),
+                                                     std::numeric_limits<std::int32_t>::min(), k_max_int32));
             }
             have_tets = true;
         } else {
@@ -128,11 +143,12 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
             if (tok.empty() || !(std::isalpha(static_cast<unsigned char>(tok.front()))))
                 r.fail("a keyword such as Vertices or Tetrahedra", TextReader::describe(tok));
             const std::string name(tok);
-            const std::int64_t count = r.next_int_in("the number of entries of " + name, 0,
-                                                     std::numeric_limits<std::int64_t>::max() / 256);
+            const std::int64_t count =
+                r.next_int_in("the number of entries of " + name, 0, std::numeric_limits<std::int64_t>::max() / 256);
             const int per = medit_entry_tokens(key);
             if (per > 0) {
-                for (std::int64_t i = 0; i < count * per; ++i) r.next("an entry of " + name);
+                for (std::int64_t i = 0; i < count * per; ++i)
+                    r.next("an entry of " + name);
             } else {
                 r.skip_rest_of_line();
                 for (std::int64_t i = 0; i < count; ++i) {

@@ -38,12 +38,18 @@ TetMesh read_mesh(const std::string& path, ReadNotes* notes)
     if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a mesh file");
     const std::string e = extension_of(path);
     TetMesh mesh;
-    if (e == ".vtk") mesh = read_vtk(path, notes);
-    else if (e == ".vtu") mesh = read_vtu(path, notes);
-    else if (e == ".msh") mesh = read_msh(path, notes);
-    else if (e == ".node" || e == ".ele") mesh = read_tetgen(path, notes);
-    else if (e == ".mesh") mesh = read_medit(path, notes);
-    else if (e == ".veg") mesh = read_veg(path, notes);
+    if (e == ".vtk")
+        mesh = read_vtk(path, notes);
+    else if (e == ".vtu")
+        mesh = read_vtu(path, notes);
+    else if (e == ".msh")
+        mesh = read_msh(path, notes);
+    else if (e == ".node" || e == ".ele")
+        mesh = read_tetgen(path, notes);
+    else if (e == ".mesh")
+        mesh = read_medit(path, notes);
+    else if (e == ".veg")
+        mesh = read_veg(path, notes);
     else if (is_surface_path(path))
         throw Error(path + ": is a surface mesh, not a tet mesh (use 'tethash tetrahedralize' to fill it with tets)");
     else
@@ -56,12 +62,18 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
 {
     mesh.check_consistency("mesh to write to " + path);
     const std::string e = extension_of(path);
-    if (e == ".vtu") write_vtu(path, mesh, fields);
-    else if (e == ".vtk") write_vtk(path, mesh, fields);
-    else if (e == ".msh") write_msh(path, mesh);
-    else if (e == ".mesh") write_medit(path, mesh);
-    else if (e == ".node" || e == ".ele") write_tetgen(path, mesh);
-    else if (is_surface_path(path)) write_surface(path, boundary_surface(mesh));
+    if (e == ".vtu")
+        write_vtu(path, mesh, fields);
+    else if (e == ".vtk")
+        write_vtk(path, mesh, fields);
+    else if (e == ".msh")
+        write_msh(path, mesh);
+    else if (e == ".mesh")
+        write_medit(path, mesh);
+    else if (e == ".node" || e == ".ele")
+        write_tetgen(path, mesh);
+    else if (is_surface_path(path))
+        write_surface(path, boundary_surface(mesh));
     else
         throw Error(path + ": unknown output format '" + e +
                     "' (expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
@@ -72,7 +84,10 @@ namespace {
 namespace fs = std::filesystem;
 
 /// Folder that will hold `target` ("." for a bare file name).
-fs::path folder_of(const fs::path& target) { return target.has_parent_path() ? target.parent_path() : fs::path("."); }
+fs::path folder_of(const fs::path& target)
+{
+    return target.has_parent_path() ? target.parent_path() : fs::path(".");
+}
 
 /// A unique hidden temporary name next to `target`.
 fs::path temporary_for(const fs::path& target)
@@ -104,7 +119,7 @@ std::atomic<bool> g_claimed[16];
 
 /// Tracks `path` while alive.
 class TrackedTemporary {
-public:
+  public:
     explicit TrackedTemporary(const std::string& path)
     {
         if (path.size() >= sizeof(TemporarySlot::path)) return;
@@ -127,7 +142,7 @@ public:
     TrackedTemporary(const TrackedTemporary&) = delete;
     TrackedTemporary& operator=(const TrackedTemporary&) = delete;
 
-private:
+  private:
     int m_slot = -1;
 };
 
@@ -146,11 +161,14 @@ void check_target(const std::string& path)
 void write_atomically(const std::vector<std::string>& paths,
                       const std::function<void(const std::vector<std::string>&)>& write)
 {
-    for (const std::string& p : paths) check_target(p);
+    for (const std::string& p : paths)
+        check_target(p);
     std::vector<std::string> tmps;
-    for (const std::string& p : paths) tmps.push_back(temporary_for(p).string());
+    for (const std::string& p : paths)
+        tmps.push_back(temporary_for(p).string());
     std::vector<std::unique_ptr<TrackedTemporary>> tracked;
-    for (const std::string& t : tmps) tracked.push_back(std::make_unique<TrackedTemporary>(t));
+    for (const std::string& t : tmps)
+        tracked.push_back(std::make_unique<TrackedTemporary>(t));
     auto remove_temporaries = [&] {
         for (const std::string& t : tmps) {
             std::error_code ec;
@@ -167,7 +185,8 @@ void write_atomically(const std::vector<std::string>& paths,
     } catch (const Error& e) {
         remove_temporaries();
         std::string msg = e.what();
-        for (std::size_t i = 0; i < paths.size(); ++i) msg = replace_all(msg, tmps[i], paths[i]);
+        for (std::size_t i = 0; i < paths.size(); ++i)
+            msg = replace_all(msg, tmps[i], paths[i]);
         throw Error(msg);
     } catch (...) {
         remove_temporaries();

@@ -37,23 +37,29 @@ SurfaceMesh boundary_surface(const TetMesh& mesh)
     const Triangles faces = boundary_faces(mesh.tets);
     std::vector<Index> new_id(static_cast<std::size_t>(mesh.num_vertices()), -1);
     for (Eigen::Index i = 0; i < faces.rows(); ++i)
-        for (int k = 0; k < 3; ++k) new_id[static_cast<std::size_t>(faces(i, k))] = 0;
+        for (int k = 0; k < 3; ++k)
+            new_id[static_cast<std::size_t>(faces(i, k))] = 0;
     Index n = 0;
     for (auto& id : new_id)
         if (id == 0) id = n++; // increasing original index: deterministic
     SurfaceMesh s;
     s.vertices.resize(n, 3);
     for (Index v = 0; v < mesh.num_vertices(); ++v)
-        if (new_id[static_cast<std::size_t>(v)] >= 0) s.vertices.row(new_id[static_cast<std::size_t>(v)]) = mesh.positions.row(v);
+        if (new_id[static_cast<std::size_t>(v)] >= 0)
+            s.vertices.row(new_id[static_cast<std::size_t>(v)]) = mesh.positions.row(v);
     s.triangles.resize(faces.rows(), 3);
     for (Eigen::Index i = 0; i < faces.rows(); ++i)
-        for (int k = 0; k < 3; ++k) s.triangles(i, k) = new_id[static_cast<std::size_t>(faces(i, k))];
+        for (int k = 0; k < 3; ++k)
+            s.triangles(i, k) = new_id[static_cast<std::size_t>(faces(i, k))];
     return s;
 }
 
 #ifdef TETHASH_HAVE_ASSIMP
 
-bool have_assimp() { return true; }
+bool have_assimp()
+{
+    return true;
+}
 
 namespace {
 
@@ -71,10 +77,12 @@ void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
             if (face.mNumIndices != 3) continue; // points and lines
-            for (int k = 0; k < 3; ++k) tri.push_back(base + static_cast<Index>(face.mIndices[k]));
+            for (int k = 0; k < 3; ++k)
+                tri.push_back(base + static_cast<Index>(face.mIndices[k]));
         }
     }
-    for (unsigned c = 0; c < node->mNumChildren; ++c) collect(scene, node->mChildren[c], m, xyz, tri);
+    for (unsigned c = 0; c < node->mNumChildren; ++c)
+        collect(scene, node->mChildren[c], m, xyz, tri);
 }
 
 } // namespace
@@ -94,13 +102,15 @@ SurfaceMesh read_surface(const std::string& path)
     // keeping the first occurrence's order.
     const std::size_t nv = xyz.size() / 3;
     std::vector<std::size_t> order(nv);
-    for (std::size_t i = 0; i < nv; ++i) order[i] = i;
+    for (std::size_t i = 0; i < nv; ++i)
+        order[i] = i;
     auto key = [&](std::size_t i) { return std::array<double, 3>{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; };
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
     std::vector<std::size_t> rep(nv);
     for (std::size_t i = 0; i < nv;) {
         std::size_t j = i;
-        while (j < nv && key(order[j]) == key(order[i])) rep[order[j++]] = order[i];
+        while (j < nv && key(order[j]) == key(order[i]))
+            rep[order[j++]] = order[i];
         i = j;
     }
     std::vector<Index> new_id(nv, -1);
@@ -124,7 +134,7 @@ namespace {
 /// assimp's own file streams ignore write errors (a full disk gives a truncated file and success);
 /// these streams record the first error so that the export can be refused.
 class CheckedWriteStream : public Assimp::IOStream {
-public:
+  public:
     CheckedWriteStream(std::FILE* f, std::string* error) : m_file(f), m_error(error) {}
     ~CheckedWriteStream() override
     {
@@ -157,7 +167,7 @@ public:
         if (std::fflush(m_file) != 0) fail();
     }
 
-private:
+  private:
     void fail()
     {
         if (m_error->empty()) m_error->assign(std::strerror(errno ? errno : EIO));
@@ -167,7 +177,7 @@ private:
 };
 
 class CheckedIOSystem : public Assimp::DefaultIOSystem {
-public:
+  public:
     explicit CheckedIOSystem(std::string* error) : m_error(error) {}
     Assimp::IOStream* Open(const char* file, const char* mode) override
     {
@@ -181,7 +191,7 @@ public:
         return new CheckedWriteStream(f, m_error);
     }
 
-private:
+  private:
     std::string* m_error;
 };
 
@@ -192,12 +202,18 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
     namespace fs = std::filesystem;
     const std::string e = extension_of(path);
     std::string format;
-    if (e == ".obj") format = "objnomtl";
-    else if (e == ".ply") format = "plyb";
-    else if (e == ".stl") format = "stlb";
-    else if (e == ".gltf") format = "gltf2";
-    else if (e == ".glb") format = "glb2";
-    else throw Error(path + ": unknown surface format '" + e + "' (expected .obj .ply .stl .gltf .glb)");
+    if (e == ".obj")
+        format = "objnomtl";
+    else if (e == ".ply")
+        format = "plyb";
+    else if (e == ".stl")
+        format = "stlb";
+    else if (e == ".gltf")
+        format = "gltf2";
+    else if (e == ".glb")
+        format = "glb2";
+    else
+        throw Error(path + ": unknown surface format '" + e + "' (expected .obj .ply .stl .gltf .glb)");
     if (surface.triangles.rows() == 0) throw Error(path + ": surface to write has no triangles");
     const auto nv = static_cast<unsigned>(surface.vertices.rows());
     for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)
@@ -210,10 +226,10 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
     aiScene scene;
     scene.mRootNode = new aiNode();
     scene.mRootNode->mName = "tethash";
-    scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+    scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
     scene.mNumMaterials = 1;
     auto* mesh = new aiMesh();
-    scene.mMeshes = new aiMesh*[1]{mesh};
+    scene.mMeshes = new aiMesh* [1] { mesh };
     scene.mNumMeshes = 1;
     scene.mRootNode->mMeshes = new unsigned[1]{0};
     scene.mRootNode->mNumMeshes = 1;
@@ -222,15 +238,17 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
     mesh->mNumVertices = nv;
     mesh->mVertices = new aiVector3D[nv];
     for (unsigned v = 0; v < nv; ++v)
-        mesh->mVertices[v] = aiVector3D(static_cast<ai_real>(surface.vertices(v, 0)), static_cast<ai_real>(surface.vertices(v, 1)),
-                                        static_cast<ai_real>(surface.vertices(v, 2)));
+        mesh->mVertices[v] =
+            aiVector3D(static_cast<ai_real>(surface.vertices(v, 0)), static_cast<ai_real>(surface.vertices(v, 1)),
+                       static_cast<ai_real>(surface.vertices(v, 2)));
     const auto nf = static_cast<unsigned>(surface.triangles.rows());
     mesh->mNumFaces = nf;
     mesh->mFaces = new aiFace[nf];
     for (unsigned f = 0; f < nf; ++f) {
         mesh->mFaces[f].mNumIndices = 3;
         mesh->mFaces[f].mIndices = new unsigned[3];
-        for (int k = 0; k < 3; ++k) mesh->mFaces[f].mIndices[k] = static_cast<unsigned>(surface.triangles(f, k));
+        for (int k = 0; k < 3; ++k)
+            mesh->mFaces[f].mIndices[k] = static_cast<unsigned>(surface.triangles(f, k));
     }
 
     write_atomically(path, [&](const std::string& tmp) {
@@ -269,8 +287,14 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
 
 #else
 
-bool have_assimp() { return false; }
-SurfaceMesh read_surface(const std::string& path) { throw Error(path + ": cannot read surfaces: tethash was built without assimp"); }
+bool have_assimp()
+{
+    return false;
+}
+SurfaceMesh read_surface(const std::string& path)
+{
+    throw Error(path + ": cannot read surfaces: tethash was built without assimp");
+}
 void write_surface(const std::string& path, const SurfaceMesh&)
 {
     throw Error(path + ": cannot write surfaces: tethash was built without assimp");

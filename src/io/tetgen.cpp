@@ -37,7 +37,10 @@ std::pair<std::string, std::string> tetgen_pair(const std::string& path)
 }
 
 /// Reads an index token `what` and checks it is an integer.
-std::int64_t read_index(TextReader& r, std::string_view what) { return r.next_int(what); }
+std::int64_t read_index(TextReader& r, std::string_view what)
+{
+    return r.next_int(what);
+}
 
 /// Reads the next integer if it is on line `line` (TetGen headers may leave out trailing values), else `fallback`.
 std::int64_t header_value(TextReader& r, std::int64_t line, std::string_view what, std::int64_t fallback)
@@ -89,11 +92,12 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
             for (int a = 0; a < 3; ++a)
                 mesh.positions(static_cast<Index>(i), a) =
                     r.next_double(std::string(axis[a]) + " coordinate of node " + std::to_string(id));
-            for (std::int64_t k = 0; k < nattr; ++k) r.next_double_any("a node attribute");
+            for (std::int64_t k = 0; k < nattr; ++k)
+                r.next_double_any("a node attribute");
             if (nmark)
-                mesh.vertex_label[static_cast<std::size_t>(i)] = static_cast<Index>(r.next_int_in(
-                    "the boundary marker of node " + std::to_string(id), std::numeric_limits<std::int32_t>::min(),
-                    k_max_int32));
+                mesh.vertex_label[static_cast<std::size_t>(i)] =
+                    static_cast<Index>(r.next_int_in("the boundary marker of node " + std::to_string(id),
+                                                     std::numeric_limits<std::int32_t>::min(), k_max_int32));
         }
         if (!r.at_end()) r.fail("end of file after " + std::to_string(n) + " nodes", TextReader::describe(r.next("")));
         if (nattr && notes) notes->messages.push_back("ignored " + std::to_string(nattr) + " node attribute(s)");
@@ -117,8 +121,9 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
         for (std::int64_t t = 0; t < m; ++t) {
             const std::int64_t id = read_index(r, "a tet index");
             if (id != base + t)
-                r.fail("tet index " + std::to_string(base + t) + " (indices are consecutive from the first node index " +
-                           std::to_string(base) + "; the header says " + std::to_string(m) + " tets)",
+                r.fail("tet index " + std::to_string(base + t) +
+                           " (indices are consecutive from the first node index " + std::to_string(base) +
+                           "; the header says " + std::to_string(m) + " tets)",
                        std::to_string(id));
             for (std::int64_t k = 0; k < per; ++k) {
                 const std::int64_t v = r.next_int("node " + std::to_string(k + 1) + " of tet " + std::to_string(id));
@@ -140,13 +145,16 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
                 integral = integral && a == std::floor(a) && std::abs(a) <= static_cast<double>(k_max_int32);
             if (integral) {
                 mesh.tet_label.resize(first_attr.size());
-                for (std::size_t t = 0; t < first_attr.size(); ++t) mesh.tet_label[t] = static_cast<Index>(first_attr[t]);
+                for (std::size_t t = 0; t < first_attr.size(); ++t)
+                    mesh.tet_label[t] = static_cast<Index>(first_attr[t]);
             } else if (notes) {
-                notes->messages.push_back(ele_path + ": the first tet attribute is not integer-valued; not kept as labels");
+                notes->messages.push_back(ele_path +
+                                          ": the first tet attribute is not integer-valued; not kept as labels");
             }
         }
         if (per == 10 && notes)
-            notes->messages.push_back(ele_path + ": 10-node tets read as 4-node tets (their first 4 nodes, the corners)");
+            notes->messages.push_back(ele_path +
+                                      ": 10-node tets read as 4-node tets (their first 4 nodes, the corners)");
     }
     return mesh;
 }

@@ -84,7 +84,8 @@ std::vector<std::array<std::int64_t, 4>> lattice_tets(const Lattice& lat)
     std::int64_t count = 0;
     for (int a = 0; a < 3; ++a) {
         std::int64_t c = 4;
-        for (int b = 0; b < 3; ++b) c *= (b == a ? lat.nc[b] - 1 : lat.nc[b]);
+        for (int b = 0; b < 3; ++b)
+            c *= (b == a ? lat.nc[b] - 1 : lat.nc[b]);
         count += c;
     }
     if (count > std::numeric_limits<Index>::max())
@@ -173,7 +174,8 @@ void repair_nonmanifold(const std::vector<std::array<std::int64_t, 4>>& all, std
         std::vector<Face> boundary;
         for (std::size_t i = 0; i < faces.size();) {
             std::size_t j = i;
-            while (j < faces.size() && faces[j] == faces[i]) ++j;
+            while (j < faces.size() && faces[j] == faces[i])
+                ++j;
             if (j - i == 1) boundary.push_back(faces[i]);
             i = j;
         }
@@ -188,27 +190,32 @@ void repair_nonmanifold(const std::vector<std::array<std::int64_t, 4>>& all, std
         std::vector<std::pair<std::int64_t, std::int64_t>> bad_edges;
         for (std::size_t i = 0; i < edges.size();) {
             std::size_t j = i;
-            while (j < edges.size() && edges[j] == edges[i]) ++j;
+            while (j < edges.size() && edges[j] == edges[i])
+                ++j;
             if (j - i > 2) bad_edges.push_back(edges[i]);
             i = j;
         }
         // Fans: per vertex, the boundary faces around it joined when they share an edge at the vertex.
         std::vector<std::pair<std::int64_t, std::size_t>> incident; // (vertex, boundary face)
         for (std::size_t f = 0; f < boundary.size(); ++f)
-            for (auto v : boundary[f]) incident.push_back({v, f});
+            for (auto v : boundary[f])
+                incident.push_back({v, f});
         std::sort(incident.begin(), incident.end());
         std::vector<std::int64_t> bad_vertices;
         std::vector<int> parent;
         for (std::size_t i = 0; i < incident.size();) {
             std::size_t j = i;
-            while (j < incident.size() && incident[j].first == incident[i].first) ++j;
+            while (j < incident.size() && incident[j].first == incident[i].first)
+                ++j;
             const std::int64_t v = incident[i].first;
             const std::size_t n = j - i;
             parent.resize(n);
-            for (std::size_t a = 0; a < n; ++a) parent[a] = static_cast<int>(a);
+            for (std::size_t a = 0; a < n; ++a)
+                parent[a] = static_cast<int>(a);
             auto find = [&](int x) {
                 while (parent[static_cast<std::size_t>(x)] != x)
-                    x = parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+                    x = parent[static_cast<std::size_t>(x)] =
+                        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
                 return x;
             };
             for (std::size_t a = 0; a < n; ++a)
@@ -253,7 +260,8 @@ void snap_boundary(TetMesh& mesh, const std::function<bool(const Vec3&, Vec3&)>&
     const Triangles bf = boundary_faces(mesh.tets);
     std::vector<char> on_boundary(static_cast<std::size_t>(n), 0);
     for (Eigen::Index i = 0; i < bf.rows(); ++i)
-        for (int k = 0; k < 3; ++k) on_boundary[static_cast<std::size_t>(bf(i, k))] = 1;
+        for (int k = 0; k < 3; ++k)
+            on_boundary[static_cast<std::size_t>(bf(i, k))] = 1;
     std::vector<Index> verts;
     for (Index v = 0; v < n; ++v)
         if (on_boundary[static_cast<std::size_t>(v)]) verts.push_back(v);
@@ -268,7 +276,7 @@ void snap_boundary(TetMesh& mesh, const std::function<bool(const Vec3&, Vec3&)>&
     std::vector<char> has_goal(verts.size(), 0);
     for (int sweep = 0; sweep < 2; ++sweep) {
         // Targets depend only on the vertex's own position: compute them in parallel.
-TETHASH_OMP("omp parallel for schedule(dynamic, 64)")
+        TETHASH_OMP("omp parallel for schedule(dynamic, 64)")
         for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(verts.size()); ++i) {
             Vec3 g;
             has_goal[static_cast<std::size_t>(i)] = target(P(verts[static_cast<std::size_t>(i)]), g) ? 1 : 0;
@@ -290,9 +298,11 @@ TETHASH_OMP("omp parallel for schedule(dynamic, 64)")
                      ok && k < inc.offsets[static_cast<std::size_t>(v) + 1]; ++k) {
                     const Index t = inc.neighbours[static_cast<std::size_t>(k)];
                     Vec3 x[4];
-                    for (int c = 0; c < 4; ++c) x[c] = mesh.tets(t, c) == v ? q : P(mesh.tets(t, c));
+                    for (int c = 0; c < 4; ++c)
+                        x[c] = mesh.tets(t, c) == v ? q : P(mesh.tets(t, c));
                     const double vol = signed_vol(x[0], x[1], x[2], x[3]);
-                    if (!(vol >= kMinVolumeFraction * vol0[static_cast<std::size_t>(t)]) || min_dihedral(x) < kMinDihedral)
+                    if (!(vol >= kMinVolumeFraction * vol0[static_cast<std::size_t>(t)]) ||
+                        min_dihedral(x) < kMinDihedral)
                         ok = false;
                 }
                 if (ok) {
@@ -311,7 +321,7 @@ TetMesh build(const Lattice& lat, const std::function<std::vector<char>(const st
 {
     const auto all = lattice_tets(lat);
     std::vector<Vec3> centroids(all.size());
-TETHASH_OMP("omp parallel for schedule(static)")
+    TETHASH_OMP("omp parallel for schedule(static)")
     for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>(all.size()); ++t) {
         const auto& q = all[static_cast<std::size_t>(t)];
         centroids[static_cast<std::size_t>(t)] =
@@ -329,7 +339,8 @@ TETHASH_OMP("omp parallel for schedule(static)")
     for (std::size_t t = 0; t < all.size(); ++t)
         if (keep[t]) {
             ++kept_tets;
-            for (auto v : all[t]) new_id[static_cast<std::size_t>(v)] = 0;
+            for (auto v : all[t])
+                new_id[static_cast<std::size_t>(v)] = 0;
         }
     Index nv = 0;
     for (auto& id : new_id)
@@ -343,7 +354,8 @@ TETHASH_OMP("omp parallel for schedule(static)")
     Eigen::Index row = 0;
     for (std::size_t t = 0; t < all.size(); ++t)
         if (keep[t]) {
-            for (int c = 0; c < 4; ++c) mesh.tets(row, c) = new_id[static_cast<std::size_t>(all[t][c])];
+            for (int c = 0; c < 4; ++c)
+                mesh.tets(row, c) = new_id[static_cast<std::size_t>(all[t][c])];
             ++row;
         }
     if (target) snap_boundary(mesh, *target, 0.75 * lat.h.maxCoeff());
@@ -353,7 +365,7 @@ TETHASH_OMP("omp parallel for schedule(static)")
 // ---- surfaces: bounding-volume hierarchy for winding numbers and closest points -------------
 
 class SurfaceTree {
-public:
+  public:
     explicit SurfaceTree(const SurfaceMesh& s) : m_s(s)
     {
         const auto nt = static_cast<std::size_t>(s.triangles.rows());
@@ -432,15 +444,15 @@ public:
         return best_p;
     }
 
-private:
+  private:
     static constexpr int kLeaf = 8;
     static constexpr double kBeta = 2.0; ///< far field when distance > kBeta × node radius
 
     struct Node {
         Eigen::AlignedBox3d box;
-        Vec3 centre = Vec3::Zero();   ///< area-weighted centroid of the node's triangles
-        Vec3 area = Vec3::Zero();     ///< sum of area vectors (½ (b-a)×(c-a))
-        double radius = 0;            ///< max distance from centre to a triangle vertex
+        Vec3 centre = Vec3::Zero(); ///< area-weighted centroid of the node's triangles
+        Vec3 area = Vec3::Zero();   ///< sum of area vectors (½ (b-a)×(c-a))
+        double radius = 0;          ///< max distance from centre to a triangle vertex
         int left = -1, right = -1, begin = 0, end = 0;
     };
 
@@ -475,7 +487,8 @@ private:
         nd.centre = total_area > 0 ? Vec3(weighted / total_area) : nd.box.center();
         for (int i = begin; i < end; ++i) {
             const auto t = static_cast<std::size_t>(m_order[static_cast<std::size_t>(i)]);
-            for (int k = 0; k < 3; ++k) nd.radius = std::max(nd.radius, (vertex(t, k) - nd.centre).norm());
+            for (int k = 0; k < 3; ++k)
+                nd.radius = std::max(nd.radius, (vertex(t, k) - nd.centre).norm());
         }
         if (end - begin > kLeaf) {
             int axis = 0;
@@ -545,14 +558,15 @@ void check_surface(const SurfaceMesh& s)
 
 } // namespace
 
-TetMesh tetrahedralize_sdf(const std::function<double(const Eigen::Vector3d&)>& sdf, const Eigen::Vector3d& box_min,
-                           const Eigen::Vector3d& box_max, int resolution, bool snap,
-                           const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&)>& project)
+TetMesh
+tetrahedralize_sdf(const std::function<double(const Eigen::Vector3d&)>& sdf, const Eigen::Vector3d& box_min,
+                   const Eigen::Vector3d& box_max, int resolution, bool snap,
+                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&, const Eigen::Vector3d&)>& project)
 {
     const Lattice lat = make_lattice(box_min, box_max, resolution);
     auto inside = [&](const std::vector<Vec3>& pts) {
         std::vector<char> in(pts.size());
-TETHASH_OMP("omp parallel for schedule(static)")
+        TETHASH_OMP("omp parallel for schedule(static)")
         for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(pts.size()); ++i)
             in[static_cast<std::size_t>(i)] = sdf(pts[static_cast<std::size_t>(i)]) < 0 ? 1 : 0;
         return in;
@@ -591,7 +605,7 @@ std::vector<double> winding_numbers(const SurfaceMesh& surface, const std::vecto
     check_surface(surface);
     const SurfaceTree tree(surface);
     std::vector<double> w(points.size());
-TETHASH_OMP("omp parallel for schedule(dynamic, 256)")
+    TETHASH_OMP("omp parallel for schedule(dynamic, 256)")
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(points.size()); ++i)
         w[static_cast<std::size_t>(i)] = tree.winding(points[static_cast<std::size_t>(i)]);
     return w;
@@ -606,7 +620,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeParams& p
     const SurfaceTree tree(surface);
     auto inside = [&](const std::vector<Vec3>& pts) {
         std::vector<char> in(pts.size());
-TETHASH_OMP("omp parallel for schedule(dynamic, 256)")
+        TETHASH_OMP("omp parallel for schedule(dynamic, 256)")
         for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(pts.size()); ++i) {
             const Vec3& p = pts[static_cast<std::size_t>(i)];
             // Outside the bounding box the winding number of a (nearly) closed surface is ~0.

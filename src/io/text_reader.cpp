@@ -52,7 +52,8 @@ void TextReader::skip_space()
         } else if (is_space(c)) {
             ++m_pos;
         } else if (m_comment && c == m_comment) {
-            while (m_pos < n && m_data[m_pos] != '\n') ++m_pos;
+            while (m_pos < n && m_data[m_pos] != '\n')
+                ++m_pos;
         } else {
             break;
         }
@@ -69,7 +70,8 @@ std::string_view TextReader::peek()
 {
     skip_space();
     std::size_t e = m_pos;
-    while (e < m_data.size() && !is_space(m_data[e]) && !(m_comment && m_data[e] == m_comment)) ++e;
+    while (e < m_data.size() && !is_space(m_data[e]) && !(m_comment && m_data[e] == m_comment))
+        ++e;
     return std::string_view(m_data).substr(m_pos, e - m_pos);
 }
 
@@ -95,12 +97,13 @@ std::string_view TextReader::next(std::string_view what)
 void TextReader::expect(std::string_view word, bool ignore_case)
 {
     const std::string_view tok = next(word);
-    const bool same = ignore_case ? (tok.size() == word.size() &&
-                                     std::equal(tok.begin(), tok.end(), word.begin(), [](char a, char b) {
-                                         return std::tolower(static_cast<unsigned char>(a)) ==
-                                                std::tolower(static_cast<unsigned char>(b));
-                                     }))
-                                  : tok == word;
+    const bool same =
+        ignore_case ? (tok.size() == word.size() && std::equal(tok.begin(), tok.end(), word.begin(),
+                                                               [](char a, char b) {
+                                                                   return std::tolower(static_cast<unsigned char>(a)) ==
+                                                                          std::tolower(static_cast<unsigned char>(b));
+                                                               }))
+                    : tok == word;
     if (!same) fail(word, describe(tok));
 }
 
@@ -139,7 +142,8 @@ double TextReader::next_double_any(std::string_view what)
 
 void TextReader::skip_rest_of_line()
 {
-    while (m_pos < m_data.size() && m_data[m_pos] != '\n') ++m_pos;
+    while (m_pos < m_data.size() && m_data[m_pos] != '\n')
+        ++m_pos;
     if (m_pos < m_data.size()) {
         ++m_pos;
         ++m_line;
@@ -151,7 +155,8 @@ std::string_view TextReader::next_line(bool* eof)
     if (eof) *eof = m_pos >= m_data.size();
     m_token_line = m_line;
     const std::size_t start = m_pos;
-    while (m_pos < m_data.size() && m_data[m_pos] != '\n') ++m_pos;
+    while (m_pos < m_data.size() && m_data[m_pos] != '\n')
+        ++m_pos;
     std::size_t end = m_pos;
     if (m_pos < m_data.size()) {
         ++m_pos;
@@ -169,7 +174,8 @@ bool TextReader::skip_past_line(std::string_view marker)
         if (hit == std::string::npos) return false;
         const bool line_start = hit == 0 || m_data[hit - 1] == '\n';
         std::size_t e = hit + marker.size();
-        while (e < m_data.size() && (m_data[e] == ' ' || m_data[e] == '\t' || m_data[e] == '\r')) ++e;
+        while (e < m_data.size() && (m_data[e] == ' ' || m_data[e] == '\t' || m_data[e] == '\r'))
+            ++e;
         const bool line_end = e >= m_data.size() || m_data[e] == '\n';
         if (line_start && line_end) {
             m_line += std::count(m_data.begin() + static_cast<std::ptrdiff_t>(m_pos),
@@ -210,7 +216,10 @@ void TextReader::fail(std::string_view expected, std::string_view found) const
                 std::string(found));
 }
 
-void TextReader::fail_message(const std::string& message) const { fail_at_line(m_token_line, message); }
+void TextReader::fail_message(const std::string& message) const
+{
+    fail_at_line(m_token_line, message);
+}
 
 void TextReader::fail_at_line(std::int64_t line, const std::string& message) const
 {
@@ -232,8 +241,7 @@ void TextReader::skip_bytes(std::size_t count, std::string_view what)
 {
     if (m_data.size() - m_pos < count)
         fail_at_byte(m_pos, "expected " + std::string(what) + " (" + std::to_string(count) +
-                                " bytes), found end of file after " + std::to_string(m_data.size() - m_pos) +
-                                " bytes");
+                                " bytes), found end of file after " + std::to_string(m_data.size() - m_pos) + " bytes");
     m_pos += count;
 }
 

@@ -21,7 +21,7 @@ std::string read_file_bytes(const std::string& path);
 
 /// Whitespace-separated tokens with line numbers; optional end-of-line comments and extra separators.
 class TextReader {
-public:
+  public:
     /// Reads `path` whole. `comment`: a character that starts a comment running to the end of the line
     /// ('\0' for none). `extra_separator`: one more character treated as whitespace ('\0' for none).
     explicit TextReader(std::string path, char comment = '\0', char extra_separator = '\0');
@@ -83,8 +83,7 @@ public:
     void set_swap_bytes(bool swap) { m_swap = swap; }
     bool swap_bytes() const { return m_swap; }
     /// Reads a value of type T (int32_t, uint32_t, uint64_t, double ...) at the current offset.
-    template <class T>
-    T read_binary(std::string_view what)
+    template <class T> T read_binary(std::string_view what)
     {
         if (m_data.size() - m_pos < sizeof(T))
             fail_at_byte(m_pos, "expected " + std::string(what) + " (" + std::to_string(sizeof(T)) +
@@ -92,7 +91,8 @@ public:
         unsigned char bytes[sizeof(T)];
         std::memcpy(bytes, m_data.data() + m_pos, sizeof(T));
         if (m_swap)
-            for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
+            for (std::size_t i = 0; i < sizeof(T) / 2; ++i)
+                std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
         T value;
         std::memcpy(&value, bytes, sizeof(T));
         m_pos += sizeof(T);
@@ -103,19 +103,18 @@ public:
     /// Skips `count` bytes; throws at the end of the file.
     void skip_bytes(std::size_t count, std::string_view what);
 
-private:
+  private:
     void skip_space();
     bool is_space(char c) const
     {
-        return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v' ||
-               (m_extra && c == m_extra);
+        return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v' || (m_extra && c == m_extra);
     }
 
     std::string m_path;
     std::string m_data;
     std::size_t m_pos = 0;
-    std::int64_t m_line = 1;        ///< line at m_pos
-    std::int64_t m_token_line = 1;  ///< line of the last token
+    std::int64_t m_line = 1;       ///< line at m_pos
+    std::int64_t m_token_line = 1; ///< line of the last token
     char m_comment = '\0';
     char m_extra = '\0';
     bool m_swap = false;

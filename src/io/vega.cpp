@@ -57,8 +57,8 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
             for (std::int64_t i = 0; i < n; ++i) {
                 const std::int64_t id = r.next_int("a vertex number");
                 if (id != i + 1)
-                    r.fail("vertex number " + std::to_string(i + 1) + " (vertices are numbered 1.." + std::to_string(n) +
-                               " in order)",
+                    r.fail("vertex number " + std::to_string(i + 1) + " (vertices are numbered 1.." +
+                               std::to_string(n) + " in order)",
                            std::to_string(id));
                 for (int a = 0; a < 3; ++a)
                     mesh.positions(static_cast<Index>(i), a) =
@@ -100,7 +100,8 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
             r.fail_message("*INCLUDE is not supported (merge the included file into " + path + ")");
         } else {
             // *MATERIAL, *REGION, *SET, *SOLVER, ...: skip to the next keyword.
-            while (!r.at_end() && r.peek().front() != '*') r.next("");
+            while (!r.at_end() && r.peek().front() != '*')
+                r.next("");
             skipped[key] += 1;
         }
     }

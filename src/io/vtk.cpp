@@ -32,37 +32,56 @@ namespace vtk_detail {
 int scalar_size(Scalar t)
 {
     switch (t) {
-    case Scalar::Bit: return 0;
+    case Scalar::Bit:
+        return 0;
     case Scalar::Int8:
-    case Scalar::UInt8: return 1;
+    case Scalar::UInt8:
+        return 1;
     case Scalar::Int16:
-    case Scalar::UInt16: return 2;
+    case Scalar::UInt16:
+        return 2;
     case Scalar::Int32:
     case Scalar::UInt32:
-    case Scalar::Float32: return 4;
+    case Scalar::Float32:
+        return 4;
     case Scalar::Int64:
     case Scalar::UInt64:
-    case Scalar::Float64: return 8;
+    case Scalar::Float64:
+        return 8;
     }
     return 0;
 }
 
-bool scalar_is_integer(Scalar t) { return t != Scalar::Float32 && t != Scalar::Float64; }
+bool scalar_is_integer(Scalar t)
+{
+    return t != Scalar::Float32 && t != Scalar::Float64;
+}
 
 const char* xml_type_name(Scalar t)
 {
     switch (t) {
-    case Scalar::Bit: return "Bit";
-    case Scalar::Int8: return "Int8";
-    case Scalar::UInt8: return "UInt8";
-    case Scalar::Int16: return "Int16";
-    case Scalar::UInt16: return "UInt16";
-    case Scalar::Int32: return "Int32";
-    case Scalar::UInt32: return "UInt32";
-    case Scalar::Int64: return "Int64";
-    case Scalar::UInt64: return "UInt64";
-    case Scalar::Float32: return "Float32";
-    case Scalar::Float64: return "Float64";
+    case Scalar::Bit:
+        return "Bit";
+    case Scalar::Int8:
+        return "Int8";
+    case Scalar::UInt8:
+        return "UInt8";
+    case Scalar::Int16:
+        return "Int16";
+    case Scalar::UInt16:
+        return "UInt16";
+    case Scalar::Int32:
+        return "Int32";
+    case Scalar::UInt32:
+        return "UInt32";
+    case Scalar::Int64:
+        return "Int64";
+    case Scalar::UInt64:
+        return "UInt64";
+    case Scalar::Float32:
+        return "Float32";
+    case Scalar::Float64:
+        return "Float64";
     }
     return "?";
 }
@@ -70,9 +89,9 @@ const char* xml_type_name(Scalar t)
 std::optional<Scalar> scalar_from_xml(std::string_view n)
 {
     static const std::pair<const char*, Scalar> table[] = {
-        {"Int8", Scalar::Int8},       {"UInt8", Scalar::UInt8},     {"Int16", Scalar::Int16},
-        {"UInt16", Scalar::UInt16},   {"Int32", Scalar::Int32},     {"UInt32", Scalar::UInt32},
-        {"Int64", Scalar::Int64},     {"UInt64", Scalar::UInt64},   {"Float32", Scalar::Float32},
+        {"Int8", Scalar::Int8},       {"UInt8", Scalar::UInt8},   {"Int16", Scalar::Int16},
+        {"UInt16", Scalar::UInt16},   {"Int32", Scalar::Int32},   {"UInt32", Scalar::UInt32},
+        {"Int64", Scalar::Int64},     {"UInt64", Scalar::UInt64}, {"Float32", Scalar::Float32},
         {"Float64", Scalar::Float64},
     };
     for (const auto& [name, t] : table)
@@ -84,7 +103,8 @@ namespace {
 std::string lower(std::string_view s)
 {
     std::string r(s);
-    for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : r)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return r;
 }
 } // namespace
@@ -100,9 +120,9 @@ std::optional<Scalar> scalar_from_legacy(std::string_view name)
         {"unsigned_short", Scalar::UInt16},
         {"int", Scalar::Int32},
         {"unsigned_int", Scalar::UInt32},
-        {"long", Scalar::Int64},            // LP64: VTK writes sizeof(long) bytes
+        {"long", Scalar::Int64}, // LP64: VTK writes sizeof(long) bytes
         {"unsigned_long", Scalar::UInt64},
-        {"vtkidtype", Scalar::Int32},       // the legacy writer stores vtkIdType arrays as int
+        {"vtkidtype", Scalar::Int32}, // the legacy writer stores vtkIdType arrays as int
         {"float", Scalar::Float32},
         {"double", Scalar::Float64},
         {"vtktypeint8", Scalar::Int8},
@@ -123,32 +143,47 @@ std::optional<Scalar> scalar_from_legacy(std::string_view name)
 }
 
 namespace {
-template <class T>
-T load(const unsigned char* p, bool big_endian)
+template <class T> T load(const unsigned char* p, bool big_endian)
 {
     unsigned char b[sizeof(T)];
     std::memcpy(b, p, sizeof(T));
     if (big_endian)
-        for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+        for (std::size_t i = 0; i < sizeof(T) / 2; ++i)
+            std::swap(b[i], b[sizeof(T) - 1 - i]);
     T v;
     std::memcpy(&v, b, sizeof(T));
     return v;
 }
 
-template <class Out>
-void convert(const unsigned char* src, Scalar t, std::size_t count, bool be, Out* out)
+template <class Out> void convert(const unsigned char* src, Scalar t, std::size_t count, bool be, Out* out)
 {
     const int s = scalar_size(t);
     for (std::size_t i = 0; i < count; ++i, src += s) {
         switch (t) {
-        case Scalar::Bit: out[i] = 0; break;
-        case Scalar::Int8: out[i] = static_cast<Out>(load<std::int8_t>(src, be)); break;
-        case Scalar::UInt8: out[i] = static_cast<Out>(load<std::uint8_t>(src, be)); break;
-        case Scalar::Int16: out[i] = static_cast<Out>(load<std::int16_t>(src, be)); break;
-        case Scalar::UInt16: out[i] = static_cast<Out>(load<std::uint16_t>(src, be)); break;
-        case Scalar::Int32: out[i] = static_cast<Out>(load<std::int32_t>(src, be)); break;
-        case Scalar::UInt32: out[i] = static_cast<Out>(load<std::uint32_t>(src, be)); break;
-        case Scalar::Int64: out[i] = static_cast<Out>(load<std::int64_t>(src, be)); break;
+        case Scalar::Bit:
+            out[i] = 0;
+            break;
+        case Scalar::Int8:
+            out[i] = static_cast<Out>(load<std::int8_t>(src, be));
+            break;
+        case Scalar::UInt8:
+            out[i] = static_cast<Out>(load<std::uint8_t>(src, be));
+            break;
+        case Scalar::Int16:
+            out[i] = static_cast<Out>(load<std::int16_t>(src, be));
+            break;
+        case Scalar::UInt16:
+            out[i] = static_cast<Out>(load<std::uint16_t>(src, be));
+            break;
+        case Scalar::Int32:
+            out[i] = static_cast<Out>(load<std::int32_t>(src, be));
+            break;
+        case Scalar::UInt32:
+            out[i] = static_cast<Out>(load<std::uint32_t>(src, be));
+            break;
+        case Scalar::Int64:
+            out[i] = static_cast<Out>(load<std::int64_t>(src, be));
+            break;
         case Scalar::UInt64: {
             const std::uint64_t v = load<std::uint64_t>(src, be);
             // Values past int64 become -1 so that range checks reject them.
@@ -238,25 +273,44 @@ std::string quote_token(std::string_view token)
 std::string cell_type_name(std::int64_t type)
 {
     switch (type) {
-    case 1: return "vertex";
-    case 2: return "poly-vertex";
-    case 3: return "line";
-    case 4: return "poly-line";
-    case 5: return "triangle";
-    case 6: return "triangle strip";
-    case 7: return "polygon";
-    case 8: return "pixel";
-    case 9: return "quad";
-    case 10: return "tetra";
-    case 11: return "voxel";
-    case 12: return "hexahedron";
-    case 13: return "wedge";
-    case 14: return "pyramid";
-    case 22: return "quadratic triangle";
-    case 24: return "quadratic tetra";
-    case 25: return "quadratic hexahedron";
-    case 42: return "polyhedron";
-    default: return "type " + std::to_string(type);
+    case 1:
+        return "vertex";
+    case 2:
+        return "poly-vertex";
+    case 3:
+        return "line";
+    case 4:
+        return "poly-line";
+    case 5:
+        return "triangle";
+    case 6:
+        return "triangle strip";
+    case 7:
+        return "polygon";
+    case 8:
+        return "pixel";
+    case 9:
+        return "quad";
+    case 10:
+        return "tetra";
+    case 11:
+        return "voxel";
+    case 12:
+        return "hexahedron";
+    case 13:
+        return "wedge";
+    case 14:
+        return "pyramid";
+    case 22:
+        return "quadratic triangle";
+    case 24:
+        return "quadratic tetra";
+    case 25:
+        return "quadratic hexahedron";
+    case 42:
+        return "polyhedron";
+    default:
+        return "type " + std::to_string(type);
     }
 }
 
@@ -264,13 +318,12 @@ std::string cell_type_name(std::int64_t type)
 
 namespace {
 const char* const k_object_names[] = {"object", "tet_object", "vertex_object"};
-const char* const k_cell_label_names[] = {"tet_label", "label", "gmsh:physical", "medit:ref", "cellentityids",
-                                          "materialids", "material"};
+const char* const k_cell_label_names[] = {"tet_label",     "label",       "gmsh:physical", "medit:ref",
+                                          "cellentityids", "materialids", "material"};
 const char* const k_point_label_names[] = {"vertex_label", "label", "medit:ref", "tetgen:ref"};
 
 /// Rank of `name` in `list` (lower is preferred), or -1.
-template <std::size_t N>
-int rank_in(const std::string& name, const char* const (&list)[N])
+template <std::size_t N> int rank_in(const std::string& name, const char* const (&list)[N])
 {
     for (std::size_t i = 0; i < N; ++i)
         if (name == list[i]) return static_cast<int>(i);
@@ -309,8 +362,8 @@ void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arra
             const int r = rank_in(lower(a.name), names);
             if (r < 0 || r >= best_rank) continue;
             if (a.values.size() != expected) {
-                note(a.where + ": array '" + a.name + "' has " + std::to_string(a.values.size()) + " values, expected " +
-                     std::to_string(expected) + "; not used as " + what);
+                note(a.where + ": array '" + a.name + "' has " + std::to_string(a.values.size()) +
+                     " values, expected " + std::to_string(expected) + "; not used as " + what);
                 continue;
             }
             if (!all_integers(a.values, min_value)) {
@@ -342,7 +395,8 @@ void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arra
     if (!mesh.tet_object.empty() && mesh.vertex_object.empty()) {
         mesh.vertex_object.assign(n, 0);
         for (Index t = 0; t < mesh.num_tets(); ++t)
-            for (int k = 0; k < 4; ++k) mesh.vertex_object[static_cast<std::size_t>(mesh.tets(t, k))] = mesh.tet_object[t];
+            for (int k = 0; k < 4; ++k)
+                mesh.vertex_object[static_cast<std::size_t>(mesh.tets(t, k))] = mesh.tet_object[t];
     } else if (mesh.tet_object.empty() && !mesh.vertex_object.empty()) {
         mesh.tet_object.resize(static_cast<std::size_t>(mesh.num_tets()));
         for (Index t = 0; t < mesh.num_tets(); ++t)
@@ -378,17 +432,19 @@ void collect_out_arrays(const std::string& path, const TetMesh& mesh, const Fiel
         for (const Field& f : in) {
             check(f, count, where);
             for (const OutArray& o : out)
-                if (o.name == f.name) throw Error(path + ": two " + std::string(where) + " fields are called '" + f.name + "'");
+                if (o.name == f.name)
+                    throw Error(path + ": two " + std::string(where) + " fields are called '" + f.name + "'");
             out.push_back({f.name, f.components, false, &f.values, nullptr});
         }
     };
     const std::size_t n = static_cast<std::size_t>(mesh.num_vertices()), m = static_cast<std::size_t>(mesh.num_tets());
     add_fields(fields.point, n, "point", point);
     add_fields(fields.cell, m, "cell", cell);
-    const auto add_ints = [](std::vector<OutArray>& out, const char* name, const std::vector<Index>& v, std::size_t count) {
+    const auto add_ints = [](std::vector<OutArray>& out, const char* name, const std::vector<Index>& v,
+                             std::size_t count) {
         if (v.size() != count || count == 0) return;
         for (const OutArray& o : out)
-            if (o.name == name) return;   // a user field of that name wins
+            if (o.name == name) return; // a user field of that name wins
         out.push_back({name, 1, true, nullptr, &v});
     };
     add_ints(point, "object", mesh.vertex_object, n);
@@ -447,10 +503,11 @@ bool Base64Reader::fill()
         }
         if (c == '=') {
             ++m_p;
-            if (got == 0) continue;    // stray padding between pieces
+            if (got == 0) continue; // stray padding between pieces
             // Consume the rest of the padding of this quantum.
             int pads = 1;
-            while (got + pads < 4 && m_p < m_end && *m_p == '=') ++m_p, ++pads;
+            while (got + pads < 4 && m_p < m_end && *m_p == '=')
+                ++m_p, ++pads;
             break;
         }
         const int v = b64_value(c);
@@ -464,8 +521,10 @@ bool Base64Reader::fill()
         ++m_p;
     }
     if (got < 2) return false;
-    for (int i = got; i < 4; ++i) vals[i] = 0;
-    const unsigned v = (unsigned(vals[0]) << 18) | (unsigned(vals[1]) << 12) | (unsigned(vals[2]) << 6) | unsigned(vals[3]);
+    for (int i = got; i < 4; ++i)
+        vals[i] = 0;
+    const unsigned v =
+        (unsigned(vals[0]) << 18) | (unsigned(vals[1]) << 12) | (unsigned(vals[2]) << 6) | unsigned(vals[3]);
     m_buf[0] = static_cast<unsigned char>(v >> 16);
     m_buf[1] = static_cast<unsigned char>(v >> 8);
     m_buf[2] = static_cast<unsigned char>(v);

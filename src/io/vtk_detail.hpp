@@ -45,22 +45,22 @@ std::string quote_token(std::string_view token);
 std::string cell_type_name(std::int64_t type);
 
 /// Appends `v` in big-/little-endian byte order.
-template <class T>
-void append_bytes(std::string& out, T v, bool big_endian)
+template <class T> void append_bytes(std::string& out, T v, bool big_endian)
 {
     unsigned char b[sizeof(T)];
     std::memcpy(b, &v, sizeof(T));
-    const bool host_big = false;  // tethash targets little-endian hosts (checked in vtk.cpp)
+    const bool host_big = false; // tethash targets little-endian hosts (checked in vtk.cpp)
     if (big_endian != host_big)
-        for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+        for (std::size_t i = 0; i < sizeof(T) / 2; ++i)
+            std::swap(b[i], b[sizeof(T) - 1 - i]);
     out.append(reinterpret_cast<const char*>(b), sizeof(T));
 }
 
 /// A single-component data array a reader kept because its name may hold labels or object ids.
 struct NamedArray {
     std::string name;
-    std::vector<double> values;   ///< one per point or per cell of the file
-    std::string where;            ///< "FILE:LINE" of the array, for notes
+    std::vector<double> values; ///< one per point or per cell of the file
+    std::string where;          ///< "FILE:LINE" of the array, for notes
 };
 
 /// True if a point/cell array called `name` may be turned into object ids or labels.
@@ -78,7 +78,7 @@ void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arra
 struct OutArray {
     std::string name;
     int components = 1;
-    bool integer = false;                 ///< written as Int32
+    bool integer = false; ///< written as Int32
     const std::vector<double>* values = nullptr;
     const std::vector<Index>* ints = nullptr;
 };
@@ -93,7 +93,7 @@ std::string base64_encode(const unsigned char* bytes, std::size_t size);
 /// Decodes base64 text piece by piece; whitespace is skipped and '=' padding may occur in the
 /// middle (VTK encodes header and data separately), so concatenated encodings decode correctly.
 class Base64Reader {
-public:
+  public:
     Base64Reader(const char* begin, const char* end) : m_p(begin), m_end(end) {}
     /// Appends up to `n` decoded bytes to `out`; returns how many were appended (fewer at the end).
     std::size_t read(std::size_t n, std::vector<unsigned char>& out);
@@ -103,7 +103,7 @@ public:
     bool bad() const { return m_bad; }
     char bad_char() const { return m_bad_char; }
 
-private:
+  private:
     bool fill();
     const char* m_p;
     const char* m_end;

@@ -14,12 +14,16 @@ namespace {
 
 using namespace vtk_detail;
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+}
 
 std::string lower(std::string_view s)
 {
     std::string r(s);
-    for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : r)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return r;
 }
 
@@ -34,17 +38,17 @@ std::string read_file(const std::string& path)
 
 /// Where an array's values start, to name the place of value k in an error message.
 struct ArrayPlace {
-    std::size_t pos = 0;           ///< byte offset of the data (binary) or of the text before the first value
-    std::int64_t line = 0;         ///< line at `pos` (ASCII)
-    int value_size = 0;            ///< bytes per value (binary)
+    std::size_t pos = 0;   ///< byte offset of the data (binary) or of the text before the first value
+    std::int64_t line = 0; ///< line at `pos` (ASCII)
+    int value_size = 0;    ///< bytes per value (binary)
 };
 
 class LegacyReader {
-public:
+  public:
     LegacyReader(std::string path, ReadNotes* notes) : m_path(std::move(path)), m_notes(notes) {}
     TetMesh read();
 
-private:
+  private:
     // ---- positions and errors
     std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
     std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
@@ -97,7 +101,8 @@ std::string_view LegacyReader::next_token()
     // At the end of a file that ends with a newline, name the last line rather than the empty one after it.
     if (m_pos == m_data.size() && m_pos > 0 && m_data[m_pos - 1] == '\n' && m_tok_line > 1) --m_tok_line;
     const std::size_t start = m_pos;
-    while (m_pos < m_data.size() && !is_space(m_data[m_pos])) ++m_pos;
+    while (m_pos < m_data.size() && !is_space(m_data[m_pos]))
+        ++m_pos;
     m_tok = std::string_view(m_data).substr(start, m_pos - start);
     return m_tok;
 }
@@ -117,13 +122,15 @@ std::string_view LegacyReader::peek_token()
 bool LegacyReader::token_on_line() const
 {
     std::size_t p = m_pos;
-    while (p < m_data.size() && (m_data[p] == ' ' || m_data[p] == '\t' || m_data[p] == '\r')) ++p;
+    while (p < m_data.size() && (m_data[p] == ' ' || m_data[p] == '\t' || m_data[p] == '\r'))
+        ++p;
     return p < m_data.size() && m_data[p] != '\n';
 }
 
 void LegacyReader::end_line()
 {
-    while (m_pos < m_data.size() && m_data[m_pos] != '\n') ++m_pos;
+    while (m_pos < m_data.size() && m_data[m_pos] != '\n')
+        ++m_pos;
     if (m_pos < m_data.size()) ++m_pos, ++m_line;
 }
 
@@ -132,7 +139,8 @@ std::string LegacyReader::read_line()
     const std::size_t start = m_pos;
     end_line();
     std::string s = m_data.substr(start, m_pos - start);
-    while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+    while (!s.empty() && (s.back() == '\n' || s.back() == '\r'))
+        s.pop_back();
     return s;
 }
 
@@ -142,7 +150,8 @@ std::int64_t LegacyReader::expect_int(const std::string& what, std::int64_t min_
     const auto v = parse_int(m_tok);
     if (!v) fail(at_token(), "expected " + what + " (an integer), found " + found_token());
     if (*v < min_value)
-        fail(at_token(), "expected " + what + " (an integer ≥ " + std::to_string(min_value) + "), found " + found_token());
+        fail(at_token(),
+             "expected " + what + " (an integer ≥ " + std::to_string(min_value) + "), found " + found_token());
     return *v;
 }
 
@@ -176,7 +185,8 @@ std::string LegacyReader::at_value(const ArrayPlace& a, std::size_t k) const
             ++p;
         }
         if (i == k || p >= m_data.size()) break;
-        while (p < m_data.size() && !is_space(m_data[p])) ++p;
+        while (p < m_data.size() && !is_space(m_data[p]))
+            ++p;
     }
     return at_line(line);
 }
@@ -185,21 +195,23 @@ template <class T>
 std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const std::string& what, ArrayPlace* place)
 {
     std::vector<T> out;
-    if (count > 8 * (m_data.size() - std::min(m_pos, m_data.size())) + 8)   // also keeps count × size from overflowing
+    if (count > 8 * (m_data.size() - std::min(m_pos, m_data.size())) + 8) // also keeps count × size from overflowing
         fail(m_binary ? at_byte(m_pos) : at_token(), "expected " + std::to_string(count) + " values of " + what +
                                                          ", but the rest of the file is far too short to hold them");
     if (m_binary) {
         end_line();
-        const std::size_t need = type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
+        const std::size_t need =
+            type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
         if (place) *place = {m_pos, m_line, scalar_size(type)};
         if (need > m_data.size() - m_pos)
-            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" + std::to_string(count) +
-                                     " values), found only " + std::to_string(m_data.size() - m_pos) +
-                                     " before the end of the file");
+            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" +
+                                     std::to_string(count) + " values), found only " +
+                                     std::to_string(m_data.size() - m_pos) + " before the end of the file");
         out.resize(count);
         const auto* src = reinterpret_cast<const unsigned char*>(m_data.data() + m_pos);
         if (type == Scalar::Bit) {
-            for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<T>((src[i / 8] >> (7 - i % 8)) & 1);
+            for (std::size_t i = 0; i < count; ++i)
+                out[i] = static_cast<T>((src[i / 8] >> (7 - i % 8)) & 1);
         } else if constexpr (std::is_same_v<T, double>) {
             convert_to_double(src, type, count, true, out.data());
         } else {
@@ -209,7 +221,7 @@ std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const s
         return out;
     }
     if (place) *place = {m_pos, m_line, 0};
-    out.reserve(std::min(count, (m_data.size() - m_pos) / 2 + 1));   // a count from a broken header may be huge
+    out.reserve(std::min(count, (m_data.size() - m_pos) / 2 + 1)); // a count from a broken header may be huge
     for (std::size_t i = 0; i < count; ++i) {
         next_token();
         if (m_tok.empty())
@@ -225,11 +237,12 @@ std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const s
             auto v = parse_int(m_tok);
             if (!v && !scalar_is_integer(type)) {
                 const auto d = parse_double(m_tok);
-                if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18) v = static_cast<std::int64_t>(*d);
+                if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18)
+                    v = static_cast<std::int64_t>(*d);
             }
             if (!v)
-                fail(at_token(), "expected an integer (value " + std::to_string(i + 1) + " of " + std::to_string(count) +
-                                     " of " + what + "), found " + found_token());
+                fail(at_token(), "expected an integer (value " + std::to_string(i + 1) + " of " +
+                                     std::to_string(count) + " of " + what + "), found " + found_token());
             out.push_back(*v);
         }
     }
@@ -243,11 +256,12 @@ void LegacyReader::skip_values(std::size_t count, Scalar type, const std::string
                                                          ", but the rest of the file is far too short to hold them");
     if (m_binary) {
         end_line();
-        const std::size_t need = type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
+        const std::size_t need =
+            type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
         if (need > m_data.size() - m_pos)
-            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" + std::to_string(count) +
-                                     " values), found only " + std::to_string(m_data.size() - m_pos) +
-                                     " before the end of the file");
+            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" +
+                                     std::to_string(count) + " values), found only " +
+                                     std::to_string(m_data.size() - m_pos) + " before the end of the file");
         m_pos += need;
         return;
     }
@@ -268,7 +282,8 @@ void LegacyReader::skip_metadata()
     end_line();
     while (m_pos < m_data.size()) {
         std::string l = read_line();
-        while (!l.empty() && is_space(l.back())) l.pop_back();
+        while (!l.empty() && is_space(l.back()))
+            l.pop_back();
         if (l.empty()) break;
     }
 }
@@ -290,7 +305,8 @@ void LegacyReader::read_field_block(bool in_data, std::size_t count, std::vector
         const std::int64_t tuples = expect_int("the number of tuples of " + what, 0);
         const Scalar type = expect_type(what);
         if (in_data && static_cast<std::size_t>(tuples) != count)
-            fail(at_token(), "expected " + std::to_string(count) + " tuples in " + what + ", found " + std::to_string(tuples));
+            fail(at_token(),
+                 "expected " + std::to_string(count) + " tuples in " + what + ", found " + std::to_string(tuples));
         const std::string where = at_token();
         const std::size_t n = static_cast<std::size_t>(comps) * static_cast<std::size_t>(tuples);
         if (keep && comps == 1 && (is_label_array_name(name, true) || is_label_array_name(name, false)))
@@ -317,7 +333,8 @@ void LegacyReader::read_attribute(const std::string& key, std::size_t count, std
         const std::size_t n = count * static_cast<std::size_t>(comps);
         if (keep && comps == 1 && (is_label_array_name(name, true) || is_label_array_name(name, false)))
             keep->push_back({name, read_values<double>(n, type, what), where});
-        else skip_values(n, type, what);
+        else
+            skip_values(n, type, what);
     } else if (key == "vectors" || key == "normals") {
         skip_values(3 * count, expect_type(what), what);
     } else if (key == "tensors" || key == "tensors6") {
@@ -346,23 +363,30 @@ TetMesh LegacyReader::read()
     if (lower(first.substr(0, magic.size())) != magic)
         fail(at_line(1), "expected '# vtk DataFile Version X.Y', found " + quote_token(first));
     std::string version = first.substr(magic.size());
-    while (!version.empty() && is_space(version.front())) version.erase(version.begin());
-    while (!version.empty() && is_space(version.back())) version.pop_back();
+    while (!version.empty() && is_space(version.front()))
+        version.erase(version.begin());
+    while (!version.empty() && is_space(version.back()))
+        version.pop_back();
     {
         const auto dot = version.find('.');
         const auto major = parse_int(version.substr(0, dot));
-        const auto minor = dot == std::string::npos ? std::optional<std::int64_t>(0) : parse_int(version.substr(dot + 1));
+        const auto minor =
+            dot == std::string::npos ? std::optional<std::int64_t>(0) : parse_int(version.substr(dot + 1));
         if (!major || !minor || *major < 1 || *major > 5 || *minor < 0)
             fail(at_line(1), "unknown legacy VTK version " + quote_token(version) + " (expected 1.0 to 5.1)");
     }
     if (m_pos >= m_data.size()) fail(at_line(2), "expected a title line, found end of file");
-    read_line();   // title
+    read_line(); // title
     if (m_pos >= m_data.size()) fail(at_line(3), "expected ASCII or BINARY, found end of file");
     std::string format = read_line();
-    while (!format.empty() && is_space(format.back())) format.pop_back();
-    while (!format.empty() && is_space(format.front())) format.erase(format.begin());
-    if (lower(format) == "binary") m_binary = true;
-    else if (lower(format) != "ascii") fail(at_line(3), "expected ASCII or BINARY, found " + quote_token(format));
+    while (!format.empty() && is_space(format.back()))
+        format.pop_back();
+    while (!format.empty() && is_space(format.front()))
+        format.erase(format.begin());
+    if (lower(format) == "binary")
+        m_binary = true;
+    else if (lower(format) != "ascii")
+        fail(at_line(3), "expected ASCII or BINARY, found " + quote_token(format));
 
     next_token();
     if (lower(m_tok) != "dataset") fail(at_token(), "expected DATASET, found " + found_token());
@@ -375,8 +399,8 @@ TetMesh LegacyReader::read()
     ArrayPlace coords_place;
     bool have_points = false, have_cells = false, have_types = false;
     std::int64_t num_points = 0, num_cells = 0;
-    std::vector<std::int64_t> offsets;   // num_cells + 1 entries into `conn`
-    std::vector<std::int64_t> conn;      // point ids (new layout) or count-prefixed lists (old layout)
+    std::vector<std::int64_t> offsets; // num_cells + 1 entries into `conn`
+    std::vector<std::int64_t> conn;    // point ids (new layout) or count-prefixed lists (old layout)
     bool old_layout = false;
     ArrayPlace conn_place, types_place;
     std::string cells_where;
@@ -391,7 +415,8 @@ TetMesh LegacyReader::read()
         if (key == "points") {
             if (have_points) fail(at_token(), "expected one POINTS section, found a second one");
             num_points = expect_int("the number of points", 0);
-            if (num_points > 2147483647) fail(at_token(), "too many points for tethash (" + std::to_string(num_points) + ")");
+            if (num_points > 2147483647)
+                fail(at_token(), "too many points for tethash (" + std::to_string(num_points) + ")");
             const Scalar type = expect_type("POINTS");
             coords = read_values<double>(3 * static_cast<std::size_t>(num_points), type,
                                          "POINTS (" + std::to_string(num_points) + " points × 3)", &coords_place);
@@ -415,7 +440,8 @@ TetMesh LegacyReader::read()
                 num_cells = a > 0 ? a - 1 : 0;
                 if (a == 0) offsets.push_back(0);
                 if (offsets[0] != 0)
-                    fail(at_value(offsets_place, 0), "expected the first offset to be 0, found " + std::to_string(offsets[0]));
+                    fail(at_value(offsets_place, 0),
+                         "expected the first offset to be 0, found " + std::to_string(offsets[0]));
                 for (std::int64_t c = 0; c < num_cells; ++c)
                     if (offsets[c + 1] < offsets[c] || offsets[c + 1] > b)
                         fail(at_value(offsets_place, static_cast<std::size_t>(c + 1)),
@@ -431,18 +457,20 @@ TetMesh LegacyReader::read()
                 num_cells = a;
                 if (a > b)
                     fail(at_token(), "expected a cell list of at least " + std::to_string(a) + " values for " +
-                                         std::to_string(a) + " cells, found CELLS " + std::to_string(a) + " " + std::to_string(b));
-                conn = read_values<std::int64_t>(static_cast<std::size_t>(b), Scalar::Int32,
-                                                 "CELLS (" + std::to_string(a) + " cells, " + std::to_string(b) + " values)",
-                                                 &conn_place);
+                                         std::to_string(a) + " cells, found CELLS " + std::to_string(a) + " " +
+                                         std::to_string(b));
+                conn = read_values<std::int64_t>(
+                    static_cast<std::size_t>(b), Scalar::Int32,
+                    "CELLS (" + std::to_string(a) + " cells, " + std::to_string(b) + " values)", &conn_place);
                 offsets.resize(static_cast<std::size_t>(a) + 1);
                 std::size_t p = 0;
                 for (std::int64_t c = 0; c < a; ++c) {
                     if (p >= conn.size())
-                        fail(at_value(conn_place, p), "expected cell " + std::to_string(c) + " of " + std::to_string(a) +
-                                                          ", found the end of the CELLS list (" + std::to_string(b) +
-                                                          " values); the counts in 'CELLS " + std::to_string(a) + " " +
-                                                          std::to_string(b) + "' do not match");
+                        fail(at_value(conn_place, p), "expected cell " + std::to_string(c) + " of " +
+                                                          std::to_string(a) + ", found the end of the CELLS list (" +
+                                                          std::to_string(b) + " values); the counts in 'CELLS " +
+                                                          std::to_string(a) + " " + std::to_string(b) +
+                                                          "' do not match");
                     const std::int64_t k = conn[p];
                     if (k < 0 || static_cast<std::size_t>(k) >= conn.size() - p)
                         fail(at_value(conn_place, p), "cell " + std::to_string(c) + " has " + std::to_string(k) +
@@ -453,8 +481,9 @@ TetMesh LegacyReader::read()
                 }
                 offsets[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(p);
                 if (p != conn.size())
-                    fail(at_value(conn_place, p), "expected " + std::to_string(a) + " cells to use all " + std::to_string(b) +
-                                                      " values of the CELLS list, but they use " + std::to_string(p));
+                    fail(at_value(conn_place, p), "expected " + std::to_string(a) + " cells to use all " +
+                                                      std::to_string(b) + " values of the CELLS list, but they use " +
+                                                      std::to_string(p));
             }
             have_cells = true;
             mode = Mode::None;
@@ -472,8 +501,9 @@ TetMesh LegacyReader::read()
             const std::int64_t n = expect_int("the number of " + std::string(point ? "points" : "cells"), 0);
             const std::int64_t expected = point ? num_points : num_cells;
             if ((point ? have_points : have_cells) && n != expected)
-                fail(at_token(), "expected " + std::string(point ? "POINT_DATA " : "CELL_DATA ") + std::to_string(expected) +
-                                     " (the number of " + (point ? "points" : "cells") + "), found " + std::to_string(n));
+                fail(at_token(), "expected " + std::string(point ? "POINT_DATA " : "CELL_DATA ") +
+                                     std::to_string(expected) + " (the number of " + (point ? "points" : "cells") +
+                                     "), found " + std::to_string(n));
             mode = point ? Mode::Point : Mode::Cell;
         } else if (key == "metadata") {
             skip_metadata();
@@ -491,7 +521,8 @@ TetMesh LegacyReader::read()
                 if (is_label_array_name(a.name, !point)) (point ? point_arrays : cell_arrays).push_back(std::move(a));
         } else {
             fail(at_token(), "expected a section keyword (POINTS, CELLS, CELL_TYPES, POINT_DATA, CELL_DATA, FIELD, "
-                             "SCALARS, ...), found " + found_token());
+                             "SCALARS, ...), found " +
+                                 found_token());
         }
     }
 
@@ -522,7 +553,7 @@ TetMesh LegacyReader::read()
         const std::size_t size = static_cast<std::size_t>(offsets[cs + 1]) - first;
         if (size != 4)
             fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type 10 (tetra) but " +
-                                                 std::to_string(size) + " points, expected 4");
+                                                std::to_string(size) + " points, expected 4");
         for (std::size_t k = 0; k < 4; ++k) {
             const std::int64_t v = conn[first + k];
             if (v < 0 || v >= num_points)
@@ -535,8 +566,10 @@ TetMesh LegacyReader::read()
     }
     mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
     for (std::size_t t = 0; t < tet_cells.size(); ++t) {
-        const std::size_t first = static_cast<std::size_t>(offsets[static_cast<std::size_t>(tet_cells[t])]) + (old_layout ? 1 : 0);
-        for (int k = 0; k < 4; ++k) mesh.tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(conn[first + k]);
+        const std::size_t first =
+            static_cast<std::size_t>(offsets[static_cast<std::size_t>(tet_cells[t])]) + (old_layout ? 1 : 0);
+        for (int k = 0; k < 4; ++k)
+            mesh.tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(conn[first + k]);
     }
     if (m_notes) {
         for (const auto& [type, count] : skipped) {
@@ -556,8 +589,10 @@ void write_values(std::string& out, bool binary, bool integer, const double* d, 
 {
     for (std::size_t i = 0; i < count; ++i) {
         if (binary) {
-            if (integer) append_bytes<std::int32_t>(out, ints[i], true);
-            else append_bytes<double>(out, d[i], true);
+            if (integer)
+                append_bytes<std::int32_t>(out, ints[i], true);
+            else
+                append_bytes<double>(out, d[i], true);
         } else {
             out += integer ? std::to_string(ints[i]) : format_double(d[i]);
             out += (i + 1) % static_cast<std::size_t>(per_line) == 0 ? '\n' : ' ';
@@ -573,7 +608,8 @@ void write_arrays(std::string& out, bool binary, const char* section, std::size_
     out += std::string(section) + " " + std::to_string(count) + "\n";
     out += "FIELD FieldData " + std::to_string(arrays.size()) + "\n";
     for (const OutArray& a : arrays) {
-        out += a.name + " " + std::to_string(a.components) + " " + std::to_string(count) + (a.integer ? " int\n" : " double\n");
+        out += a.name + " " + std::to_string(a.components) + " " + std::to_string(count) +
+               (a.integer ? " int\n" : " double\n");
         write_values(out, binary, a.integer, a.values ? a.values->data() : nullptr, a.ints ? a.ints->data() : nullptr,
                      count * static_cast<std::size_t>(a.components), a.components);
     }
@@ -581,7 +617,10 @@ void write_arrays(std::string& out, bool binary, const char* section, std::size_
 
 } // namespace
 
-TetMesh read_vtk(const std::string& path, ReadNotes* notes) { return LegacyReader(path, notes).read(); }
+TetMesh read_vtk(const std::string& path, ReadNotes* notes)
+{
+    return LegacyReader(path, notes).read();
+}
 
 void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& fields, bool binary)
 {
@@ -604,7 +643,8 @@ void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& field
     for (std::size_t t = 0; t < m; ++t) {
         if (binary) {
             append_bytes<std::int32_t>(out, 4, true);
-            for (int k = 0; k < 4; ++k) append_bytes<std::int32_t>(out, mesh.tets(static_cast<Eigen::Index>(t), k), true);
+            for (int k = 0; k < 4; ++k)
+                append_bytes<std::int32_t>(out, mesh.tets(static_cast<Eigen::Index>(t), k), true);
         } else {
             out += "4";
             for (int k = 0; k < 4; ++k) {
@@ -617,8 +657,10 @@ void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& field
     if (binary) out += '\n';
     out += "CELL_TYPES " + std::to_string(m) + "\n";
     for (std::size_t t = 0; t < m; ++t) {
-        if (binary) append_bytes<std::int32_t>(out, 10, true);
-        else out += "10\n";
+        if (binary)
+            append_bytes<std::int32_t>(out, 10, true);
+        else
+            out += "10\n";
     }
     if (binary) out += '\n';
     write_arrays(out, binary, "POINT_DATA", n, point_arrays);

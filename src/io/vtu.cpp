@@ -16,7 +16,10 @@ namespace {
 
 using namespace vtk_detail;
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
+bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
 
 std::string read_file(const std::string& path)
 {
@@ -32,12 +35,23 @@ std::string xml_escape(std::string_view s)
     std::string r;
     for (char c : s) {
         switch (c) {
-        case '&': r += "&amp;"; break;
-        case '<': r += "&lt;"; break;
-        case '>': r += "&gt;"; break;
-        case '"': r += "&quot;"; break;
-        case '\'': r += "&apos;"; break;
-        default: r += c;
+        case '&':
+            r += "&amp;";
+            break;
+        case '<':
+            r += "&lt;";
+            break;
+        case '>':
+            r += "&gt;";
+            break;
+        case '"':
+            r += "&quot;";
+            break;
+        case '\'':
+            r += "&apos;";
+            break;
+        default:
+            r += c;
         }
     }
     return r;
@@ -49,8 +63,8 @@ struct XmlElement {
     std::string name;
     std::vector<std::pair<std::string, std::string>> attrs;
     std::vector<XmlElement> children;
-    std::vector<std::pair<std::size_t, std::size_t>> text;   ///< [begin, end) byte ranges of direct text
-    std::vector<std::int64_t> text_line;                      ///< line at the start of each text range
+    std::vector<std::pair<std::size_t, std::size_t>> text; ///< [begin, end) byte ranges of direct text
+    std::vector<std::int64_t> text_line;                   ///< line at the start of each text range
     std::int64_t line = 0;
 
     const std::string* attr(std::string_view key) const
@@ -69,18 +83,21 @@ struct XmlElement {
 
 struct XmlDocument {
     XmlElement root;
-    std::size_t appended_pos = std::string::npos;   ///< first byte after the '_' of <AppendedData>
+    std::size_t appended_pos = std::string::npos; ///< first byte after the '_' of <AppendedData>
     std::string appended_encoding;
     std::int64_t appended_line = 0;
 };
 
 class XmlParser {
-public:
+  public:
     XmlParser(const std::string& path, const std::string& data) : m_path(path), m_data(data) {}
     XmlDocument parse();
 
-private:
-    [[noreturn]] void fail(const std::string& msg) const { throw Error(m_path + ":" + std::to_string(m_line) + ": " + msg); }
+  private:
+    [[noreturn]] void fail(const std::string& msg) const
+    {
+        throw Error(m_path + ":" + std::to_string(m_line) + ": " + msg);
+    }
     std::string found() const
     {
         if (m_pos >= m_data.size()) return "end of file";
@@ -102,7 +119,8 @@ private:
     void skip_past(std::string_view end, const char* what)
     {
         const std::size_t p = m_data.find(end, m_pos);
-        if (p == std::string::npos) fail("expected '" + std::string(end) + "' to close " + what + ", found end of file");
+        if (p == std::string::npos)
+            fail("expected '" + std::string(end) + "' to close " + what + ", found end of file");
         advance_to(p + end.size());
     }
     std::string name()
@@ -110,8 +128,10 @@ private:
         const std::size_t s = m_pos;
         while (m_pos < m_data.size()) {
             const unsigned char c = static_cast<unsigned char>(m_data[m_pos]);
-            if (std::isalnum(c) || c == '_' || c == ':' || c == '.' || c == '-' || c >= 128) ++m_pos;
-            else break;
+            if (std::isalnum(c) || c == '_' || c == ':' || c == '.' || c == '-' || c >= 128)
+                ++m_pos;
+            else
+                break;
         }
         return m_data.substr(s, m_pos - s);
     }
@@ -137,14 +157,20 @@ std::string XmlParser::decode_entities(std::string_view v) const
             continue;
         }
         const std::string_view ent = v.substr(i + 1, semi - i - 1);
-        if (ent == "amp") r += '&';
-        else if (ent == "lt") r += '<';
-        else if (ent == "gt") r += '>';
-        else if (ent == "quot") r += '"';
-        else if (ent == "apos") r += '\'';
+        if (ent == "amp")
+            r += '&';
+        else if (ent == "lt")
+            r += '<';
+        else if (ent == "gt")
+            r += '>';
+        else if (ent == "quot")
+            r += '"';
+        else if (ent == "apos")
+            r += '\'';
         else if (!ent.empty() && ent[0] == '#') {
             const bool hex = ent.size() > 1 && (ent[1] == 'x' || ent[1] == 'X');
-            const unsigned long code = std::strtoul(std::string(ent.substr(hex ? 2 : 1)).c_str(), nullptr, hex ? 16 : 10);
+            const unsigned long code =
+                std::strtoul(std::string(ent.substr(hex ? 2 : 1)).c_str(), nullptr, hex ? 16 : 10);
             r += code < 128 ? static_cast<char>(code) : '?';
         } else {
             r += std::string(v.substr(i, semi - i + 1));
@@ -164,7 +190,8 @@ XmlDocument XmlParser::parse()
         if (lt == std::string::npos) {
             if (!stack.empty()) {
                 advance_to(m_data.size());
-                if (!m_data.empty() && m_data.back() == '\n' && m_line > 1) --m_line;   // the last line, not the empty one after it
+                if (!m_data.empty() && m_data.back() == '\n' && m_line > 1)
+                    --m_line; // the last line, not the empty one after it
                 fail("expected </" + stack.back()->name + ">, found end of file");
             }
             break;
@@ -192,7 +219,8 @@ XmlDocument XmlParser::parse()
             m_pos += 2;
             const std::string n = name();
             skip_ws();
-            if (m_pos >= m_data.size() || m_data[m_pos] != '>') fail("expected '>' after </" + n + ", found " + found());
+            if (m_pos >= m_data.size() || m_data[m_pos] != '>')
+                fail("expected '>' after </" + n + ", found " + found());
             ++m_pos;
             if (stack.empty() || stack.back()->name != n)
                 fail("expected " + (stack.empty() ? std::string("no end tag") : "</" + stack.back()->name + ">") +
@@ -246,7 +274,7 @@ XmlDocument XmlParser::parse()
                     doc.appended_pos = m_pos + 1;
                 }
                 stack.back()->children.push_back(std::move(el));
-                break;   // the rest is (possibly binary) appended data
+                break; // the rest is (possibly binary) appended data
             }
             XmlElement* added;
             if (stack.empty()) {
@@ -268,11 +296,11 @@ XmlDocument XmlParser::parse()
 // ---- .vtu reader ---------------------------------------------------------------------------
 
 class VtuReader {
-public:
+  public:
     VtuReader(std::string path, ReadNotes* notes) : m_path(std::move(path)), m_notes(notes) {}
     TetMesh read();
 
-private:
+  private:
     std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
     std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
     [[noreturn]] void fail(const std::string& where, const std::string& msg) const { throw Error(where + ": " + msg); }
@@ -280,7 +308,8 @@ private:
     {
         const std::string* v = el.attr(key);
         if (!v && required)
-            fail(at_line(el.line), "expected attribute " + std::string(key) + "=\"...\" in <" + el.name + ">, found none");
+            fail(at_line(el.line),
+                 "expected attribute " + std::string(key) + "=\"...\" in <" + el.name + ">, found none");
         return v ? *v : std::string();
     }
     std::int64_t int_attr(const XmlElement& el, const char* key, std::int64_t min_value) const;
@@ -293,8 +322,7 @@ private:
     std::string at_value(const XmlElement& da, std::size_t k) const;
 
     /// Decodes a DataArray of `expected` values (components included) into T (double or int64).
-    template <class T>
-    std::vector<T> read_array(const XmlElement& da, std::size_t expected, const std::string& what);
+    template <class T> std::vector<T> read_array(const XmlElement& da, std::size_t expected, const std::string& what);
     template <class T>
     std::vector<T> read_ascii(const XmlElement& da, Scalar type, std::size_t expected, const std::string& what);
     /// The payload bytes of a binary block (header + data, possibly zlib-compressed).
@@ -315,8 +343,10 @@ std::int64_t VtuReader::int_attr(const XmlElement& el, const char* key, std::int
 {
     const std::string v = attr(el, key);
     std::string_view s = v;
-    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+    while (!s.empty() && is_space(s.front()))
+        s.remove_prefix(1);
+    while (!s.empty() && is_space(s.back()))
+        s.remove_suffix(1);
     const auto i = parse_int(s);
     if (!i || *i < min_value)
         fail(at_line(el.line), "expected " + std::string(key) + " in <" + el.name + "> to be an integer ≥ " +
@@ -327,7 +357,8 @@ std::int64_t VtuReader::int_attr(const XmlElement& el, const char* key, std::int
 std::string VtuReader::at_value(const XmlElement& da, std::size_t k) const
 {
     const std::string* format = da.attr("format");
-    if (!format || *format != "ascii") return at_line(da.line) + ": " + array_label(da) + ", value " + std::to_string(k);
+    if (!format || *format != "ascii")
+        return at_line(da.line) + ": " + array_label(da) + ", value " + std::to_string(k);
     // Find the line of the k-th token of the text (error path only).
     std::size_t count = 0;
     std::int64_t line = da.line;
@@ -341,7 +372,8 @@ std::string VtuReader::at_value(const XmlElement& da, std::size_t k) const
                 continue;
             }
             if (count == k) return at_line(line);
-            while (p < e && !is_space(m_data[p])) ++p;
+            while (p < e && !is_space(m_data[p]))
+                ++p;
             ++count;
         }
     }
@@ -352,7 +384,7 @@ template <class T>
 std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::size_t expected, const std::string& what)
 {
     std::vector<T> out;
-    out.reserve(std::min(expected, m_data.size() / 2 + 1));   // a count from a broken file may be huge
+    out.reserve(std::min(expected, m_data.size() / 2 + 1)); // a count from a broken file may be huge
     std::int64_t line = da.line;
     std::size_t count = 0;
     std::int64_t last_line = line;
@@ -367,7 +399,8 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
                 continue;
             }
             const std::size_t s = p;
-            while (p < e && !is_space(m_data[p])) ++p;
+            while (p < e && !is_space(m_data[p]))
+                ++p;
             const std::string_view tok(m_data.data() + s, p - s);
             last_line = line;
             if (count >= expected) {
@@ -380,7 +413,8 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
                             continue;
                         }
                         ++total;
-                        while (q < re && !is_space(m_data[q])) ++q;
+                        while (q < re && !is_space(m_data[q]))
+                            ++q;
                     }
                 }
                 fail(at_line(line), "expected " + std::to_string(expected) + " values in " + what + ", found " +
@@ -388,22 +422,28 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
             }
             if constexpr (std::is_same_v<T, double>) {
                 const auto v = parse_double(tok);
-                if (!v) fail(at_line(line), "expected a number (value " + std::to_string(count) + " of " + what + "), found " + quote_token(tok));
+                if (!v)
+                    fail(at_line(line), "expected a number (value " + std::to_string(count) + " of " + what +
+                                            "), found " + quote_token(tok));
                 out.push_back(*v);
             } else {
                 auto v = parse_int(tok);
                 if (!v && !scalar_is_integer(type)) {
                     const auto d = parse_double(tok);
-                    if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18) v = static_cast<std::int64_t>(*d);
+                    if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18)
+                        v = static_cast<std::int64_t>(*d);
                 }
-                if (!v) fail(at_line(line), "expected an integer (value " + std::to_string(count) + " of " + what + "), found " + quote_token(tok));
+                if (!v)
+                    fail(at_line(line), "expected an integer (value " + std::to_string(count) + " of " + what +
+                                            "), found " + quote_token(tok));
                 out.push_back(*v);
             }
             ++count;
         }
     }
     if (count != expected)
-        fail(at_line(last_line), "expected " + std::to_string(expected) + " values in " + what + ", found " + std::to_string(count));
+        fail(at_line(last_line),
+             "expected " + std::to_string(expected) + " values in " + what + ", found " + std::to_string(count));
     return out;
 }
 
@@ -414,7 +454,8 @@ struct RawSource {
     bool take(std::size_t n, std::vector<unsigned char>& out)
     {
         if (n > data.size() - std::min(pos, data.size())) return false;
-        out.insert(out.end(), data.begin() + static_cast<std::ptrdiff_t>(pos), data.begin() + static_cast<std::ptrdiff_t>(pos + n));
+        out.insert(out.end(), data.begin() + static_cast<std::ptrdiff_t>(pos),
+                   data.begin() + static_cast<std::ptrdiff_t>(pos + n));
         pos += n;
         return true;
     }
@@ -423,7 +464,7 @@ struct RawSource {
 /// Bytes decoded from base64 text (inline binary or base64 appended data).
 struct Base64Source {
     Base64Reader reader;
-    std::size_t pos = 0;   ///< decoded bytes so far
+    std::size_t pos = 0; ///< decoded bytes so far
     bool take(std::size_t n, std::vector<unsigned char>& out)
     {
         const std::size_t got = reader.read(n, out);
@@ -442,14 +483,14 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
     const auto where = [&] { return raw ? at_byte(src.pos) : at_line(da.line); };
     const auto short_data = [&](std::size_t need, const char* part) {
         if constexpr (raw) {
-            fail(at_byte(src.pos), "expected " + std::to_string(need) + " bytes of " + part + " of " + what + " (line " +
-                                       std::to_string(da.line) + "), found only " +
+            fail(at_byte(src.pos), "expected " + std::to_string(need) + " bytes of " + part + " of " + what +
+                                       " (line " + std::to_string(da.line) + "), found only " +
                                        std::to_string(m_data.size() - std::min(src.pos, m_data.size())) +
                                        " before the end of the file");
         } else {
             if (src.reader.bad())
-                fail(at_line(da.line), what + ": invalid character " + quote_token(std::string(1, src.reader.bad_char())) +
-                                           " in base64 data");
+                fail(at_line(da.line), what + ": invalid character " +
+                                           quote_token(std::string(1, src.reader.bad_char())) + " in base64 data");
             fail(at_line(da.line), "expected " + std::to_string(need) + " bytes of " + part + " of " + what +
                                        ", found the end of the base64 text after " + std::to_string(src.pos) +
                                        " decoded bytes");
@@ -467,9 +508,9 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
         const std::size_t header_pos = src.pos;
         const std::int64_t nbytes = header_words(1)[0];
         if (nbytes < 0 || static_cast<std::size_t>(nbytes) != expected_bytes)
-            fail(raw ? at_byte(header_pos) : at_line(da.line),
-                 "expected the block header of " + what + " to give " + std::to_string(expected_bytes) +
-                     " bytes, found " + std::to_string(nbytes));
+            fail(raw ? at_byte(header_pos) : at_line(da.line), "expected the block header of " + what + " to give " +
+                                                                   std::to_string(expected_bytes) + " bytes, found " +
+                                                                   std::to_string(nbytes));
         out.reserve(std::min(expected_bytes, m_data.size()));
         if (!src.take(expected_bytes, out)) short_data(expected_bytes, "data");
         return out;
@@ -478,24 +519,26 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
     const auto h = header_words(3);
     const std::int64_t nblocks = h[0], block_size = h[1], last_size = h[2];
     const std::int64_t last = nblocks > 0 && last_size == 0 ? block_size : last_size;
-    const bool sane = nblocks >= 0 && nblocks <= (1 << 30) && block_size >= 0 && block_size <= (std::int64_t(1) << 32) &&
-                      last >= 0 && last <= block_size;
+    const bool sane = nblocks >= 0 && nblocks <= (1 << 30) && block_size >= 0 &&
+                      block_size <= (std::int64_t(1) << 32) && last >= 0 && last <= block_size;
     const std::int64_t total = sane && nblocks > 0 ? (nblocks - 1) * block_size + last : 0;
     if (!sane || total != static_cast<std::int64_t>(expected_bytes))
         fail(raw ? at_byte(header_pos) : at_line(da.line),
              "expected the compressed block header of " + what + " to give " + std::to_string(expected_bytes) +
-                 " bytes, found " + std::to_string(nblocks) + " blocks of " + std::to_string(block_size) +
-                 " (last " + std::to_string(last_size) + ")");
+                 " bytes, found " + std::to_string(nblocks) + " blocks of " + std::to_string(block_size) + " (last " +
+                 std::to_string(last_size) + ")");
     if (static_cast<std::size_t>(nblocks) > m_data.size() / hs + 1)
-        fail(raw ? at_byte(header_pos) : at_line(da.line),
-             what + ": the compressed block header lists " + std::to_string(nblocks) + " blocks, more than the file can hold");
+        fail(raw ? at_byte(header_pos) : at_line(da.line), what + ": the compressed block header lists " +
+                                                               std::to_string(nblocks) +
+                                                               " blocks, more than the file can hold");
     const auto sizes = header_words(static_cast<std::size_t>(nblocks));
     out.reserve(std::min(expected_bytes, 4 * m_data.size()));
     std::vector<unsigned char> comp;
     for (std::int64_t b = 0; b < nblocks; ++b) {
         const std::int64_t cs = sizes[static_cast<std::size_t>(b)];
         if (cs < 0 || cs > (std::int64_t(1) << 40))
-            fail(where(), what + ": compressed block " + std::to_string(b) + " has an invalid size " + std::to_string(cs));
+            fail(where(),
+                 what + ": compressed block " + std::to_string(b) + " has an invalid size " + std::to_string(cs));
         comp.clear();
         const std::size_t block_pos = src.pos;
         if (!src.take(static_cast<std::size_t>(cs), comp)) short_data(static_cast<std::size_t>(cs), "compressed data");
@@ -516,7 +559,8 @@ std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected,
     if (!type)
         fail(at_line(da.line), "expected the type of " + what +
                                    " to be one of Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, "
-                                   "Float32, Float64, found \"" + type_name + "\"");
+                                   "Float32, Float64, found \"" +
+                                   type_name + "\"");
     const std::string format = attr(da, "format", false);
     if (format == "ascii") return read_ascii<T>(da, *type, expected, what);
     const std::size_t size = static_cast<std::size_t>(scalar_size(*type));
@@ -528,8 +572,9 @@ std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected,
         std::string joined;
         const char* pb = m_data.data() + b;
         const char* pe = m_data.data() + e;
-        if (da.text.size() > 1) {   // text split by comments or child elements
-            for (const auto& [tb, te] : da.text) joined.append(m_data, tb, te - tb);
+        if (da.text.size() > 1) { // text split by comments or child elements
+            for (const auto& [tb, te] : da.text)
+                joined.append(m_data, tb, te - tb);
             pb = joined.data();
             pe = joined.data() + joined.size();
         }
@@ -551,11 +596,14 @@ std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected,
             payload = read_block(src, da, bytes, what);
         }
     } else {
-        fail(at_line(da.line), "expected format=\"ascii\", \"binary\" or \"appended\" for " + what + ", found \"" + format + "\"");
+        fail(at_line(da.line),
+             "expected format=\"ascii\", \"binary\" or \"appended\" for " + what + ", found \"" + format + "\"");
     }
     std::vector<T> out(expected);
-    if constexpr (std::is_same_v<T, double>) convert_to_double(payload.data(), *type, expected, m_big_endian, out.data());
-    else convert_to_int64(payload.data(), *type, expected, m_big_endian, out.data());
+    if constexpr (std::is_same_v<T, double>)
+        convert_to_double(payload.data(), *type, expected, m_big_endian, out.data());
+    else
+        convert_to_int64(payload.data(), *type, expected, m_big_endian, out.data());
     return out;
 }
 
@@ -567,7 +615,8 @@ TetMesh VtuReader::read()
     if (root.name != "VTKFile") fail(at_line(root.line), "expected <VTKFile>, found <" + root.name + ">");
     const std::string type = attr(root, "type");
     if (type != "UnstructuredGrid")
-        fail(at_line(root.line), "expected type=\"UnstructuredGrid\" (the only VTK XML dataset tethash reads), found \"" + type + "\"");
+        fail(at_line(root.line),
+             "expected type=\"UnstructuredGrid\" (the only VTK XML dataset tethash reads), found \"" + type + "\"");
     if (const std::string* v = root.attr("version")) {
         const auto dot = v->find('.');
         const auto major = parse_int(std::string_view(*v).substr(0, dot));
@@ -575,20 +624,24 @@ TetMesh VtuReader::read()
             fail(at_line(root.line), "unknown VTK XML version \"" + *v + "\" (expected 0.1 to 2.x)");
     }
     const std::string order = attr(root, "byte_order", false);
-    if (order == "BigEndian") m_big_endian = true;
+    if (order == "BigEndian")
+        m_big_endian = true;
     else if (!order.empty() && order != "LittleEndian")
         fail(at_line(root.line), "expected byte_order=\"LittleEndian\" or \"BigEndian\", found \"" + order + "\"");
     const std::string header = attr(root, "header_type", false);
-    if (header == "UInt64") m_header64 = true;
+    if (header == "UInt64")
+        m_header64 = true;
     else if (!header.empty() && header != "UInt32")
         fail(at_line(root.line), "expected header_type=\"UInt32\" or \"UInt64\", found \"" + header + "\"");
     const std::string compressor = attr(root, "compressor", false);
     if (compressor == "vtkZLibDataCompressor") {
         m_zlib = true;
         if (!vtu_zlib_supported())
-            fail(at_line(root.line), "zlib-compressed data (compressor=\"vtkZLibDataCompressor\"), but tethash was built without zlib");
+            fail(at_line(root.line),
+                 "zlib-compressed data (compressor=\"vtkZLibDataCompressor\"), but tethash was built without zlib");
     } else if (!compressor.empty()) {
-        fail(at_line(root.line), "unsupported compressor \"" + compressor + "\" (expected vtkZLibDataCompressor or none)");
+        fail(at_line(root.line),
+             "unsupported compressor \"" + compressor + "\" (expected vtkZLibDataCompressor or none)");
     }
     if (!m_doc.appended_encoding.empty() || m_doc.appended_pos != std::string::npos) {
         if (m_doc.appended_encoding != "raw" && m_doc.appended_encoding != "base64")
@@ -609,7 +662,8 @@ TetMesh VtuReader::read()
         if (piece.name != "Piece") continue;
         const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
         const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
-        if (nc > (std::int64_t(1) << 40)) fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
+        if (nc > (std::int64_t(1) << 40))
+            fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
         if (total_points + np > 2147483647)
             fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points + np) + ")");
         const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
@@ -621,12 +675,15 @@ TetMesh VtuReader::read()
         if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
         const std::string comps = attr(*pda, "NumberOfComponents", false);
         if (comps != "3")
-            fail(at_line(pda->line), "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
-        const std::vector<double> pc = read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
+            fail(at_line(pda->line),
+                 "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
+        const std::vector<double> pc =
+            read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
         for (std::size_t i = 0; i < npz; ++i)
             for (int k = 0; k < 3; ++k)
                 if (!std::isfinite(pc[3 * i + k]))
-                    fail(at_value(*pda, 3 * i + k), "point " + std::to_string(total_points + static_cast<std::int64_t>(i)) +
+                    fail(at_value(*pda, 3 * i + k), "point " +
+                                                        std::to_string(total_points + static_cast<std::int64_t>(i)) +
                                                         " has a non-finite coordinate");
         coords.insert(coords.end(), pc.begin(), pc.end());
 
@@ -637,18 +694,22 @@ TetMesh VtuReader::read()
             const auto find = [&](const char* name) -> const XmlElement& {
                 for (const auto& c : cells->children)
                     if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
-                fail(at_line(cells->line), "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
+                fail(at_line(cells->line),
+                     "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
             };
             const XmlElement& oda = find("offsets");
             const XmlElement& cda = find("connectivity");
             const XmlElement& tda = find("types");
-            const auto offsets = read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
-            const auto types = read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
+            const auto offsets =
+                read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
+            const auto types =
+                read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
             std::int64_t prev = 0;
             for (std::size_t c = 0; c < ncz; ++c) {
                 if (offsets[c] < prev)
                     fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
-                                               ", expected at least " + std::to_string(prev) + " (offsets must not decrease)");
+                                               ", expected at least " + std::to_string(prev) +
+                                               " (offsets must not decrease)");
                 prev = offsets[c];
             }
             const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
@@ -680,7 +741,8 @@ TetMesh VtuReader::read()
         }
 
         // Point and cell arrays that may hold object ids or labels.
-        const auto gather = [&](const char* section, bool cell, std::size_t count, std::map<std::string, NamedArray>& into) {
+        const auto gather = [&](const char* section, bool cell, std::size_t count,
+                                std::map<std::string, NamedArray>& into) {
             const XmlElement* s = piece.child(section);
             if (!s) return;
             for (const auto& da : s->children) {
@@ -714,8 +776,10 @@ TetMesh VtuReader::read()
         }
     }
     std::vector<NamedArray> pa, ca;
-    for (auto& [k, a] : point_arrays) pa.push_back(std::move(a));
-    for (auto& [k, a] : cell_arrays) ca.push_back(std::move(a));
+    for (auto& [k, a] : point_arrays)
+        pa.push_back(std::move(a));
+    for (auto& [k, a] : cell_arrays)
+        ca.push_back(std::move(a));
     apply_label_arrays(mesh, pa, ca, tet_cells, static_cast<std::size_t>(total_cells), m_notes);
     return mesh;
 }
@@ -733,7 +797,10 @@ void write_whole(const std::string& path, const std::string& text)
 
 } // namespace
 
-TetMesh read_vtu(const std::string& path, ReadNotes* notes) { return VtuReader(path, notes).read(); }
+TetMesh read_vtu(const std::string& path, ReadNotes* notes)
+{
+    return VtuReader(path, notes).read();
+}
 
 void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)
 {
@@ -748,7 +815,7 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
     const bool offsets64 = 4 * m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
     // Every array as (XML attributes, byte size, writer of its little-endian data).
     struct Block {
-        std::string section;   // "PointData", "CellData", "Points", "Cells"
+        std::string section; // "PointData", "CellData", "Points", "Cells"
         std::string attrs;
         std::size_t bytes;
         std::function<void(std::string&)> write;
@@ -757,40 +824,49 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
     const auto add_fields = [&](const std::vector<OutArray>& arrays, const char* section, std::size_t count) {
         for (const OutArray& a : arrays) {
             const std::size_t values = count * static_cast<std::size_t>(a.components);
-            std::string at = std::string("type=\"") + (a.integer ? "Int32" : "Float64") + "\" Name=\"" + xml_escape(a.name) +
-                             "\" NumberOfComponents=\"" + std::to_string(a.components) + "\"";
+            std::string at = std::string("type=\"") + (a.integer ? "Int32" : "Float64") + "\" Name=\"" +
+                             xml_escape(a.name) + "\" NumberOfComponents=\"" + std::to_string(a.components) + "\"";
             blocks.push_back({section, at, values * (a.integer ? 4 : 8), [a, values](std::string& out) {
                                   for (std::size_t i = 0; i < values; ++i) {
-                                      if (a.integer) append_bytes<std::int32_t>(out, (*a.ints)[i], false);
-                                      else append_bytes<double>(out, (*a.values)[i], false);
+                                      if (a.integer)
+                                          append_bytes<std::int32_t>(out, (*a.ints)[i], false);
+                                      else
+                                          append_bytes<double>(out, (*a.values)[i], false);
                                   }
                               }});
         }
     };
     add_fields(point_arrays, "PointData", n);
     add_fields(cell_arrays, "CellData", m);
-    blocks.push_back({"Points", "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * n * 8, [&](std::string& out) {
-                          for (std::size_t i = 0; i < 3 * n; ++i) append_bytes<double>(out, mesh.positions.data()[i], false);
-                      }});
+    blocks.push_back(
+        {"Points", "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * n * 8, [&](std::string& out) {
+             for (std::size_t i = 0; i < 3 * n; ++i)
+                 append_bytes<double>(out, mesh.positions.data()[i], false);
+         }});
     blocks.push_back({"Cells", "type=\"Int32\" Name=\"connectivity\"", 4 * m * 4, [&](std::string& out) {
-                          for (std::size_t i = 0; i < 4 * m; ++i) append_bytes<std::int32_t>(out, mesh.tets.data()[i], false);
+                          for (std::size_t i = 0; i < 4 * m; ++i)
+                              append_bytes<std::int32_t>(out, mesh.tets.data()[i], false);
                       }});
     blocks.push_back({"Cells", std::string("type=\"") + (offsets64 ? "Int64" : "Int32") + "\" Name=\"offsets\"",
                       m * (offsets64 ? 8 : 4), [&](std::string& out) {
                           for (std::size_t t = 1; t <= m; ++t) {
-                              if (offsets64) append_bytes<std::int64_t>(out, static_cast<std::int64_t>(4 * t), false);
-                              else append_bytes<std::int32_t>(out, static_cast<std::int32_t>(4 * t), false);
+                              if (offsets64)
+                                  append_bytes<std::int64_t>(out, static_cast<std::int64_t>(4 * t), false);
+                              else
+                                  append_bytes<std::int32_t>(out, static_cast<std::int32_t>(4 * t), false);
                           }
                       }});
     blocks.push_back({"Cells", "type=\"UInt8\" Name=\"types\"", m, [&](std::string& out) { out.append(m, '\x0a'); }});
 
     bool header64 = false;
-    for (const Block& b : blocks) header64 = header64 || b.bytes > 0xffffffffu;
+    for (const Block& b : blocks)
+        header64 = header64 || b.bytes > 0xffffffffu;
     const std::size_t hs = header64 ? 8 : 4;
 
     std::string xml = "<?xml version=\"1.0\"?>\n";
-    xml += std::string("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"") +
-           (header64 ? "UInt64" : "UInt32") + "\">\n";
+    xml +=
+        std::string("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"") +
+        (header64 ? "UInt64" : "UInt32") + "\">\n";
     xml += "  <UnstructuredGrid>\n";
     xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
     // The data go in reverse document order (the last DataArray at offset 0). VTK does not care;
@@ -808,9 +884,11 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
             if (blocks[i].section != section) continue;
             if (!any) xml += std::string("      <") + section + ">\n";
             any = true;
-            xml += "        <DataArray " + blocks[i].attrs + " format=\"appended\" offset=\"" + std::to_string(offsets[i]) + "\"/>\n";
+            xml += "        <DataArray " + blocks[i].attrs + " format=\"appended\" offset=\"" +
+                   std::to_string(offsets[i]) + "\"/>\n";
         }
-        if (any) xml += std::string("      </") + section + ">\n";
+        if (any)
+            xml += std::string("      </") + section + ">\n";
         else if (std::string(section) == "PointData" || std::string(section) == "CellData")
             xml += std::string("      <") + section + "/>\n";
     }
@@ -818,8 +896,10 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
     xml.reserve(xml.size() + offset + 64);
     for (auto it = blocks.rbegin(); it != blocks.rend(); ++it) {
         const Block& b = *it;
-        if (header64) append_bytes<std::uint64_t>(xml, b.bytes, false);
-        else append_bytes<std::uint32_t>(xml, static_cast<std::uint32_t>(b.bytes), false);
+        if (header64)
+            append_bytes<std::uint64_t>(xml, b.bytes, false);
+        else
+            append_bytes<std::uint32_t>(xml, static_cast<std::uint32_t>(b.bytes), false);
         b.write(xml);
     }
     xml += "\n  </AppendedData>\n</VTKFile>\n";
@@ -828,11 +908,14 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
 
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries)
 {
-    std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
+    std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+                      "byte_order=\"LittleEndian\">\n  <Collection>\n";
     for (const auto& [time, file] : entries) {
-        if (!std::isfinite(time)) throw Error(path + ": time " + format_double(time) + " of '" + file + "' is not finite");
+        if (!std::isfinite(time))
+            throw Error(path + ": time " + format_double(time) + " of '" + file + "' is not finite");
         if (file.empty()) throw Error(path + ": an entry at time " + format_double(time) + " has an empty file name");
-        xml += "    <DataSet timestep=\"" + format_double(time) + "\" group=\"\" part=\"0\" file=\"" + xml_escape(file) + "\"/>\n";
+        xml += "    <DataSet timestep=\"" + format_double(time) + "\" group=\"\" part=\"0\" file=\"" +
+               xml_escape(file) + "\"/>\n";
     }
     xml += "  </Collection>\n</VTKFile>\n";
     write_whole(path, xml);
@@ -843,10 +926,12 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
     const std::string data = read_file(path);
     const XmlDocument doc = XmlParser(path, data).parse();
     const auto at = [&](std::int64_t line) { return path + ":" + std::to_string(line); };
-    if (doc.root.name != "VTKFile") throw Error(at(doc.root.line) + ": expected <VTKFile>, found <" + doc.root.name + ">");
+    if (doc.root.name != "VTKFile")
+        throw Error(at(doc.root.line) + ": expected <VTKFile>, found <" + doc.root.name + ">");
     const std::string* type = doc.root.attr("type");
     if (!type || *type != "Collection")
-        throw Error(at(doc.root.line) + ": expected type=\"Collection\", found \"" + (type ? *type : std::string()) + "\"");
+        throw Error(at(doc.root.line) + ": expected type=\"Collection\", found \"" + (type ? *type : std::string()) +
+                    "\"");
     const XmlElement* col = doc.root.child("Collection");
     if (!col) throw Error(at(doc.root.line) + ": expected <Collection>, found none");
     std::vector<std::pair<double, std::string>> r;
@@ -858,7 +943,8 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
         double t = 0;
         if (ts) {
             const auto v = parse_double(*ts);
-            if (!v || !std::isfinite(*v)) throw Error(at(ds.line) + ": expected a number for timestep, found \"" + *ts + "\"");
+            if (!v || !std::isfinite(*v))
+                throw Error(at(ds.line) + ": expected a number for timestep, found \"" + *ts + "\"");
             t = *v;
         }
         r.emplace_back(t, *file);

@@ -26,7 +26,8 @@ std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const T
         return positions(a, 0) < positions(b, 0) || (positions(a, 0) == positions(b, 0) && a < b);
     });
     std::vector<double> xs(n);
-    for (Index i = 0; i < n; ++i) xs[i] = positions(order[i], 0);
+    for (Index i = 0; i < n; ++i)
+        xs[i] = positions(order[i], 0);
 
     const Index m = static_cast<Index>(tets.rows());
     std::vector<std::vector<Contact>> per_tet(m);
@@ -36,7 +37,8 @@ std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const T
         const Index ids[4] = {tets(t, 0), tets(t, 1), tets(t, 2), tets(t, 3)};
         double c[4][3];
         for (int k = 0; k < 4; ++k)
-            for (int a = 0; a < 3; ++a) c[k][a] = positions(ids[k], a);
+            for (int a = 0; a < 3; ++a)
+                c[k][a] = positions(ids[k], a);
         const predicates::Orientation o = predicates::orient3d(c[0], c[1], c[2], c[3]);
         exact += o.exact;
         if (o.sign == 0) {
@@ -70,12 +72,14 @@ std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const T
             ct.tet = t;
             ct.vertex_object = vo;
             ct.tet_object = to;
-            for (int k = 0; k < 4; ++k) ct.bary[k] = r.bary[k];
+            for (int k = 0; k < 4; ++k)
+                ct.bary[k] = r.bary[k];
             per_tet[t].push_back(ct);
         }
     }
     std::vector<Contact> out;
-    for (auto& v : per_tet) out.insert(out.end(), v.begin(), v.end());
+    for (auto& v : per_tet)
+        out.insert(out.end(), v.begin(), v.end());
     std::sort(out.begin(), out.end(), [](const Contact& a, const Contact& b) {
         return a.vertex < b.vertex || (a.vertex == b.vertex && a.tet < b.tet);
     });

@@ -16,7 +16,10 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
-Vec3 row(const Positions& x, Index i) { return x.row(i).transpose(); }
+Vec3 row(const Positions& x, Index i)
+{
+    return x.row(i).transpose();
+}
 
 /// Signed volume and its gradient with respect to the four vertices (rows of g).
 double volume_and_gradient(const Positions& x, const Index* t, Eigen::Matrix<double, 4, 3>& g)
@@ -39,9 +42,12 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     const Index n = mesh.num_vertices();
     const Positions& rest = mesh.rest();
     auto tet_obj = [&](Index t) { return mesh.tet_object.empty() ? 0 : mesh.tet_object[static_cast<size_t>(t)]; };
-    auto is_static = [&](Index o) { return static_cast<size_t>(o) < object_static.size() && object_static[static_cast<size_t>(o)]; };
+    auto is_static = [&](Index o) {
+        return static_cast<size_t>(o) < object_static.size() && object_static[static_cast<size_t>(o)];
+    };
     auto material = [&](Index o) -> const Material& {
-        if (static_cast<size_t>(o) >= materials.size()) throw Error("model: no material for object " + std::to_string(o));
+        if (static_cast<size_t>(o) >= materials.size())
+            throw Error("model: no material for object " + std::to_string(o));
         return materials[static_cast<size_t>(o)];
     };
 
@@ -66,18 +72,21 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         double vol = volume_and_gradient(rest, v, g);
         double lmean = 0;
         for (int a = 0; a < 4; ++a)
-            for (int b = a + 1; b < 4; ++b) lmean += (row(rest, v[a]) - row(rest, v[b])).norm() / 6.0;
+            for (int b = a + 1; b < 4; ++b)
+                lmean += (row(rest, v[a]) - row(rest, v[b])).norm() / 6.0;
         if (!(std::abs(vol) > 1e-12 * lmean * lmean * lmean) || !std::isfinite(vol))
             throw Error("model: tet " + std::to_string(t) + " has zero volume in the rest state (volume " +
                         std::to_string(vol) + "); fix the mesh (tethash info reports such tets)");
-        if (vol < 0) {  // inverted at rest: orient the volume term so that its rest volume is positive
+        if (vol < 0) { // inverted at rest: orient the volume term so that its rest volume is positive
             std::swap(v[2], v[3]);
             vol = -vol;
         }
         const Material& mat = material(tet_obj(t));
-        for (int a = 0; a < 4; ++a) m.mass[static_cast<size_t>(v[a])] += mat.density * vol / 4.0;
+        for (int a = 0; a < 4; ++a)
+            m.mass[static_cast<size_t>(v[a])] += mat.density * vol / 4.0;
         const double young = mat.stiffness > 0 ? mat.stiffness / lmean : mat.young;
-        for (int a = 0; a < 4; ++a) m.volumes.tets(static_cast<Index>(q), a) = v[a];
+        for (int a = 0; a < 4; ++a)
+            m.volumes.tets(static_cast<Index>(q), a) = v[a];
         // Nearly flat rest tets would give a huge stiffness k/V0·|∇V|²; the volume scale is floored at
         // 1e-3·l³ (a regular tet has ≈ 0.118·l³) so that slivers stay as stiff as an ordinary tet.
         // Stored so that k/V0 = volume_stiffness·young / max(V0, 1e-3·l³).
@@ -87,7 +96,8 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
 
     // Springs: unique edges of the dynamic tets.
     Tets dyn_tets(static_cast<Index>(dyn.size()), 4);
-    for (size_t q = 0; q < dyn.size(); ++q) dyn_tets.row(static_cast<Index>(q)) = mesh.tets.row(dyn[q]);
+    for (size_t q = 0; q < dyn.size(); ++q)
+        dyn_tets.row(static_cast<Index>(q)) = mesh.tets.row(dyn[q]);
     m.springs.edges = unique_edges(dyn_tets);
     const Index ne = static_cast<Index>(m.springs.edges.rows());
     m.springs.rest.resize(static_cast<size_t>(ne));
@@ -107,7 +117,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     }
     for (Index i = 0; i < n; ++i)
         if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
-            m.fixed[static_cast<size_t>(i)] = 1;  // unreferenced vertex: nothing moves it
+            m.fixed[static_cast<size_t>(i)] = 1; // unreferenced vertex: nothing moves it
     return m;
 }
 
@@ -148,11 +158,13 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
             const double vol = volume_and_gradient(x, &volumes.tets(t, 0), g);
             const double v0 = volumes.rest[static_cast<size_t>(t)];
             const double s = -opt.volume_scale * volumes.k[static_cast<size_t>(t)] * (vol - v0) / v0;
-            for (int a = 0; a < 4; ++a) f.row(volumes.tets(t, a)) += s * g.row(a);
+            for (int a = 0; a < 4; ++a)
+                f.row(volumes.tets(t, a)) += s * g.row(a);
         }
     }
     if ((opt.parts & ForceOptions::gravity) && gravity.squaredNorm() > 0)
-        for (Index i = 0; i < n; ++i) f.row(i) += mass[static_cast<size_t>(i)] * gravity.transpose();
+        for (Index i = 0; i < n; ++i)
+            f.row(i) += mass[static_cast<size_t>(i)] * gravity.transpose();
     if ((opt.parts & ForceOptions::ground) && ground.enabled) {
         const Vec3& nrm = ground.normal;
         for (Index i = 0; i < n; ++i) {
@@ -165,7 +177,7 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
             if (ground.friction > 0) {
                 const Vec3 vt = vi - vn * nrm;
                 const double speed = vt.norm();
-                double ft = ground.friction * fn;  // Coulomb, smoothed below 1 mm/s of sliding
+                double ft = ground.friction * fn; // Coulomb, smoothed below 1 mm/s of sliding
                 ft *= speed / std::max(speed, 1e-3);
                 if (opt.h > 0) ft = std::min(ft, mass[static_cast<size_t>(i)] * speed / opt.h);
                 if (speed > 0) force -= ft * vt / speed;
@@ -220,8 +232,10 @@ void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, s
         volume_and_gradient(x, &m.volumes.tets(t, 0), g);
         const double s = m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)];
         double total = 0;
-        for (int a = 0; a < 4; ++a) total += g.row(a).norm();
-        for (int a = 0; a < 4; ++a) ksum[static_cast<size_t>(m.volumes.tets(t, a))] += s * g.row(a).norm() * total;
+        for (int a = 0; a < 4; ++a)
+            total += g.row(a).norm();
+        for (int a = 0; a < 4; ++a)
+            ksum[static_cast<size_t>(m.volumes.tets(t, a))] += s * g.row(a).norm() * total;
     }
 }
 } // namespace
@@ -277,7 +291,8 @@ void Model::add_matrix_triplets(const Positions& x, double scale_k, double scale
         const double k = springs.k[static_cast<size_t>(e)];
         // −∂f/∂x of a spring, with the transverse term clamped at 0 (compressed springs) to stay semi-definite.
         const double tr = std::max(0.0, 1.0 - springs.rest[static_cast<size_t>(e)] / len);
-        const Mat3 b = scale_k * k * (uu + tr * (Mat3::Identity() - uu)) + scale_c * springs.c[static_cast<size_t>(e)] * uu;
+        const Mat3 b =
+            scale_k * k * (uu + tr * (Mat3::Identity() - uu)) + scale_c * springs.c[static_cast<size_t>(e)] * uu;
         add_block(i, i, b);
         add_block(j, j, b);
         add_block(i, j, -b);
@@ -332,7 +347,8 @@ void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, con
             volume_and_gradient(x, &volumes.tets(t, 0), g);
             const double s = scale_k * volumes.k[static_cast<size_t>(t)] / volumes.rest[static_cast<size_t>(t)];
             double gp = 0;
-            for (int a = 0; a < 4; ++a) gp += g.row(a).dot(pv(volumes.tets(t, a)));
+            for (int a = 0; a < 4; ++a)
+                gp += g.row(a).dot(pv(volumes.tets(t, a)));
             for (int a = 0; a < 4; ++a)
                 if (free(volumes.tets(t, a))) out.segment<3>(3 * volumes.tets(t, a)) += s * gp * g.row(a).transpose();
         }
@@ -340,8 +356,8 @@ void Model::apply_matrix(const Positions& x, double scale_k, double scale_c, con
     if (ground.enabled) {
         for (Index i = 0; i < num_vertices(); ++i)
             if (free(i) && ground.height - ground.normal.dot(row(x, i)) > 0)
-                out.segment<3>(3 * i) += (scale_k * ground_k_at(i) + scale_c * ground_c_at(i)) * ground.normal *
-                                         ground.normal.dot(pv(i));
+                out.segment<3>(3 * i) +=
+                    (scale_k * ground_k_at(i) + scale_c * ground_c_at(i)) * ground.normal * ground.normal.dot(pv(i));
     }
 }
 
@@ -357,15 +373,17 @@ void Model::Linearised::update(const Model& m, const Positions& x, double scale_
     const Index n = m.num_vertices();
     const Index ne = static_cast<Index>(m.springs.edges.rows());
     const Index nt = static_cast<Index>(m.volumes.tets.rows());
-    if (model != &m || static_cast<Index>(spring_start.size()) != n + 1 || static_cast<Index>(spring_id.size()) != 2 * ne ||
-        static_cast<Index>(tet_slot.size()) != 4 * nt) {
+    if (model != &m || static_cast<Index>(spring_start.size()) != n + 1 ||
+        static_cast<Index>(spring_id.size()) != 2 * ne || static_cast<Index>(tet_slot.size()) != 4 * nt) {
         // CSR adjacency by counting.
         spring_start.assign(static_cast<size_t>(n + 1), 0);
         tet_start.assign(static_cast<size_t>(n + 1), 0);
         for (Index e = 0; e < ne; ++e)
-            for (int s = 0; s < 2; ++s) ++spring_start[static_cast<size_t>(m.springs.edges(e, s) + 1)];
+            for (int s = 0; s < 2; ++s)
+                ++spring_start[static_cast<size_t>(m.springs.edges(e, s) + 1)];
         for (Index t = 0; t < nt; ++t)
-            for (int a = 0; a < 4; ++a) ++tet_start[static_cast<size_t>(m.volumes.tets(t, a) + 1)];
+            for (int a = 0; a < 4; ++a)
+                ++tet_start[static_cast<size_t>(m.volumes.tets(t, a) + 1)];
         for (Index i = 0; i < n; ++i) {
             spring_start[static_cast<size_t>(i + 1)] += spring_start[static_cast<size_t>(i)];
             tet_start[static_cast<size_t>(i + 1)] += tet_start[static_cast<size_t>(i)];
@@ -387,14 +405,16 @@ void Model::Linearised::update(const Model& m, const Positions& x, double scale_
     }
     model = &m;
     spring_block.resize(static_cast<size_t>(ne));
-    for (Index e = 0; e < ne; ++e) spring_block[static_cast<size_t>(e)] = spring_block_at(m, x, e, scale_k, scale_c);
+    for (Index e = 0; e < ne; ++e)
+        spring_block[static_cast<size_t>(e)] = spring_block_at(m, x, e, scale_k, scale_c);
     grad.resize(scale_k != 0 ? static_cast<size_t>(nt) : 0);
     tet_dot.resize(grad.size());
     for (Index t = 0; t < static_cast<Index>(grad.size()); ++t) {
         Eigen::Matrix<double, 4, 3>& g = grad[static_cast<size_t>(t)];
         volume_and_gradient(x, &m.volumes.tets(t, 0), g);
         // The Gauss–Newton block s ∇V ∇Vᵀ with s ≥ 0 (scale_k ≥ 0 in every use) as (√s ∇V)(√s ∇V)ᵀ.
-        g *= std::sqrt(std::max(0.0, scale_k * m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)]));
+        g *= std::sqrt(
+            std::max(0.0, scale_k * m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)]));
     }
     ground.assign(m.ground.enabled ? static_cast<size_t>(n) : 0, 0.0);
     if (m.ground.enabled)
@@ -416,7 +436,8 @@ void Model::Linearised::apply(const Eigen::VectorXd& p, Eigen::VectorXd& out) co
             const Eigen::Matrix<double, 4, 3>& g = grad[static_cast<size_t>(t)];
             const Index* v = &m.volumes.tets(t, 0);
             double gp = 0;
-            for (int a = 0; a < 4; ++a) gp += g.row(a).dot(pv(v[a]));
+            for (int a = 0; a < 4; ++a)
+                gp += g.row(a).dot(pv(v[a]));
             tet_dot[static_cast<size_t>(t)] = gp;
         }
         for (Index i = 0; i < n; ++i) {
@@ -429,9 +450,11 @@ void Model::Linearised::apply(const Eigen::VectorXd& p, Eigen::VectorXd& out) co
             if (nt)
                 for (Index k = tet_start[static_cast<size_t>(i)]; k < tet_start[static_cast<size_t>(i + 1)]; ++k) {
                     const Index slot = tet_slot[static_cast<size_t>(k)];
-                    acc += tet_dot[static_cast<size_t>(slot / 4)] * grad[static_cast<size_t>(slot / 4)].row(slot % 4).transpose();
+                    acc += tet_dot[static_cast<size_t>(slot / 4)] *
+                           grad[static_cast<size_t>(slot / 4)].row(slot % 4).transpose();
                 }
-            if (!ground.empty() && ground[static_cast<size_t>(i)] != 0) acc += ground[static_cast<size_t>(i)] * nrm * nrm.dot(pi);
+            if (!ground.empty() && ground[static_cast<size_t>(i)] != 0)
+                acc += ground[static_cast<size_t>(i)] * nrm * nrm.dot(pi);
             out.segment<3>(3 * i) += acc;
         }
     }
@@ -471,7 +494,8 @@ void Model::add_matrix_diagonal(const Positions& x, double scale_k, double scale
             const double s = scale_k * volumes.k[static_cast<size_t>(t)] / volumes.rest[static_cast<size_t>(t)];
             for (int a = 0; a < 4; ++a)
                 if (free(volumes.tets(t, a)))
-                    diag.segment<3>(3 * volumes.tets(t, a)) += s * g.row(a).transpose().cwiseProduct(g.row(a).transpose());
+                    diag.segment<3>(3 * volumes.tets(t, a)) +=
+                        s * g.row(a).transpose().cwiseProduct(g.row(a).transpose());
         }
     }
     if (ground.enabled) {

@@ -23,9 +23,12 @@ Integrator parse_integrator(const std::string& name)
 const char* to_string(Integrator integrator)
 {
     switch (integrator) {
-    case Integrator::symplectic_euler: return "symplectic_euler";
-    case Integrator::implicit_euler: return "implicit_euler";
-    case Integrator::local_global: return "local_global";
+    case Integrator::symplectic_euler:
+        return "symplectic_euler";
+    case Integrator::implicit_euler:
+        return "implicit_euler";
+    case Integrator::local_global:
+        return "local_global";
     }
     return "?";
 }
@@ -37,13 +40,16 @@ LinearSolver parse_linear_solver(const std::string& name)
     throw Error("solver '" + name + "' unknown (cg, ldlt)");
 }
 
-const char* to_string(LinearSolver solver) { return solver == LinearSolver::cg ? "cg" : "ldlt"; }
+const char* to_string(LinearSolver solver)
+{
+    return solver == LinearSolver::cg ? "cg" : "ldlt";
+}
 
 namespace {
 
 /// Reads one TOML table, checking every key is known and every value has the right type.
 class Reader {
-public:
+  public:
     Reader(std::string source, std::string base_dir) : m_source(std::move(source)), m_base(std::move(base_dir)) {}
 
     [[noreturn]] void fail(const toml::node* node, const std::string& key, const std::string& what) const
@@ -56,13 +62,20 @@ public:
     static const char* type_name(const toml::node& n)
     {
         switch (n.type()) {
-        case toml::node_type::table: return "a table";
-        case toml::node_type::array: return "an array";
-        case toml::node_type::string: return "a string";
-        case toml::node_type::integer: return "an integer";
-        case toml::node_type::floating_point: return "a number";
-        case toml::node_type::boolean: return "a boolean";
-        default: return "a date/time";
+        case toml::node_type::table:
+            return "a table";
+        case toml::node_type::array:
+            return "an array";
+        case toml::node_type::string:
+            return "a string";
+        case toml::node_type::integer:
+            return "an integer";
+        case toml::node_type::floating_point:
+            return "a number";
+        case toml::node_type::boolean:
+            return "a boolean";
+        default:
+            return "a date/time";
         }
     }
 
@@ -74,7 +87,8 @@ public:
             if (std::find_if(known.begin(), known.end(), [&](const char* s) { return key == s; }) != known.end())
                 continue;
             std::string list;
-            for (const char* s : known) list += (list.empty() ? "" : ", ") + std::string(s);
+            for (const char* s : known)
+                list += (list.empty() ? "" : ", ") + std::string(s);
             std::string where = m_source;
             const auto& src = k.source().begin ? k.source() : v.source();
             if (src.begin) where += ":" + std::to_string(src.begin.line);
@@ -124,8 +138,10 @@ public:
     Eigen::Vector3d vec3(const toml::node& n, const std::string& key) const
     {
         const toml::array* a = n.as_array();
-        if (!a || a->size() != 3) fail(&n, key, std::string("expected an array of 3 numbers, found ") +
-                                                    (a ? "an array of " + std::to_string(a->size()) : type_name(n)));
+        if (!a || a->size() != 3)
+            fail(&n, key,
+                 std::string("expected an array of 3 numbers, found ") +
+                     (a ? "an array of " + std::to_string(a->size()) : type_name(n)));
         Eigen::Vector3d v;
         for (int i = 0; i < 3; ++i) {
             v[i] = number(*a->get(static_cast<size_t>(i)), key + "[" + std::to_string(i) + "]");
@@ -152,7 +168,7 @@ public:
         return s.str();
     }
 
-private:
+  private:
     std::string m_source, m_base;
 };
 
@@ -161,11 +177,16 @@ void read_material(const Reader& r, const toml::table& t, const std::string& pre
     r.check_keys(t, pre, {"density", "stiffness", "young", "damping", "volume_stiffness"});
     for (auto&& [k, v] : t) {
         const std::string key(k.str()), full = pre + key;
-        if (key == "density") m.density = r.positive(v, full);
-        else if (key == "stiffness") m.stiffness = r.positive(v, full);
-        else if (key == "young") m.young = r.positive(v, full);
-        else if (key == "damping") m.damping = r.non_negative(v, full);
-        else if (key == "volume_stiffness") m.volume_stiffness = r.non_negative(v, full);
+        if (key == "density")
+            m.density = r.positive(v, full);
+        else if (key == "stiffness")
+            m.stiffness = r.positive(v, full);
+        else if (key == "young")
+            m.young = r.positive(v, full);
+        else if (key == "damping")
+            m.damping = r.non_negative(v, full);
+        else if (key == "volume_stiffness")
+            m.volume_stiffness = r.non_negative(v, full);
     }
 }
 
@@ -173,23 +194,35 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
 {
     ObjectSpec o;
     o.name = "object " + std::to_string(index);
-    r.check_keys(t, pre, {"name", "mesh", "generate", "surface_resolution", "scale", "rotate", "translate",
-                          "velocity", "material", "self_collision", "static"});
+    r.check_keys(t, pre,
+                 {"name", "mesh", "generate", "surface_resolution", "scale", "rotate", "translate", "velocity",
+                  "material", "self_collision", "static"});
     for (auto&& [k, v] : t) {
         const std::string key(k.str()), full = pre + key;
-        if (key == "name") o.name = r.string(v, full);
-        else if (key == "mesh") o.mesh = r.path(r.string(v, full));
-        else if (key == "surface_resolution") o.surface_resolution = static_cast<int>(r.integer_at_least(v, full, 1));
+        if (key == "name")
+            o.name = r.string(v, full);
+        else if (key == "mesh")
+            o.mesh = r.path(r.string(v, full));
+        else if (key == "surface_resolution")
+            o.surface_resolution = static_cast<int>(r.integer_at_least(v, full, 1));
         else if (key == "scale") {
-            if (v.is_number()) o.scale.setConstant(r.positive(v, full));
-            else o.scale = r.vec3(v, full);
+            if (v.is_number())
+                o.scale.setConstant(r.positive(v, full));
+            else
+                o.scale = r.vec3(v, full);
             if (!(o.scale.minCoeff() > 0)) r.fail(&v, full, "must be positive");
-        } else if (key == "rotate") o.rotate_deg = r.vec3(v, full);
-        else if (key == "translate") o.translate = r.vec3(v, full);
-        else if (key == "velocity") o.velocity = r.vec3(v, full);
-        else if (key == "self_collision") o.self_collision = r.boolean(v, full);
-        else if (key == "static") o.is_static = r.boolean(v, full);
-        else if (key == "material") read_material(r, r.table(v, full), full + ".", o.material);
+        } else if (key == "rotate")
+            o.rotate_deg = r.vec3(v, full);
+        else if (key == "translate")
+            o.translate = r.vec3(v, full);
+        else if (key == "velocity")
+            o.velocity = r.vec3(v, full);
+        else if (key == "self_collision")
+            o.self_collision = r.boolean(v, full);
+        else if (key == "static")
+            o.is_static = r.boolean(v, full);
+        else if (key == "material")
+            read_material(r, r.table(v, full), full + ".", o.material);
         else if (key == "generate") {
             const toml::table& g = r.table(v, full);
             r.check_keys(g, full + ".", {"shape", "resolution", "size", "snap"});
@@ -201,22 +234,29 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
                     gp.shape = r.string(gv, gfull);
                     // Checked here so the message names the line; generate() checks again.
                     std::vector<std::string> shapes;
-                    try { shapes = io::generate_shapes(); } catch (const std::exception&) {}
+                    try {
+                        shapes = io::generate_shapes();
+                    } catch (const std::exception&) {
+                    }
                     if (!shapes.empty() && std::find(shapes.begin(), shapes.end(), gp.shape) == shapes.end()) {
                         std::string list;
-                        for (const auto& s : shapes) list += (list.empty() ? "" : ", ") + s;
+                        for (const auto& s : shapes)
+                            list += (list.empty() ? "" : ", ") + s;
                         r.fail(&gv, gfull, "unknown shape '" + gp.shape + "' (known: " + list + ")");
                     }
-                } else if (gkey == "resolution") gp.resolution = static_cast<int>(r.integer_at_least(gv, gfull, 1));
+                } else if (gkey == "resolution")
+                    gp.resolution = static_cast<int>(r.integer_at_least(gv, gfull, 1));
                 else if (gkey == "size") {
                     // A single number is the longest extent (the shape keeps its proportions);
                     // three numbers are the bounding-box extents (the shape is stretched to them).
-                    if (gv.is_number()) longest = r.positive(gv, gfull);
+                    if (gv.is_number())
+                        longest = r.positive(gv, gfull);
                     else {
                         gp.size = r.vec3(gv, gfull);
                         if (!(gp.size.minCoeff() > 0)) r.fail(&gv, gfull, "must be positive");
                     }
-                } else if (gkey == "snap") gp.snap = r.boolean(gv, gfull);
+                } else if (gkey == "snap")
+                    gp.snap = r.boolean(gv, gfull);
             }
             if (longest > 0) gp.scale = longest / io::shape_natural_size(gp.shape).maxCoeff();
             o.generate = gp;
@@ -243,47 +283,69 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     const Reader r(source_name, base_dir);
     Scene s;
     s.source = source_name;
-    r.check_keys(root, "", {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "gravity",
-                            "ground", "contact", "detector", "output", "object", "pin"});
+    r.check_keys(root, "",
+                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "gravity", "ground",
+                  "contact", "detector", "output", "object", "pin"});
     for (auto&& [k, v] : root) {
         const std::string key(k.str());
-        if (key == "dt") s.dt = r.positive(v, key);
-        else if (key == "steps") s.steps = static_cast<int>(r.integer_at_least(v, key, 0));
-        else if (key == "substeps") s.substeps = static_cast<int>(r.integer_at_least(v, key, 1));
-        else if (key == "iterations") s.iterations = static_cast<int>(r.integer_at_least(v, key, 1));
-        else if (key == "tolerance") s.tolerance = r.positive(v, key);
-        else if (key == "gravity") s.gravity = r.vec3(v, key);
+        if (key == "dt")
+            s.dt = r.positive(v, key);
+        else if (key == "steps")
+            s.steps = static_cast<int>(r.integer_at_least(v, key, 0));
+        else if (key == "substeps")
+            s.substeps = static_cast<int>(r.integer_at_least(v, key, 1));
+        else if (key == "iterations")
+            s.iterations = static_cast<int>(r.integer_at_least(v, key, 1));
+        else if (key == "tolerance")
+            s.tolerance = r.positive(v, key);
+        else if (key == "gravity")
+            s.gravity = r.vec3(v, key);
         else if (key == "integrator") {
-            try { s.integrator = parse_integrator(r.string(v, key)); }
-            catch (const Error& e) { r.fail(&v, key, e.what()); }
+            try {
+                s.integrator = parse_integrator(r.string(v, key));
+            } catch (const Error& e) {
+                r.fail(&v, key, e.what());
+            }
         } else if (key == "solver") {
-            try { s.solver = parse_linear_solver(r.string(v, key)); }
-            catch (const Error& e) { r.fail(&v, key, e.what()); }
+            try {
+                s.solver = parse_linear_solver(r.string(v, key));
+            } catch (const Error& e) {
+                r.fail(&v, key, e.what());
+            }
         } else if (key == "ground") {
             const toml::table& t = r.table(v, key);
             s.ground.enabled = true;
             r.check_keys(t, "ground.", {"enabled", "height", "normal", "stiffness", "damping", "friction"});
             for (auto&& [gk, gv] : t) {
                 const std::string g(gk.str()), full = "ground." + g;
-                if (g == "enabled") s.ground.enabled = r.boolean(gv, full);
-                else if (g == "height") s.ground.height = r.number(gv, full);
+                if (g == "enabled")
+                    s.ground.enabled = r.boolean(gv, full);
+                else if (g == "height")
+                    s.ground.height = r.number(gv, full);
                 else if (g == "normal") {
                     s.ground.normal = r.vec3(gv, full);
                     if (!(s.ground.normal.norm() > 0)) r.fail(&gv, full, "must not be the zero vector");
                     s.ground.normal.normalize();
-                } else if (g == "stiffness") s.ground.stiffness = r.non_negative(gv, full);
-                else if (g == "damping") s.ground.damping = r.non_negative(gv, full);
-                else if (g == "friction") s.ground.friction = r.non_negative(gv, full);
+                } else if (g == "stiffness")
+                    s.ground.stiffness = r.non_negative(gv, full);
+                else if (g == "damping")
+                    s.ground.damping = r.non_negative(gv, full);
+                else if (g == "friction")
+                    s.ground.friction = r.non_negative(gv, full);
             }
         } else if (key == "contact") {
             const toml::table& t = r.table(v, key);
             r.check_keys(t, "contact.", {"stiffness", "damping", "friction", "in_matrix"});
             for (auto&& [ck, cv] : t) {
                 const std::string c(ck.str()), full = "contact." + c;
-                if (c == "stiffness") s.contact.stiffness = r.non_negative(cv, full);
-                else if (c == "damping") s.contact.damping = r.non_negative(cv, full);
-                else if (c == "friction") s.contact.friction = r.non_negative(cv, full);
-                else if (c == "in_matrix") s.contact.in_matrix = r.boolean(cv, full);
+                if (c == "stiffness")
+                    s.contact.stiffness = r.non_negative(cv, full);
+                else if (c == "damping")
+                    s.contact.damping = r.non_negative(cv, full);
+                else if (c == "friction")
+                    s.contact.friction = r.non_negative(cv, full);
+                else if (c == "in_matrix")
+                    s.contact.in_matrix = r.boolean(cv, full);
             }
         } else if (key == "detector") {
             const toml::table& t = r.table(v, key);
@@ -296,26 +358,34 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         s.detect.cell_size = r.positive(dv, full);
                     } else {
                         const std::string str = r.string(dv, full);
-                        if (str == "auto") s.detect.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
+                        if (str == "auto")
+                            s.detect.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
                         else if (str.size() > 1 && str[0] == 'x') {
                             char* end = nullptr;
                             const double f = std::strtod(str.c_str() + 1, &end);
                             if (*end != '\0' || !(f > 0) || !std::isfinite(f))
-                                r.fail(&dv, full, "expected a number, \"auto\" or \"xF\" (F > 0), found \"" + str + "\"");
+                                r.fail(&dv, full,
+                                       "expected a number, \"auto\" or \"xF\" (F > 0), found \"" + str + "\"");
                             s.detect.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
                             s.detect.cell_size = f;
-                        } else r.fail(&dv, full, "expected a number, \"auto\" or \"xF\", found \"" + str + "\"");
+                        } else
+                            r.fail(&dv, full, "expected a number, \"auto\" or \"xF\", found \"" + str + "\"");
                     }
                 } else if (d == "table_size") {
                     if (dv.is_string()) {
                         if (r.string(dv, full) != "auto") r.fail(&dv, full, "expected an integer ≥ 1 or \"auto\"");
                         s.detect.table_size = 0;
-                    } else s.detect.table_size = r.integer_at_least(dv, full, 1);
+                    } else
+                        s.detect.table_size = r.integer_at_least(dv, full, 1);
                 } else if (d == "hash") {
-                    try { s.detect.hash = parse_hash_function(r.string(dv, full)); }
-                    catch (const Error& e) { r.fail(&dv, full, e.what()); }
-                } else if (d == "threads") s.detect.threads = static_cast<int>(r.integer_at_least(dv, full, 0));
-                else if (d == "skin") {   // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
+                    try {
+                        s.detect.hash = parse_hash_function(r.string(dv, full));
+                    } catch (const Error& e) {
+                        r.fail(&dv, full, e.what());
+                    }
+                } else if (d == "threads")
+                    s.detect.threads = static_cast<int>(r.integer_at_least(dv, full, 0));
+                else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
                     if (dv.is_number()) {
                         s.detect.skin_mode = DetectParams::SkinMode::absolute;
                         s.detect.skin = r.non_negative(dv, full);
@@ -324,8 +394,9 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         char* end = nullptr;
                         const double f = str.size() > 1 && str[0] == 'x' ? std::strtod(str.c_str() + 1, &end) : -1.0;
                         if (!end || *end != '\0' || !(f >= 0) || !std::isfinite(f))
-                            r.fail(&dv, full, "expected a number ≥ 0 or \"xF\" (F ≥ 0, a factor of the cell size), found \"" +
-                                                  str + "\"");
+                            r.fail(&dv, full,
+                                   "expected a number ≥ 0 or \"xF\" (F ≥ 0, a factor of the cell size), found \"" +
+                                       str + "\"");
                         s.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
                         s.detect.skin = f;
                     }
@@ -336,10 +407,12 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             r.check_keys(t, "output.", {"every", "fields"});
             for (auto&& [ok, ov] : t) {
                 const std::string o(ok.str()), full = "output." + o;
-                if (o == "every") s.output.every = static_cast<int>(r.integer_at_least(ov, full, 0));
+                if (o == "every")
+                    s.output.every = static_cast<int>(r.integer_at_least(ov, full, 0));
                 else if (o == "fields") {
                     const toml::array* a = ov.as_array();
-                    if (!a) r.fail(&ov, full, std::string("expected an array of strings, found ") + Reader::type_name(ov));
+                    if (!a)
+                        r.fail(&ov, full, std::string("expected an array of strings, found ") + Reader::type_name(ov));
                     s.output.fields.clear();
                     for (const toml::node& e : *a) {
                         const std::string f = r.string(e, full);
@@ -351,7 +424,9 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             }
         } else if (key == "object" || key == "pin") {
             const toml::array* a = v.as_array();
-            if (!a) r.fail(&v, key, std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
+            if (!a)
+                r.fail(&v, key,
+                       std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
             for (size_t i = 0; i < a->size(); ++i) {
                 const toml::node& e = *a->get(i);
                 const std::string pre = key + "[" + std::to_string(i) + "].";
@@ -365,17 +440,28 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                 bool has_min = false, has_max = false;
                 for (auto&& [pk, pv] : t) {
                     const std::string pkey(pk.str()), full = pre + pkey;
-                    if (pkey == "object") p.object = static_cast<int>(r.integer_at_least(pv, full, 0));
+                    if (pkey == "object")
+                        p.object = static_cast<int>(r.integer_at_least(pv, full, 0));
                     else if (pkey == "vertices") {
                         const toml::array* va = pv.as_array();
-                        if (!va) r.fail(&pv, full, std::string("expected an array of integers, found ") + Reader::type_name(pv));
-                        for (const toml::node& id : *va) p.vertices.push_back(static_cast<Index>(r.integer_at_least(id, full, 0)));
-                    } else if (pkey == "box_min") { p.box_min = r.vec3(pv, full); has_min = true; }
-                    else if (pkey == "box_max") { p.box_max = r.vec3(pv, full); has_max = true; }
+                        if (!va)
+                            r.fail(&pv, full,
+                                   std::string("expected an array of integers, found ") + Reader::type_name(pv));
+                        for (const toml::node& id : *va)
+                            p.vertices.push_back(static_cast<Index>(r.integer_at_least(id, full, 0)));
+                    } else if (pkey == "box_min") {
+                        p.box_min = r.vec3(pv, full);
+                        has_min = true;
+                    } else if (pkey == "box_max") {
+                        p.box_max = r.vec3(pv, full);
+                        has_max = true;
+                    }
                 }
-                if (has_min != has_max) r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
+                if (has_min != has_max)
+                    r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
                 p.has_box = has_min;
-                if (!p.has_box && p.vertices.empty()) r.fail(&e, key + "[" + std::to_string(i) + "]", "a pin needs 'vertices' or 'box_min'/'box_max'");
+                if (!p.has_box && p.vertices.empty())
+                    r.fail(&e, key + "[" + std::to_string(i) + "]", "a pin needs 'vertices' or 'box_min'/'box_max'");
                 s.pins.push_back(std::move(p));
             }
         }
@@ -383,7 +469,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     for (size_t i = 0; i < s.pins.size(); ++i)
         if (s.pins[i].object >= static_cast<int>(s.objects.size()))
             throw Error(source_name + ": key 'pin[" + std::to_string(i) + "].object': object " +
-                        std::to_string(s.pins[i].object) + " does not exist (" + std::to_string(s.objects.size()) + " objects)");
+                        std::to_string(s.pins[i].object) + " does not exist (" + std::to_string(s.objects.size()) +
+                        " objects)");
     if (s.objects.empty()) throw Error(source_name + ": the scene has no [[object]]");
     return s;
 }
@@ -402,7 +489,8 @@ Scene load_scene(const std::string& path)
 
 const std::string& default_scene_text()
 {
-    static const std::string text = R"(# tethash default scene: a soft bar, a ball and a ring dropped onto a static block and the ground.
+    static const std::string text =
+        R"(# tethash default scene: a soft bar, a ball and a ring dropped onto a static block and the ground.
 dt = 2e-3
 steps = 400
 integrator = "implicit_euler"
@@ -445,6 +533,9 @@ material = { density = 400, young = 1e5 }
     return text;
 }
 
-Scene default_scene() { return parse_scene(default_scene_text(), "<default scene>", "."); }
+Scene default_scene()
+{
+    return parse_scene(default_scene_text(), "<default scene>", ".");
+}
 
 } // namespace tethash::sim

@@ -73,16 +73,17 @@ TetMesh load_object(const ObjectSpec& o)
     apply(m.positions);
     if (m.rest_positions.rows()) apply(m.rest_positions);
     for (Index i = 0; i < m.num_vertices(); ++i)
-        if (!m.positions.row(i).allFinite()) throw Error("object '" + o.name + "': vertex " + std::to_string(i) + " is not finite");
+        if (!m.positions.row(i).allFinite())
+            throw Error("object '" + o.name + "': vertex " + std::to_string(i) + " is not finite");
     return m;
 }
 
 } // namespace
 
 class SimulationImpl {
-public:
+  public:
     Scene scene;
-    TetMesh mesh;                       // positions = current x
+    TetMesh mesh; // positions = current x
     Positions v;
     Model model;
     std::vector<std::pair<Index, Index>> obj_vertices, obj_tets;
@@ -91,14 +92,14 @@ public:
     bool detect_enabled = false;
     Penetration penetration;
     std::vector<Contact> contacts;
-    std::vector<double> contact_weight;  // 1 / number of contacts of (vertex, object)
-    std::vector<double> contact_k, contact_c, contact_mred;  // per contact: stiffness, damping, reduced mass
-    std::vector<double> object_k;        // per object: stiffest spring (0 for static objects)
+    std::vector<double> contact_weight;                     // 1 / number of contacts of (vertex, object)
+    std::vector<double> contact_k, contact_c, contact_mred; // per contact: stiffness, damping, reduced mass
+    std::vector<double> object_k;                           // per object: stiffest spring (0 for static objects)
     double mu = 0;
-    double msum = 0;                     // total free mass
-    Vec3 centre0{0, 0, 0};               // bounding box centre at start
-    double radius0 = 0;                  // half the bounding box diagonal at start
-    double speed_bound = 0;              // no vertex can reach this speed on the energy available at start
+    double msum = 0;        // total free mass
+    Vec3 centre0{0, 0, 0};  // bounding box centre at start
+    double radius0 = 0;     // half the bounding box diagonal at start
+    double speed_bound = 0; // no vertex can reach this speed on the energy available at start
     StepStats stats;
     std::vector<std::string> warnings;
     std::int64_t steps_done = 0;
@@ -106,10 +107,10 @@ public:
     double energy_ref = 0;
     double dt_limit = std::numeric_limits<double>::infinity();
     double min_free_mass = 0, mean_free_mass = 0;
-    Model::Linearised lin;               // implicit Euler (CG): operator cache, adjacency kept between steps
+    Model::Linearised lin; // implicit Euler (CG): operator cache, adjacency kept between steps
     // local/global
     double lg_h = -1;
-    std::vector<Index> lg_free;          // vertex → free index or −1
+    std::vector<Index> lg_free; // vertex → free index or −1
     Eigen::SimplicialLLT<SpMat> lg_solver;
     SpMat lg_matrix;
     double lg_vol_scale = 1;
@@ -222,7 +223,9 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         for (Index i = 0; i < n; ++i) {
             const size_t o = static_cast<size_t>(mesh.vertex_object[static_cast<size_t>(i)]);
             double& k = model.ground_k[static_cast<size_t>(i)];
-            if (!(k > 0)) k = scene.contact.stiffness > 0 ? scene.contact.stiffness : pair_stiffness(static_cast<Index>(o), static_cast<Index>(o));
+            if (!(k > 0))
+                k = scene.contact.stiffness > 0 ? scene.contact.stiffness
+                                                : pair_stiffness(static_cast<Index>(o), static_cast<Index>(o));
             double& c = model.ground_c[static_cast<size_t>(i)];
             if (!(c > 0)) c = std::sqrt(k * model.mass[static_cast<size_t>(i)]);
         }
@@ -255,20 +258,24 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
             for (Index a = 0; a < nobj; ++a)
                 for (Index b = 0; b < nobj; ++b)
                     if ((a != b || scene.objects[static_cast<size_t>(a)].self_collision) &&
-                        !(scene.objects[static_cast<size_t>(a)].is_static && scene.objects[static_cast<size_t>(b)].is_static))
-                        obj_contact_k[static_cast<size_t>(a)] = std::max(obj_contact_k[static_cast<size_t>(a)], pair_stiffness(a, b));
+                        !(scene.objects[static_cast<size_t>(a)].is_static &&
+                          scene.objects[static_cast<size_t>(b)].is_static))
+                        obj_contact_k[static_cast<size_t>(a)] =
+                            std::max(obj_contact_k[static_cast<size_t>(a)], pair_stiffness(a, b));
         for (Index i = 0; i < n; ++i) {
             const size_t u = static_cast<size_t>(i);
             double k = obj_contact_k[static_cast<size_t>(mesh.vertex_object[u])];
             if (model.ground.enabled) k = std::max(k, model.ground_k_at(i));
             extra_k[u] = k;
-            extra_c[u] = scene.contact.damping > 0 && !model.ground.enabled ? scene.contact.damping : std::sqrt(k * model.mass[u]);
+            extra_c[u] = scene.contact.damping > 0 && !model.ground.enabled ? scene.contact.damping
+                                                                            : std::sqrt(k * model.mass[u]);
         }
         dt_limit = model.explicit_dt_limit(mesh.positions, extra_k, extra_c);
     }
     if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
         warnings.push_back("time step " + num(h) + " s (dt/substeps) exceeds the explicit stability limit ≈ " +
-                           num(dt_limit) + " s estimated from the largest stiffness/mass ratio; symplectic_euler "
+                           num(dt_limit) +
+                           " s estimated from the largest stiffness/mass ratio; symplectic_euler "
                            "will likely blow up: use more substeps, a smaller dt, or implicit_euler");
 
     // Reference energy for blow-up detection: all the energy the scene can draw on at start.
@@ -298,7 +305,7 @@ double SimulationImpl::pair_stiffness(Index a, Index b) const
     double ka = object_k[static_cast<size_t>(a)], kb = object_k[static_cast<size_t>(b)];
     if (!(ka > 0)) ka = kb;
     if (!(kb > 0)) kb = ka;
-    if (!(ka > 0)) return 1e4;   // two objects without springs (cannot happen for a contact the detector reports)
+    if (!(ka > 0)) return 1e4; // two objects without springs (cannot happen for a contact the detector reports)
     return 10 * 2 * ka * kb / (ka + kb);
 }
 
@@ -312,7 +319,8 @@ void SimulationImpl::contact_coefficients()
         const Contact& c = contacts[q];
         contact_k[q] = pair_stiffness(mesh.vertex_object[static_cast<size_t>(c.vertex)], c.tet_object);
         // Reduced mass of the vertex and the penetrated tet's point (fixed vertices have infinite mass).
-        double inv_v = model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
+        double inv_v =
+            model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
         double mt = 0;
         bool tet_fixed = false;
         for (int k = 0; k < 4; ++k) {
@@ -346,10 +354,12 @@ void SimulationImpl::detect_and_respond(double& ms_detect, double& ms_response)
     contact_weight.assign(contacts.size(), 1.0);
     for (size_t a = 0; a < contacts.size();) {
         size_t b = a;
-        while (b < contacts.size() && contacts[b].vertex == contacts[a].vertex) ++b;
+        while (b < contacts.size() && contacts[b].vertex == contacts[a].vertex)
+            ++b;
         for (size_t i = a; i < b; ++i) {
             int same = 0;
-            for (size_t j = a; j < b; ++j) same += contacts[j].tet_object == contacts[i].tet_object ? 1 : 0;
+            for (size_t j = a; j < b; ++j)
+                same += contacts[j].tet_object == contacts[i].tet_object ? 1 : 0;
             contact_weight[i] = 1.0 / same;
         }
         a = b;
@@ -364,7 +374,8 @@ void SimulationImpl::add_contact_forces(const Positions& vel, Positions& f, doub
         if (!(c.depth > 0)) continue;
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
         Vec3 vrel = vel.row(c.vertex).transpose();
-        for (int k = 0; k < 4; ++k) vrel -= c.bary[k] * vel.row(mesh.tets(c.tet, k)).transpose();
+        for (int k = 0; k < 4; ++k)
+            vrel -= c.bary[k] * vel.row(mesh.tets(c.tet, k)).transpose();
         const double vn = vrel.dot(nrm);
         const double w = contact_weight[q];
         double scale = 1.0;
@@ -381,18 +392,21 @@ void SimulationImpl::add_contact_forces(const Positions& vel, Positions& f, doub
             if (speed > 0) force -= ft * vt / speed;
         }
         f.row(c.vertex) += force.transpose();
-        for (int k = 0; k < 4; ++k) f.row(mesh.tets(c.tet, k)) -= c.bary[k] * force.transpose();
+        for (int k = 0; k < 4; ++k)
+            f.row(mesh.tets(c.tet, k)) -= c.bary[k] * force.transpose();
     }
 }
 
-void SimulationImpl::add_contact_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const
+void SimulationImpl::add_contact_triplets(double scale_k, double scale_c,
+                                          std::vector<Eigen::Triplet<double>>& out) const
 {
     for (size_t q = 0; q < contacts.size(); ++q) {
         const Contact& c = contacts[q];
         if (!(c.depth > 0)) continue;
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
         const Mat3 nn = contact_weight[q] * (scale_k * contact_k[q] + scale_c * contact_c[q]) * nrm * nrm.transpose();
-        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2), mesh.tets(c.tet, 3)};
+        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2),
+                               mesh.tets(c.tet, 3)};
         const double coef[5] = {1.0, -c.bary[0], -c.bary[1], -c.bary[2], -c.bary[3]};
         for (int a = 0; a < 5; ++a) {
             if (model.fixed[static_cast<size_t>(node[a])]) continue;
@@ -415,7 +429,10 @@ double SimulationImpl::contact_energy() const
     return e;
 }
 
-bool SimulationImpl::state_finite() const { return mesh.positions.allFinite() && v.allFinite(); }
+bool SimulationImpl::state_finite() const
+{
+    return mesh.positions.allFinite() && v.allFinite();
+}
 
 std::string SimulationImpl::check_state(double t_end) const
 {
@@ -471,7 +488,8 @@ void SimulationImpl::contact_apply(double scale_k, double scale_c, const Eigen::
         const Contact& c = contacts[q];
         if (!(c.depth > 0)) continue;
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
-        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2), mesh.tets(c.tet, 3)};
+        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2),
+                               mesh.tets(c.tet, 3)};
         const double coef[5] = {1.0, -c.bary[0], -c.bary[1], -c.bary[2], -c.bary[3]};
         double jp = 0;
         for (int a = 0; a < 5; ++a)
@@ -488,7 +506,8 @@ void SimulationImpl::contact_diagonal(double scale_k, double scale_c, Eigen::Vec
         const Contact& c = contacts[q];
         if (!(c.depth > 0)) continue;
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
-        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2), mesh.tets(c.tet, 3)};
+        const Index node[5] = {c.vertex, mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2),
+                               mesh.tets(c.tet, 3)};
         const double coef[5] = {1.0, -c.bary[0], -c.bary[1], -c.bary[2], -c.bary[3]};
         const double s = contact_weight[q] * (scale_k * contact_k[q] + scale_c * contact_c[q]);
         for (int a = 0; a < 5; ++a)
@@ -528,11 +547,13 @@ int SimulationImpl::substep_implicit(double h)
         std::vector<Eigen::Triplet<double>> t;
         model.add_matrix_triplets(mesh.positions, h * h, h, t);
         if (cin) add_contact_triplets(h * h, h, t);
-        for (Index k = 0; k < N; ++k) t.emplace_back(k, k, mdiag[k]);
+        for (Index k = 0; k < N; ++k)
+            t.emplace_back(k, k, mdiag[k]);
         SpMat A(N, N);
         A.setFromTriplets(t.begin(), t.end());
         Eigen::SimplicialLDLT<SpMat> solver(A);
-        if (solver.info() != Eigen::Success) throw RunFailure("the implicit Euler system matrix could not be factorised");
+        if (solver.info() != Eigen::Success)
+            throw RunFailure("the implicit Euler system matrix could not be factorised");
         vnew = solver.solve(rhs);
     } else {
         // Matrix-free preconditioned CG (Jacobi): no assembly, a few sweeps over springs and tets per iteration.
@@ -589,7 +610,8 @@ void SimulationImpl::setup_local_global(double h)
     std::vector<Eigen::Triplet<double>> t;
     for (Index i = 0; i < n; ++i)
         if (lg_free[static_cast<size_t>(i)] >= 0)
-            t.emplace_back(lg_free[static_cast<size_t>(i)], lg_free[static_cast<size_t>(i)], model.mass[static_cast<size_t>(i)]);
+            t.emplace_back(lg_free[static_cast<size_t>(i)], lg_free[static_cast<size_t>(i)],
+                           model.mass[static_cast<size_t>(i)]);
     for (Index e = 0; e < model.springs.edges.rows(); ++e) {
         const Index fi = lg_free[static_cast<size_t>(model.springs.edges(e, 0))];
         const Index fj = lg_free[static_cast<size_t>(model.springs.edges(e, 1))];
@@ -608,7 +630,8 @@ void SimulationImpl::setup_local_global(double h)
     // The volume term stays explicit in this integrator: scale it down to its own stability limit at h.
     Model vol_only = model;
     vol_only.springs = Springs{};
-    for (double& c : vol_only.springs.c) c = 0;
+    for (double& c : vol_only.springs.c)
+        c = 0;
     const double w2 = vol_only.omega_max_sq(mesh.rest());
     lg_vol_scale = (w2 * h * h > 1.0) ? 1.0 / (w2 * h * h) : 1.0;
     lg_h = h;
@@ -626,9 +649,10 @@ void SimulationImpl::substep_local_global(double h)
     opt.h = h;
     opt.volume_scale = lg_vol_scale;
     if (model.ground.enabled) {
-        double ratio = 0;   // largest ground stiffness / mass
+        double ratio = 0; // largest ground stiffness / mass
         for (Index i = 0; i < n; ++i)
-            if (!model.fixed[static_cast<size_t>(i)]) ratio = std::max(ratio, model.ground_k_at(i) / model.mass[static_cast<size_t>(i)]);
+            if (!model.fixed[static_cast<size_t>(i)])
+                ratio = std::max(ratio, model.ground_k_at(i) / model.mass[static_cast<size_t>(i)]);
         if (ratio > 0) opt.ground_scale = std::min(1.0, 0.5 / (h * h * ratio));
     }
     model.add_forces(mesh.positions, v, f, opt);
@@ -641,7 +665,8 @@ void SimulationImpl::substep_local_global(double h)
     Positions x = y;
     Eigen::MatrixXd base(nf, 3), rhs(nf, 3);
     for (Index i = 0; i < n; ++i)
-        if (lg_free[static_cast<size_t>(i)] >= 0) base.row(lg_free[static_cast<size_t>(i)]) = model.mass[static_cast<size_t>(i)] * y.row(i);
+        if (lg_free[static_cast<size_t>(i)] >= 0)
+            base.row(lg_free[static_cast<size_t>(i)]) = model.mass[static_cast<size_t>(i)] * y.row(i);
     for (int it = 0; it < scene.iterations; ++it) {
         rhs = base;
         for (Index e = 0; e < model.springs.edges.rows(); ++e) {
@@ -651,11 +676,14 @@ void SimulationImpl::substep_local_global(double h)
             const double len = dx.norm();
             const double kh2 = h * h * model.springs.k[static_cast<size_t>(e)];
             const double ch = h * model.springs.c[static_cast<size_t>(e)];
-            const Eigen::RowVector3d d = len > 0 ? Eigen::RowVector3d(model.springs.rest[static_cast<size_t>(e)] / len * dx)
-                                                 : Eigen::RowVector3d::Zero();
+            const Eigen::RowVector3d d = len > 0
+                                             ? Eigen::RowVector3d(model.springs.rest[static_cast<size_t>(e)] / len * dx)
+                                             : Eigen::RowVector3d::Zero();
             const Eigen::RowVector3d term = kh2 * d + ch * (xn.row(i) - xn.row(j));
-            if (fi >= 0) rhs.row(fi) += term + (fj < 0 ? Eigen::RowVector3d((kh2 + ch) * x.row(j)) : Eigen::RowVector3d::Zero());
-            if (fj >= 0) rhs.row(fj) -= term - (fi < 0 ? Eigen::RowVector3d((kh2 + ch) * x.row(i)) : Eigen::RowVector3d::Zero());
+            if (fi >= 0)
+                rhs.row(fi) += term + (fj < 0 ? Eigen::RowVector3d((kh2 + ch) * x.row(j)) : Eigen::RowVector3d::Zero());
+            if (fj >= 0)
+                rhs.row(fj) -= term - (fi < 0 ? Eigen::RowVector3d((kh2 + ch) * x.row(i)) : Eigen::RowVector3d::Zero());
         }
         const Eigen::MatrixXd sol = lg_solver.solve(rhs);
         for (Index i = 0; i < n; ++i)
@@ -707,9 +735,9 @@ void Simulation::step()
         const std::string where = s.scene.substeps > 1 && sub < s.scene.substeps
                                       ? ", substep " + std::to_string(sub + 1) + "/" + std::to_string(s.scene.substeps)
                                       : std::string();
-        throw RunFailure("simulation blew up at step " + std::to_string(step_no) + where + " (t = " +
-                         num(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) + " s): " + what +
-                         "; likely cause: " + s.likely_cause(h));
+        throw RunFailure("simulation blew up at step " + std::to_string(step_no) + where +
+                         " (t = " + num(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) +
+                         " s): " + what + "; likely cause: " + s.likely_cause(h));
     };
     for (; sub < s.scene.substeps; ++sub) {
         try {
@@ -721,9 +749,15 @@ void Simulation::step()
         }
         const auto t0 = Clock::now();
         switch (s.scene.integrator) {
-        case Integrator::symplectic_euler: s.substep_symplectic(h); break;
-        case Integrator::implicit_euler: st.solver_iterations += s.substep_implicit(h); break;
-        case Integrator::local_global: s.substep_local_global(h); break;
+        case Integrator::symplectic_euler:
+            s.substep_symplectic(h);
+            break;
+        case Integrator::implicit_euler:
+            st.solver_iterations += s.substep_implicit(h);
+            break;
+        case Integrator::local_global:
+            s.substep_local_global(h);
+            break;
         }
         st.ms_integrate += ms_since(t0);
         const std::string bad = s.check_state(s.t + (sub + 1) * h);
@@ -748,15 +782,42 @@ void Simulation::step()
     s.t += s.scene.dt;
 }
 
-const Scene& Simulation::scene() const { return m_impl->scene; }
-std::int64_t Simulation::step_index() const { return m_impl->steps_done; }
-double Simulation::time() const { return m_impl->t; }
-const TetMesh& Simulation::mesh() const { return m_impl->mesh; }
-const Positions& Simulation::positions() const { return m_impl->mesh.positions; }
-const Positions& Simulation::velocities() const { return m_impl->v; }
-const Model& Simulation::model() const { return m_impl->model; }
-std::pair<Index, Index> Simulation::object_vertices(int k) const { return m_impl->obj_vertices.at(static_cast<size_t>(k)); }
-std::pair<Index, Index> Simulation::object_tets(int k) const { return m_impl->obj_tets.at(static_cast<size_t>(k)); }
+const Scene& Simulation::scene() const
+{
+    return m_impl->scene;
+}
+std::int64_t Simulation::step_index() const
+{
+    return m_impl->steps_done;
+}
+double Simulation::time() const
+{
+    return m_impl->t;
+}
+const TetMesh& Simulation::mesh() const
+{
+    return m_impl->mesh;
+}
+const Positions& Simulation::positions() const
+{
+    return m_impl->mesh.positions;
+}
+const Positions& Simulation::velocities() const
+{
+    return m_impl->v;
+}
+const Model& Simulation::model() const
+{
+    return m_impl->model;
+}
+std::pair<Index, Index> Simulation::object_vertices(int k) const
+{
+    return m_impl->obj_vertices.at(static_cast<size_t>(k));
+}
+std::pair<Index, Index> Simulation::object_tets(int k) const
+{
+    return m_impl->obj_tets.at(static_cast<size_t>(k));
+}
 
 Energy Simulation::energy() const
 {
@@ -774,7 +835,10 @@ Eigen::Vector3d Simulation::momentum() const
     return p;
 }
 
-const std::vector<Contact>& Simulation::contacts() const { return m_impl->contacts; }
+const std::vector<Contact>& Simulation::contacts() const
+{
+    return m_impl->contacts;
+}
 
 double Simulation::max_penetration() const
 {
@@ -788,7 +852,8 @@ double Simulation::mean_penetration() const
 {
     if (m_impl->contacts.empty()) return 0;
     double s = 0;
-    for (const Contact& c : m_impl->contacts) s += c.depth > 0 ? c.depth : 0.0;
+    for (const Contact& c : m_impl->contacts)
+        s += c.depth > 0 ? c.depth : 0.0;
     return s / static_cast<double>(m_impl->contacts.size());
 }
 
@@ -813,16 +878,26 @@ double Simulation::contact_stiffness(int a, int b) const
     return m_impl->pair_stiffness(a, b);
 }
 
-const StepStats& Simulation::last_stats() const { return m_impl->stats; }
-double Simulation::explicit_dt_limit() const { return m_impl->dt_limit; }
-const std::vector<std::string>& Simulation::warnings() const { return m_impl->warnings; }
+const StepStats& Simulation::last_stats() const
+{
+    return m_impl->stats;
+}
+double Simulation::explicit_dt_limit() const
+{
+    return m_impl->dt_limit;
+}
+const std::vector<std::string>& Simulation::warnings() const
+{
+    return m_impl->warnings;
+}
 
 io::Fields Simulation::output_fields() const
 {
     const SimulationImpl& s = *m_impl;
     const Index n = s.mesh.num_vertices();
     auto wanted = [&](const char* name) {
-        return std::find(s.scene.output.fields.begin(), s.scene.output.fields.end(), name) != s.scene.output.fields.end();
+        return std::find(s.scene.output.fields.begin(), s.scene.output.fields.end(), name) !=
+               s.scene.output.fields.end();
     };
     io::Fields f;
     if (wanted("velocity")) {
@@ -841,7 +916,8 @@ io::Fields Simulation::output_fields() const
     }
     if (wanted("object")) {
         io::Field fl{"object", 1, {}};
-        for (Index t : s.mesh.tet_object) fl.values.push_back(static_cast<double>(t));
+        for (Index t : s.mesh.tet_object)
+            fl.values.push_back(static_cast<double>(t));
         f.cell.push_back(std::move(fl));
     }
     return f;

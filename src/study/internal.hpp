@@ -14,24 +14,24 @@ namespace tethash::study {
 
 struct SceneData {
     std::string name;
-    std::string source;   ///< files or generator description
+    std::string source; ///< files or generator description
     TetMesh mesh;
     double mean_edge = 0;
-    std::optional<std::vector<Contact>> oracle;   ///< computed at the first point of the scene that needs it
+    std::optional<std::vector<Contact>> oracle; ///< computed at the first point of the scene that needs it
     bool oracle_failed = false;
 };
 
 struct DetectPoint {
     std::size_t scene = 0;
     double cell_factor = 1;
-    std::int64_t table_size = 0;   ///< 0 = auto
-    std::string table_kind;        ///< auto, given, pow2, prime
-    std::string table_request;     ///< the spec item it came from
+    std::int64_t table_size = 0; ///< 0 = auto
+    std::string table_kind;      ///< auto, given, pow2, prime
+    std::string table_request;   ///< the spec item it came from
     HashFunction hash = HashFunction::column;
     int threads = 1;
 };
 
-struct SimPlan;   // sim_study.cpp
+struct SimPlan; // sim_study.cpp
 struct SimPlanDeleter {
     void operator()(SimPlan* p) const;
 };
@@ -39,10 +39,10 @@ struct SimPlanDeleter {
 struct StudyPlan {
     StudyOptions options;
     std::vector<std::string> columns;
-    std::vector<PointInfo> points;          ///< every point of the study, all shards
+    std::vector<PointInfo> points; ///< every point of the study, all shards
     std::vector<SceneData> scenes;
-    std::vector<DetectPoint> detect_points; ///< same indices as points (detection sweeps)
-    std::unique_ptr<SimPlan, SimPlanDeleter> sim;   ///< integrator sweep
+    std::vector<DetectPoint> detect_points;       ///< same indices as points (detection sweeps)
+    std::unique_ptr<SimPlan, SimPlanDeleter> sim; ///< integrator sweep
     std::vector<std::string> notes;
 };
 

@@ -81,10 +81,8 @@ Choice choose_object(double target_tets, double target_vertices)
 const std::vector<ScenarioSpec>& teschner_specs()
 {
     static const std::vector<ScenarioSpec> specs = {
-        {"teschner1", 100, 1000, 1200, 6.0},
-        {"teschner2", 8, 4000, 1936, 15.0},
-        {"teschner3", 20, 10000, 4840, 34.0},
-        {"teschner4", 2, 20514, 5898, 72.0},
+        {"teschner1", 100, 1000, 1200, 6.0},     {"teschner2", 8, 4000, 1936, 15.0},
+        {"teschner3", 20, 10000, 4840, 34.0},    {"teschner4", 2, 20514, 5898, 72.0},
         {"teschner5", 100, 50000, 24200, 174.0},
     };
     return specs;
@@ -97,8 +95,8 @@ Scenario teschner_scenario(int index)
         throw Error("teschner scenario index " + std::to_string(index) + " out of range 0.." +
                     std::to_string(specs.size() - 1));
     const ScenarioSpec& spec = specs[static_cast<std::size_t>(index)];
-    Choice obj = choose_object(static_cast<double>(spec.tets) / spec.objects,
-                               static_cast<double>(spec.vertices) / spec.objects);
+    Choice obj =
+        choose_object(static_cast<double>(spec.tets) / spec.objects, static_cast<double>(spec.vertices) / spec.objects);
 
     // Object size: the diagonal-ish extent of its bounding box.
     const auto [lo, hi] = bounding_box(obj.mesh.positions);
@@ -108,7 +106,8 @@ Scenario teschner_scenario(int index)
     // Centres on a k × k × k lattice (filled in order), spacing 0.6 × size: every object overlaps its
     // lattice neighbours by about 40 % of its size; a small jitter breaks the symmetry.
     int k = 1;
-    while (k * k * k < spec.objects) ++k;
+    while (k * k * k < spec.objects)
+        ++k;
     const double spacing = 0.6 * size;
     SplitMix rng{0x7e5c4e42ULL + static_cast<std::uint64_t>(index)};
 
@@ -119,7 +118,8 @@ Scenario teschner_scenario(int index)
     for (int o = 0; o < spec.objects; ++o) {
         const int ix = o % k, iy = (o / k) % k, iz = o / (k * k);
         Eigen::Vector3d c(ix * spacing, iy * spacing, iz * spacing);
-        for (int a = 0; a < 3; ++a) c[a] += (rng.uniform() - 0.5) * 0.1 * size;
+        for (int a = 0; a < 3; ++a)
+            c[a] += (rng.uniform() - 0.5) * 0.1 * size;
         // Uniform random rotation (Shoemake's method).
         const double u1 = rng.uniform(), u2 = rng.uniform() * 2 * M_PI, u3 = rng.uniform() * 2 * M_PI;
         const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(u3), std::sqrt(1 - u1) * std::sin(u2),
@@ -145,7 +145,8 @@ Scenario teschner_scenario(int index)
 std::vector<Scenario> teschner_scenarios()
 {
     std::vector<Scenario> all;
-    for (int i = 0; i < static_cast<int>(teschner_specs().size()); ++i) all.push_back(teschner_scenario(i));
+    for (int i = 0; i < static_cast<int>(teschner_specs().size()); ++i)
+        all.push_back(teschner_scenario(i));
     return all;
 }
 

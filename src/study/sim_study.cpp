@@ -24,7 +24,7 @@ struct SimPlan {
     std::string scene_name;
     std::vector<SimPoint> points;
     double duration = 0;
-    std::vector<double> sample_times;   ///< where positions are compared (s)
+    std::vector<double> sample_times; ///< where positions are compared (s)
     double ref_dt = 0;
     // The reference run, computed at the first point that needs it.
     std::optional<std::vector<Positions>> ref_samples;
@@ -33,21 +33,49 @@ struct SimPlan {
     double ref_max_penetration = 0;
 };
 
-void SimPlanDeleter::operator()(SimPlan* p) const { delete p; }
+void SimPlanDeleter::operator()(SimPlan* p) const
+{
+    delete p;
+}
 
 namespace {
 
 const std::vector<std::string> k_sim_columns = {
-    "point", "repeat", "scene", "sweep", "integrator", "dt", "substeps", "steps", "duration", "vertices", "tets",
-    "status", "err_rms", "err_max", "max_penetration", "final_contacts", "energy_start", "energy_end",
-    "energy_drift", "energy_drift_rel", "ref_integrator", "ref_dt", "ref_energy_drift", "ref_max_penetration",
-    "ms_wall", "wall_s_per_sim_s", "ms_detect", "ms_response", "ms_integrate",
+    "point",
+    "repeat",
+    "scene",
+    "sweep",
+    "integrator",
+    "dt",
+    "substeps",
+    "steps",
+    "duration",
+    "vertices",
+    "tets",
+    "status",
+    "err_rms",
+    "err_max",
+    "max_penetration",
+    "final_contacts",
+    "energy_start",
+    "energy_end",
+    "energy_drift",
+    "energy_drift_rel",
+    "ref_integrator",
+    "ref_dt",
+    "ref_energy_drift",
+    "ref_max_penetration",
+    "ms_wall",
+    "wall_s_per_sim_s",
+    "ms_detect",
+    "ms_response",
+    "ms_integrate",
 };
 
 /// Result of one simulated run.
 struct RunOutcome {
     std::string status = "ok";
-    std::vector<Positions> samples;   ///< positions at plan.sample_times (fewer when it failed)
+    std::vector<Positions> samples; ///< positions at plan.sample_times (fewer when it failed)
     std::int64_t steps = 0;
     double wall_ms = 0, ms_detect = 0, ms_response = 0, ms_integrate = 0;
     double e0 = 0, e1 = 0, max_pen = 0;
@@ -86,7 +114,8 @@ RunOutcome simulate(const SimPlan& plan, const SimPoint& pt, const std::atomic<b
             out.ms_integrate += st.ms_integrate;
             const double t = s.time();
             while (next < plan.sample_times.size() && plan.sample_times[next] <= t + 1e-12 * plan.duration) {
-                const double w = t > t_prev ? std::clamp((plan.sample_times[next] - t_prev) / (t - t_prev), 0.0, 1.0) : 1.0;
+                const double w =
+                    t > t_prev ? std::clamp((plan.sample_times[next] - t_prev) / (t - t_prev), 0.0, 1.0) : 1.0;
                 out.samples.push_back(prev + w * (s.positions() - prev));
                 ++next;
             }
@@ -123,8 +152,8 @@ void plan_sim_study(StudyPlan& plan)
             const std::string it = spec.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
             if (it.empty()) throw Error("--integrator: empty value in '" + spec + "'");
             if (it == "all") {
-                integrators.insert(integrators.end(), {sim::Integrator::symplectic_euler, sim::Integrator::implicit_euler,
-                                                       sim::Integrator::local_global});
+                integrators.insert(integrators.end(), {sim::Integrator::symplectic_euler,
+                                                       sim::Integrator::implicit_euler, sim::Integrator::local_global});
             } else {
                 integrators.push_back(sim::parse_integrator(it));
             }
@@ -149,11 +178,12 @@ void plan_sim_study(StudyPlan& plan)
         sp->scene = sim::default_scene();
         sp->scene_name = "default";
     }
-    const auto dts = parse_real_list(o.dt.empty() ? std::vector<std::string>{"x0.25:x4:5"} : o.dt, "--dt",
-                                     sp->scene.dt, true);
+    const auto dts =
+        parse_real_list(o.dt.empty() ? std::vector<std::string>{"x0.25:x4:5"} : o.dt, "--dt", sp->scene.dt, true);
     sp->duration = o.duration > 0 ? o.duration : std::min(0.5, sp->scene.dt * sp->scene.steps);
     if (!(sp->duration > 0)) throw Error("--duration: the scene has no duration; give --duration SECONDS");
-    for (int k = 1; k <= o.samples; ++k) sp->sample_times.push_back(sp->duration * k / o.samples);
+    for (int k = 1; k <= o.samples; ++k)
+        sp->sample_times.push_back(sp->duration * k / o.samples);
     sp->ref_dt = *std::min_element(dts.begin(), dts.end()) / o.reference_factor;
 
     plan.columns = k_sim_columns;
@@ -163,7 +193,8 @@ void plan_sim_study(StudyPlan& plan)
                 PointInfo info;
                 info.index = static_cast<std::int64_t>(plan.points.size());
                 info.scene = sp->scene_name;
-                info.params = {{"integrator", sim::to_string(integ)}, {"dt", fmt_double(dt)}, {"substeps", std::to_string(sub)}};
+                info.params = {
+                    {"integrator", sim::to_string(integ)}, {"dt", fmt_double(dt)}, {"substeps", std::to_string(sub)}};
                 plan.points.push_back(std::move(info));
                 sp->points.push_back({integ, dt, sub});
             }
@@ -185,12 +216,13 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
             if (!(sp.ref_dt < 0.5 * probe.explicit_dt_limit())) ref.integrator = sim::Integrator::implicit_euler;
         }
         if (hooks.on_note)
-            hooks.on_note("reference run: " + std::string(sim::to_string(ref.integrator)) + " dt " + fmt_double(sp.ref_dt) +
-                          " s for " + fmt_double(sp.duration) + " s");
+            hooks.on_note("reference run: " + std::string(sim::to_string(ref.integrator)) + " dt " +
+                          fmt_double(sp.ref_dt) + " s for " + fmt_double(sp.duration) + " s");
         RunOutcome r = simulate(sp, ref, hooks.stop);
         if (r.status == "interrupted") return {};
-        if (r.status != "ok") throw RunFailure("reference run (" + std::string(sim::to_string(ref.integrator)) + ", dt " +
-                                               fmt_double(sp.ref_dt) + "): " + r.status);
+        if (r.status != "ok")
+            throw RunFailure("reference run (" + std::string(sim::to_string(ref.integrator)) + ", dt " +
+                             fmt_double(sp.ref_dt) + "): " + r.status);
         sp.ref_samples = std::move(r.samples);
         sp.ref_integrator = sim::to_string(ref.integrator);
         sp.ref_energy_drift = r.e1 - r.e0;
@@ -222,14 +254,35 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
             err_max = fmt_double(std::sqrt(mx));
         }
         const double drift = out.e1 - out.e0;
-        rows.push_back({std::to_string(index), std::to_string(r), sp.scene_name, "integrator", sim::to_string(pt.integrator),
-                        fmt_double(pt.dt), std::to_string(pt.substeps), std::to_string(out.steps), fmt_double(sp.duration),
-                        std::to_string(out.vertices), std::to_string(out.tets), out.status, err_rms, err_max, fmt_double(out.max_pen), std::to_string(out.contacts),
-                        fmt_double(out.e0), fmt_double(out.e1), fmt_double(drift),
-                        out.e0 != 0 ? fmt_double(drift / std::abs(out.e0)) : "", sp.ref_integrator, fmt_double(sp.ref_dt),
-                        fmt_double(sp.ref_energy_drift), fmt_double(sp.ref_max_penetration), fmt_double(out.wall_ms),
-                        fmt_double(out.wall_ms / 1000.0 / sp.duration), fmt_double(out.ms_detect),
-                        fmt_double(out.ms_response), fmt_double(out.ms_integrate)});
+        rows.push_back({std::to_string(index),
+                        std::to_string(r),
+                        sp.scene_name,
+                        "integrator",
+                        sim::to_string(pt.integrator),
+                        fmt_double(pt.dt),
+                        std::to_string(pt.substeps),
+                        std::to_string(out.steps),
+                        fmt_double(sp.duration),
+                        std::to_string(out.vertices),
+                        std::to_string(out.tets),
+                        out.status,
+                        err_rms,
+                        err_max,
+                        fmt_double(out.max_pen),
+                        std::to_string(out.contacts),
+                        fmt_double(out.e0),
+                        fmt_double(out.e1),
+                        fmt_double(drift),
+                        out.e0 != 0 ? fmt_double(drift / std::abs(out.e0)) : "",
+                        sp.ref_integrator,
+                        fmt_double(sp.ref_dt),
+                        fmt_double(sp.ref_energy_drift),
+                        fmt_double(sp.ref_max_penetration),
+                        fmt_double(out.wall_ms),
+                        fmt_double(out.wall_ms / 1000.0 / sp.duration),
+                        fmt_double(out.ms_detect),
+                        fmt_double(out.ms_response),
+                        fmt_double(out.ms_integrate)});
     }
     return rows;
 }

@@ -37,23 +37,35 @@ namespace fs = std::filesystem;
 
 std::int64_t now_ns()
 {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
         .count();
 }
 
-double elapsed_ms(std::int64_t start_ns) { return static_cast<double>(now_ns() - start_ns) * 1e-6; }
+double elapsed_ms(std::int64_t start_ns)
+{
+    return static_cast<double>(now_ns() - start_ns) * 1e-6;
+}
 
 std::string json_escape(const std::string& s)
 {
     std::string o = "\"";
     for (unsigned char c : s) {
         switch (c) {
-        case '"': o += "\\\""; break;
-        case '\\': o += "\\\\"; break;
-        case '\n': o += "\\n"; break;
-        case '\r': o += "\\r"; break;
-        case '\t': o += "\\t"; break;
+        case '"':
+            o += "\\\"";
+            break;
+        case '\\':
+            o += "\\\\";
+            break;
+        case '\n':
+            o += "\\n";
+            break;
+        case '\r':
+            o += "\\r";
+            break;
+        case '\t':
+            o += "\\t";
+            break;
         default:
             if (c < 0x20) {
                 char buf[8];
@@ -172,14 +184,16 @@ bool is_prime(std::int64_t n)
 std::int64_t next_prime(std::int64_t n)
 {
     if (n <= 2) return 2;
-    while (!is_prime(n)) ++n;
+    while (!is_prime(n))
+        ++n;
     return n;
 }
 
 std::int64_t next_pow2(std::int64_t n)
 {
     std::int64_t p = 1;
-    while (p < n) p <<= 1;
+    while (p < n)
+        p <<= 1;
     return p;
 }
 
@@ -192,7 +206,8 @@ std::vector<double> parse_real_list(const std::vector<std::string>& specs, const
     for (const auto& it : items_of(specs, option)) {
         if (it.find(':') != std::string::npos) {
             if (!log_ranges) throw Error(option + ": ranges are not allowed here, found '" + it + "'");
-            for (double v : log_range(it, option, scale_for_x)) out.push_back(v);
+            for (double v : log_range(it, option, scale_for_x))
+                out.push_back(v);
         } else {
             const double v = parse_scaled(it, option, scale_for_x);
             if (!(v > 0)) throw Error(option + ": value " + it + " must be > 0");
@@ -215,7 +230,8 @@ std::vector<int> parse_int_list(const std::vector<std::string>& specs, const std
             const long long a = parse_integer(trim(parts[0]), option), b = parse_integer(trim(parts[1]), option);
             if (a < 1 || b < a || b > 1000000)
                 throw Error(option + ": empty range '" + it + "' (need 1 <= FROM <= TO)");
-            for (long long v = a; v <= b; ++v) out.push_back(static_cast<int>(v));
+            for (long long v = a; v <= b; ++v)
+                out.push_back(static_cast<int>(v));
         } else {
             throw Error(option + ": expected N or FROM:TO, found '" + it + "'");
         }
@@ -238,12 +254,18 @@ Sweep parse_sweep(const std::string& name)
 const char* to_string(Sweep s)
 {
     switch (s) {
-    case Sweep::cell_size: return "cell-size";
-    case Sweep::table_size: return "table-size";
-    case Sweep::hash: return "hash";
-    case Sweep::threads: return "threads";
-    case Sweep::grid: return "grid";
-    case Sweep::integrator: return "integrator";
+    case Sweep::cell_size:
+        return "cell-size";
+    case Sweep::table_size:
+        return "table-size";
+    case Sweep::hash:
+        return "hash";
+    case Sweep::threads:
+        return "threads";
+    case Sweep::grid:
+        return "grid";
+    case Sweep::integrator:
+        return "integrator";
     }
     return "?";
 }
@@ -268,7 +290,8 @@ void parse_shard(const std::string& spec, int& index, int& count)
 std::string PointInfo::label() const
 {
     std::string s = scene;
-    for (const auto& [k, v] : params) s += " " + k + "=" + v;
+    for (const auto& [k, v] : params)
+        s += " " + k + "=" + v;
     return s;
 }
 
@@ -277,14 +300,20 @@ std::string PointInfo::label() const
 namespace {
 
 const std::vector<std::string> k_detect_columns = {
-    "point", "repeat", "scene", "sweep", "objects",
-    "cell_factor", "table_request", "table_kind", "hash", "threads_request",
-    "cell_size", "table_size", "threads", "vertices", "tets",
-    "cells_visited", "entries_scanned", "hash_collisions", "collision_rate", "box_rejections", "own_vertex_skips",
-    "inside_tests", "exact_fallbacks", "degenerate_tets", "contacts", "table_load", "memory_bytes",
-    "oracle_contacts", "missed", "extra",
-    "pen_pairs", "depth_err_rms", "depth_err_max", "depth_exact_max",
-    "ms_total", "ms_vertices", "ms_tets", "ms_inside", "ms_sort", "ms_wall", "ms_penetration",
+    "point",           "repeat",          "scene",
+    "sweep",           "objects",         "cell_factor",
+    "table_request",   "table_kind",      "hash",
+    "threads_request", "cell_size",       "table_size",
+    "threads",         "vertices",        "tets",
+    "cells_visited",   "entries_scanned", "hash_collisions",
+    "collision_rate",  "box_rejections",  "own_vertex_skips",
+    "inside_tests",    "exact_fallbacks", "degenerate_tets",
+    "contacts",        "table_load",      "memory_bytes",
+    "oracle_contacts", "missed",          "extra",
+    "pen_pairs",       "depth_err_rms",   "depth_err_max",
+    "depth_exact_max", "ms_total",        "ms_vertices",
+    "ms_tets",         "ms_inside",       "ms_sort",
+    "ms_wall",         "ms_penetration",
 };
 
 std::vector<SceneData> load_scenes(const StudyOptions& o)
@@ -374,7 +403,8 @@ std::vector<TableChoice> table_choices(const std::vector<std::string>& specs, st
     std::vector<TableChoice> unique;
     for (const auto& c : out) {
         bool dup = false;
-        for (const auto& u : unique) dup = dup || (u.size == c.size && u.kind == c.kind);
+        for (const auto& u : unique)
+            dup = dup || (u.size == c.size && u.kind == c.kind);
         if (!dup) unique.push_back(c);
     }
     return unique;
@@ -429,10 +459,11 @@ void plan_detection(StudyPlan& plan)
     const auto cells = parse_real_list(cell_specs, "--cell-size", -1, true);
     const auto hashes = hash_choices(hash_specs);
     const auto threads = parse_int_list(thread_specs, "--threads");
-    (void)table_choices(table_specs, 1000);   // syntax and value checks
+    (void)table_choices(table_specs, 1000); // syntax and value checks
 
     plan.scenes = load_scenes(o);
-    if (plan.scenes.empty()) throw Error("no scene: give --mesh FILE, --teschner-scenarios (or --scene FILE for the integrator sweep)");
+    if (plan.scenes.empty())
+        throw Error("no scene: give --mesh FILE, --teschner-scenarios (or --scene FILE for the integrator sweep)");
 
     plan.columns = k_detect_columns;
     for (std::size_t s = 0; s < plan.scenes.size(); ++s) {
@@ -459,7 +490,8 @@ void plan_detection(StudyPlan& plan)
 // ---------------------------------------------------------------- measuring detection points
 
 /// (vertex, tet) pairs of `got` missing from / extra to `want` (both sorted by vertex, then tet).
-std::pair<std::int64_t, std::int64_t> compare_contacts(const std::vector<Contact>& got, const std::vector<Contact>& want)
+std::pair<std::int64_t, std::int64_t> compare_contacts(const std::vector<Contact>& got,
+                                                       const std::vector<Contact>& want)
 {
     auto key = [](const Contact& c) { return std::pair<Index, Index>(c.vertex, c.tet); };
     std::int64_t missed = 0, extra = 0;
@@ -518,7 +550,8 @@ std::vector<Row> run_detect_point(StudyPlan& plan, std::int64_t index, const Run
     dp.threads = p.threads;
     Detector det(dp);
     det.set_topology(mesh);
-    for (int w = 0; w < o.warmup; ++w) det.detect(mesh.positions);
+    for (int w = 0; w < o.warmup; ++w)
+        det.detect(mesh.positions);
 
     // Penetration depth error (Heidelberger et al. 2004 against the exact distance), once per point.
     PenetrationResult pen;
@@ -567,18 +600,47 @@ std::vector<Row> run_detect_point(StudyPlan& plan, std::int64_t index, const Run
         }
         const double rate = st.entries_scanned ? static_cast<double>(st.hash_collisions) / st.entries_scanned : 0.0;
         auto i64 = [](std::int64_t v) { return std::to_string(v); };
-        Row row = {std::to_string(index), std::to_string(r), scene.name, to_string(o.sweep),
+        Row row = {std::to_string(index),
+                   std::to_string(r),
+                   scene.name,
+                   to_string(o.sweep),
                    std::to_string(mesh.num_objects()),
-                   fmt_double(p.cell_factor), p.table_request, p.table_kind, to_string(p.hash), std::to_string(p.threads),
-                   fmt_double(st.cell_size), i64(st.table_size), std::to_string(st.threads), i64(st.vertices), i64(st.tets),
-                   i64(st.cells_visited), i64(st.entries_scanned), i64(st.hash_collisions), fmt_double(rate),
-                   i64(st.box_rejections), i64(st.own_vertex_skips), i64(st.inside_tests), i64(st.exact_fallbacks),
-                   i64(st.degenerate_tets), i64(st.contacts), fmt_double(st.table_load), i64(st.memory_bytes),
-                   oc, missed, extra,
-                   pen.available ? i64(pen.pairs) : "", pen.available ? fmt_double(pen.err_rms) : "",
-                   pen.available ? fmt_double(pen.err_max) : "", pen.available ? fmt_double(pen.exact_max) : "",
-                   fmt_double(st.ms_total), fmt_double(st.ms_vertices), fmt_double(st.ms_tets), fmt_double(st.ms_inside),
-                   fmt_double(st.ms_sort), fmt_double(wall), pen.available ? fmt_double(pen.ms) : ""};
+                   fmt_double(p.cell_factor),
+                   p.table_request,
+                   p.table_kind,
+                   to_string(p.hash),
+                   std::to_string(p.threads),
+                   fmt_double(st.cell_size),
+                   i64(st.table_size),
+                   std::to_string(st.threads),
+                   i64(st.vertices),
+                   i64(st.tets),
+                   i64(st.cells_visited),
+                   i64(st.entries_scanned),
+                   i64(st.hash_collisions),
+                   fmt_double(rate),
+                   i64(st.box_rejections),
+                   i64(st.own_vertex_skips),
+                   i64(st.inside_tests),
+                   i64(st.exact_fallbacks),
+                   i64(st.degenerate_tets),
+                   i64(st.contacts),
+                   fmt_double(st.table_load),
+                   i64(st.memory_bytes),
+                   oc,
+                   missed,
+                   extra,
+                   pen.available ? i64(pen.pairs) : "",
+                   pen.available ? fmt_double(pen.err_rms) : "",
+                   pen.available ? fmt_double(pen.err_max) : "",
+                   pen.available ? fmt_double(pen.exact_max) : "",
+                   fmt_double(st.ms_total),
+                   fmt_double(st.ms_vertices),
+                   fmt_double(st.ms_tets),
+                   fmt_double(st.ms_inside),
+                   fmt_double(st.ms_sort),
+                   fmt_double(wall),
+                   pen.available ? fmt_double(pen.ms) : ""};
         rows.push_back(std::move(row));
     }
     return rows;
@@ -626,10 +688,10 @@ namespace {
 void check_out_dir(const std::string& dir)
 {
     fs::path p(dir);
-    while (!p.empty() && !fs::exists(p) && p.has_parent_path() && p.parent_path() != p) p = p.parent_path();
+    while (!p.empty() && !fs::exists(p) && p.has_parent_path() && p.parent_path() != p)
+        p = p.parent_path();
     if (p.empty() || !fs::exists(p)) p = ".";
-    if (!fs::is_directory(p))
-        throw Error("--out: " + dir + ": '" + p.string() + "' exists and is not a folder");
+    if (!fs::is_directory(p)) throw Error("--out: " + dir + ": '" + p.string() + "' exists and is not a folder");
     io::check_output_file((p / "study.csv").string(), "--out " + dir);
 }
 
@@ -657,7 +719,8 @@ std::shared_ptr<StudyPlan> plan_study(const StudyOptions& options)
     check_out_dir(o.out_dir);
     if (o.sweep == Sweep::integrator) {
         if (!o.meshes.empty() || o.teschner || !o.scenarios.empty())
-            throw Error("integrator sweep: takes --scene FILE (or the default scene), not --mesh / --teschner-scenarios");
+            throw Error(
+                "integrator sweep: takes --scene FILE (or the default scene), not --mesh / --teschner-scenarios");
         plan_sim_study(*plan);
     } else {
         if (!o.scene_file.empty())
@@ -667,7 +730,10 @@ std::shared_ptr<StudyPlan> plan_study(const StudyOptions& options)
     return plan;
 }
 
-std::int64_t points_total(const StudyPlan& plan) { return static_cast<std::int64_t>(plan.points.size()); }
+std::int64_t points_total(const StudyPlan& plan)
+{
+    return static_cast<std::int64_t>(plan.points.size());
+}
 
 std::int64_t points_in_shard(const StudyPlan& plan)
 {
@@ -675,7 +741,10 @@ std::int64_t points_in_shard(const StudyPlan& plan)
     return n > i ? (n - i + k - 1) / k : 0;
 }
 
-const std::vector<std::string>& columns(const StudyPlan& plan) { return plan.columns; }
+const std::vector<std::string>& columns(const StudyPlan& plan)
+{
+    return plan.columns;
+}
 
 // ---------------------------------------------------------------- machine, summary, JSON
 
@@ -717,7 +786,8 @@ std::string summary_json(const Table& t)
     const int ip = t.index_of("point");
     if (ip < 0) throw Error("study table: no 'point' column");
     std::map<long long, std::vector<const Row*>> groups;
-    for (const Row& r : t.rows) groups[std::atoll(r[static_cast<std::size_t>(ip)].c_str())].push_back(&r);
+    for (const Row& r : t.rows)
+        groups[std::atoll(r[static_cast<std::size_t>(ip)].c_str())].push_back(&r);
     std::ostringstream j;
     j << "[";
     bool first_point = true;
@@ -741,8 +811,8 @@ std::string summary_json(const Table& t)
             std::sort(v.begin(), v.end());
             const std::size_t n = v.size();
             const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-            j << ", " << json_escape(name) << ": {\"median\": " << fmt_double(median) << ", \"min\": " << fmt_double(v.front())
-              << ", \"max\": " << fmt_double(v.back()) << "}";
+            j << ", " << json_escape(name) << ": {\"median\": " << fmt_double(median)
+              << ", \"min\": " << fmt_double(v.front()) << ", \"max\": " << fmt_double(v.back()) << "}";
         }
         j << "}";
     }
@@ -776,8 +846,8 @@ StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)
             break;
         }
         if (hooks.on_point) hooks.on_point(k, res.points_planned, plan.points[static_cast<std::size_t>(i)]);
-        std::vector<Row> rows = o.sweep == Sweep::integrator ? run_sim_point(plan, i, hooks)
-                                                             : run_detect_point(plan, i, hooks);
+        std::vector<Row> rows =
+            o.sweep == Sweep::integrator ? run_sim_point(plan, i, hooks) : run_detect_point(plan, i, hooks);
         for (Row& r : rows) {
             csv.write(r);
             table.rows.push_back(std::move(r));
@@ -795,13 +865,11 @@ StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)
 
     std::ostringstream j;
     j << "{\n  \"tethash_study\": 1,\n  \"sweep\": " << json_escape(to_string(o.sweep))
-      << ",\n  \"command\": " << json_escape(o.command_line)
-      << ",\n  \"machine\": " << machine_json(o.compiler_flags)
+      << ",\n  \"command\": " << json_escape(o.command_line) << ",\n  \"machine\": " << machine_json(o.compiler_flags)
       << ",\n  \"points_total\": " << points_total(plan) << ",\n  \"shard\": {\"index\": " << o.shard_index
       << ", \"count\": " << o.shard_count << "},\n  \"points_planned\": " << res.points_planned
-      << ",\n  \"points_done\": " << res.points_done << ",\n  \"rows\": " << res.rows
-      << ",\n  \"repeat\": " << o.repeat << ",\n  \"warmup\": " << o.warmup
-      << ",\n  \"interrupted\": " << (res.interrupted ? "true" : "false")
+      << ",\n  \"points_done\": " << res.points_done << ",\n  \"rows\": " << res.rows << ",\n  \"repeat\": " << o.repeat
+      << ",\n  \"warmup\": " << o.warmup << ",\n  \"interrupted\": " << (res.interrupted ? "true" : "false")
       << ",\n  \"seconds\": " << fmt_double(elapsed_ms(t_start) / 1000.0) << ",\n  \"scenes\": [";
     for (std::size_t s = 0; s < plan.scenes.size(); ++s) {
         const auto& sc = plan.scenes[s];
@@ -810,7 +878,8 @@ StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)
           << ", \"tets\": " << sc.mesh.num_tets() << ", \"mean_edge\": " << fmt_double(sc.mean_edge) << "}";
     }
     j << "],\n  \"notes\": [";
-    for (std::size_t n = 0; n < plan.notes.size(); ++n) j << (n ? ", " : "") << json_escape(plan.notes[n]);
+    for (std::size_t n = 0; n < plan.notes.size(); ++n)
+        j << (n ? ", " : "") << json_escape(plan.notes[n]);
     j << "],\n  \"summary\": " << summary_json(table) << "\n}\n";
     write_json(res.json_path, j.str());
     res.notes = plan.notes;
@@ -824,7 +893,8 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
 {
     if (dirs.empty()) throw Error("study merge: no input folders");
     for (const auto& d : dirs)
-        if (!fs::exists(fs::path(d) / "study.csv")) throw Error("study merge: " + (fs::path(d) / "study.csv").string() + ": file not found");
+        if (!fs::exists(fs::path(d) / "study.csv"))
+            throw Error("study merge: " + (fs::path(d) / "study.csv").string() + ": file not found");
     Table merged;
     std::vector<std::string> jsons;
     long long total = -1;
@@ -835,15 +905,18 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
         if (merged.columns.empty()) {
             merged.columns = t.columns;
         } else if (t.columns != merged.columns) {
-            throw Error("study merge: " + csv + ": columns differ from " + (fs::path(dirs.front()) / "study.csv").string());
+            throw Error("study merge: " + csv + ": columns differ from " +
+                        (fs::path(dirs.front()) / "study.csv").string());
         }
-        for (auto& r : t.rows) merged.rows.push_back(std::move(r));
+        for (auto& r : t.rows)
+            merged.rows.push_back(std::move(r));
         const auto json_path = fs::path(d) / "study.json";
         if (fs::exists(json_path)) {
             const std::string text = read_file_text(json_path.string());
             jsons.push_back(text);
             std::smatch m;
-            if (std::regex_search(text, m, std::regex("\"points_total\": ([0-9]+)"))) total = std::max(total, std::stoll(m[1]));
+            if (std::regex_search(text, m, std::regex("\"points_total\": ([0-9]+)")))
+                total = std::max(total, std::stoll(m[1]));
             if (std::regex_search(text, m, std::regex("\"sweep\": (\"[^\"]*\")"))) sweep = m[1];
         }
     }
@@ -853,7 +926,8 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
         return std::pair<long long, long long>(std::atoll(r[static_cast<std::size_t>(ip)].c_str()),
                                                std::atoll(r[static_cast<std::size_t>(ir)].c_str()));
     };
-    std::stable_sort(merged.rows.begin(), merged.rows.end(), [&](const Row& a, const Row& b) { return key(a) < key(b); });
+    std::stable_sort(merged.rows.begin(), merged.rows.end(),
+                     [&](const Row& a, const Row& b) { return key(a) < key(b); });
     for (std::size_t i = 1; i < merged.rows.size(); ++i)
         if (key(merged.rows[i]) == key(merged.rows[i - 1]))
             throw Error("study merge: point " + std::to_string(key(merged.rows[i]).first) + " repeat " +
@@ -874,11 +948,14 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
     std::ostringstream j;
     j << "{\n  \"tethash_study\": 1,\n  \"sweep\": " << sweep << ",\n  \"command\": " << json_escape(command_line)
       << ",\n  \"merged_from\": [";
-    for (std::size_t i = 0; i < dirs.size(); ++i) j << (i ? ", " : "") << json_escape(dirs[i]);
+    for (std::size_t i = 0; i < dirs.size(); ++i)
+        j << (i ? ", " : "") << json_escape(dirs[i]);
     j << "],\n  \"points_total\": " << total << ",\n  \"rows\": " << merged.rows.size() << ",\n  \"missing_points\": [";
-    for (std::size_t i = 0; i < missing.size(); ++i) j << (i ? ", " : "") << missing[i];
+    for (std::size_t i = 0; i < missing.size(); ++i)
+        j << (i ? ", " : "") << missing[i];
     j << "],\n  \"shards\": [";
-    for (std::size_t i = 0; i < jsons.size(); ++i) j << (i ? ",\n" : "\n") << jsons[i];
+    for (std::size_t i = 0; i < jsons.size(); ++i)
+        j << (i ? ",\n" : "\n") << jsons[i];
     j << "],\n  \"summary\": " << summary_json(merged) << "\n}\n";
     write_json((fs::path(out_dir) / "study.json").string(), j.str());
     return missing;

@@ -102,7 +102,8 @@ Table Table::read_csv(const std::string& path)
 void Table::write_csv(const std::string& path) const
 {
     std::string text = csv_line(columns) + "\n";
-    for (const Row& r : rows) text += csv_line(r) + "\n";
+    for (const Row& r : rows)
+        text += csv_line(r) + "\n";
     io::write_text_file(path, text);
 }
 
@@ -139,7 +140,10 @@ std::string fmt_double(double v)
     return buf;
 }
 
-CsvWriter::~CsvWriter() { abandon(); }
+CsvWriter::~CsvWriter()
+{
+    abandon();
+}
 
 void CsvWriter::open(const std::string& path, const std::vector<std::string>& columns)
 {

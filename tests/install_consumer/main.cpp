@@ -7,8 +7,7 @@
 int main()
 {
     // Two unit tets; vertex 7 (of the second) lies inside the first.
-    std::vector<double> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1,
-                               5, 5, 5, 6, 5, 5, 5, 6, 5, 0.1, 0.1, 0.1};
+    std::vector<double> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 5, 5, 5, 6, 5, 5, 5, 6, 5, 0.1, 0.1, 0.1};
     std::vector<tethash::Index> tets = {0, 1, 2, 3, 4, 5, 6, 7};
     const Eigen::Map<const tethash::Positions> positions(xyz.data(), 8, 3);
     const Eigen::Map<const tethash::Tets> topology(tets.data(), 2, 4);

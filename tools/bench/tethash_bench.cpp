@@ -75,9 +75,11 @@ TetMesh lattice_scene(int objects, std::uint32_t seed)
     obj.rest_positions.resize(0, 3);
     const Eigen::RowVector3d lo = obj.positions.colwise().minCoeff(), hi = obj.positions.colwise().maxCoeff();
     const double size = (hi - lo).maxCoeff();
-    for (Eigen::Index v = 0; v < obj.positions.rows(); ++v) obj.positions.row(v) -= 0.5 * (lo + hi);
+    for (Eigen::Index v = 0; v < obj.positions.rows(); ++v)
+        obj.positions.row(v) -= 0.5 * (lo + hi);
     int k = 1;
-    while (k * k * k < objects) ++k;
+    while (k * k * k < objects)
+        ++k;
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     Positions p(static_cast<Eigen::Index>(objects) * obj.positions.rows(), 3);
@@ -85,7 +87,8 @@ TetMesh lattice_scene(int objects, std::uint32_t seed)
     TetMesh scene;
     for (int o = 0; o < objects; ++o) {
         const Eigen::Matrix3d rot =
-            Eigen::AngleAxisd(3.14159 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+            Eigen::AngleAxisd(3.14159 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized())
+                .toRotationMatrix();
         const Eigen::RowVector3d c(0.6 * size * (o % k), 0.6 * size * ((o / k) % k), 0.6 * size * (o / (k * k)));
         const Eigen::Index vb = o * obj.positions.rows(), tb = o * obj.tets.rows();
         for (Eigen::Index v = 0; v < obj.positions.rows(); ++v)
@@ -106,7 +109,7 @@ TetMesh lattice_scene(int objects, std::uint32_t seed)
 /// vertices, and computes barycentric coordinates in double (no exactness). Pairs found through several
 /// cells sharing a bucket are filtered by comparing the vertex's cell with the visited cell.
 class Baseline {
-public:
+  public:
     void run(const TetMesh& m, double l, std::vector<std::pair<Index, Index>>& out)
     {
         const Index n = m.num_vertices();
@@ -122,7 +125,8 @@ public:
             const std::int32_t c[3] = {static_cast<std::int32_t>(std::floor(m.positions(v, 0) * inv)),
                                        static_cast<std::int32_t>(std::floor(m.positions(v, 1) * inv)),
                                        static_cast<std::int32_t>(std::floor(m.positions(v, 2) * inv))};
-            for (int k = 0; k < 3; ++k) m_cell[3 * v + k] = c[k];
+            for (int k = 0; k < 3; ++k)
+                m_cell[3 * v + k] = c[k];
             const std::size_t b = teschner_hash(c[0], c[1], c[2]) % m_table;
             if (m_stamp[b] != m_step) {
                 m_stamp[b] = m_step;
@@ -134,7 +138,8 @@ public:
         for (Index t = 0; t < m.num_tets(); ++t) {
             const Index id[4] = {m.tets(t, 0), m.tets(t, 1), m.tets(t, 2), m.tets(t, 3)};
             Eigen::Vector3d p[4];
-            for (int k = 0; k < 4; ++k) p[k] = m.positions.row(id[k]).transpose();
+            for (int k = 0; k < 4; ++k)
+                p[k] = m.positions.row(id[k]).transpose();
             const Eigen::Vector3d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]).cwiseMin(p[3]);
             const Eigen::Vector3d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]).cwiseMax(p[3]);
             const Eigen::Vector3d e1 = p[1] - p[0], e2 = p[2] - p[0], e3 = p[3] - p[0];
@@ -164,7 +169,7 @@ public:
         }
     }
 
-private:
+  private:
     std::size_t m_table = 0;
     std::vector<std::vector<Index>> m_buckets;
     std::vector<std::uint32_t> m_stamp;
@@ -176,8 +181,8 @@ private:
 
 struct Measured {
     double ms = 0;
-    double cpu_ms = 0;   ///< CPU time of the calling thread (meaningful at 1 thread)
-    double process_cpu_ms = 0;   ///< CPU time of all threads (includes OpenMP spin-waiting)
+    double cpu_ms = 0;         ///< CPU time of the calling thread (meaningful at 1 thread)
+    double process_cpu_ms = 0; ///< CPU time of all threads (includes OpenMP spin-waiting)
     DetectStats stats;
 };
 
@@ -186,7 +191,7 @@ Measured measure(const TetMesh& m, DetectParams p, int repeat)
     Detector det(p);
     det.set_topology(m);
     DetectStats st;
-    det.detect(m.positions);   // warm-up (auto cell size, buffers)
+    det.detect(m.positions); // warm-up (auto cell size, buffers)
     std::vector<double> ms, cpu, pcpu, s1, s2, s3, s4;
     for (int r = 0; r < repeat; ++r) {
         const double c0 = thread_cpu_ms(), p0 = process_cpu_ms();
@@ -234,19 +239,21 @@ double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& con
 __attribute__((noinline)) std::size_t profile_detects(Detector& det, const TetMesh& m, int calls)
 {
     std::size_t n = 0;
-    for (int r = 0; r < calls; ++r) n += det.detect(m.positions).size();
+    for (int r = 0; r < calls; ++r)
+        n += det.detect(m.positions).size();
     return n;
 }
 
-double g_table_factor = 0;   ///< --table-factor F (0: automatic table size)
+double g_table_factor = 0; ///< --table-factor F (0: automatic table size)
 
 void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline)
 {
     DetectParams p1 = base;
-    if (g_table_factor > 0) {   // --table-factor: the power of two nearest to F × vertices
+    if (g_table_factor > 0) { // --table-factor: the power of two nearest to F × vertices
         const double want = g_table_factor * m.num_vertices();
         std::int64_t n = 1;
-        while (static_cast<double>(n) * 1.41421356 < want) n <<= 1;
+        while (static_cast<double>(n) * 1.41421356 < want)
+            n <<= 1;
         p1.table_size = n;
     }
     p1.threads = 1;
@@ -293,14 +300,15 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
 /// random perturbation of both per step (a quarter of that); the translations reverse every 40 steps, so objects
 /// move apart and together again.
 class MovingScene {
-public:
+  public:
     MovingScene(const TetMesh& m, double mean_edge, double speed, std::uint32_t seed)
         : m_mesh(m), m_positions(m.positions), m_rng(seed), m_step_length(speed * mean_edge)
     {
         const int objects = m.num_objects();
         m_members.assign(static_cast<std::size_t>(objects), {});
         for (Eigen::Index v = 0; v < m.positions.rows(); ++v)
-            m_members[static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)])].push_back(static_cast<Index>(v));
+            m_members[static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)])].push_back(
+                static_cast<Index>(v));
         std::normal_distribution<double> g;
         for (int o = 0; o < objects; ++o) {
             Eigen::Vector3d dir(g(m_rng), g(m_rng), g(m_rng)), axis(g(m_rng), g(m_rng), g(m_rng));
@@ -308,8 +316,9 @@ public:
             m_axis.push_back(axis.normalized());
             double radius = 1e-12;
             const Eigen::RowVector3d c = centroid(o);
-            for (Index v : m_members[static_cast<std::size_t>(o)]) radius = std::max(radius, (m_positions.row(v) - c).norm());
-            m_omega.push_back(0.5 * m_step_length / radius);   // rim speed: half a step length
+            for (Index v : m_members[static_cast<std::size_t>(o)])
+                radius = std::max(radius, (m_positions.row(v) - c).norm());
+            m_omega.push_back(0.5 * m_step_length / radius); // rim speed: half a step length
         }
     }
     const Positions& positions() const { return m_positions; }
@@ -324,8 +333,9 @@ public:
             const Eigen::Matrix3d R = (Eigen::AngleAxisd(m_omega[o], m_axis[o]) *
                                        Eigen::AngleAxisd(0.25 * m_omega[o] * g(m_rng), jitter_axis))
                                           .toRotationMatrix();
-            const Eigen::Vector3d shift = sign * m_velocity[o] +
-                                          0.25 * 0.5 * m_step_length * Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
+            const Eigen::Vector3d shift =
+                sign * m_velocity[o] +
+                0.25 * 0.5 * m_step_length * Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
             for (Index v : m_members[o]) {
                 const Eigen::Vector3d p = (m_positions.row(v) - c).transpose();
                 m_positions.row(v) = (R * p + c.transpose() + shift).transpose();
@@ -333,11 +343,12 @@ public:
         }
     }
 
-private:
+  private:
     Eigen::RowVector3d centroid(int o) const
     {
         Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
-        for (Index v : m_members[static_cast<std::size_t>(o)]) c += m_positions.row(v);
+        for (Index v : m_members[static_cast<std::size_t>(o)])
+            c += m_positions.row(v);
         return c / std::max<double>(1.0, static_cast<double>(m_members[static_cast<std::size_t>(o)].size()));
     }
     const TetMesh& m_mesh;
@@ -357,9 +368,10 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
 {
     const TetMesh& m = sc.mesh;
     const double edge = mean_edge_length(m.positions, m.tets);
-    std::printf("moving scene: scenario %s r%d, %d objects, %d tets, %d vertices, %d steps, fastest vertex ~%.3g x mean "
-                "edge per step\n",
-                sc.shape.c_str(), sc.resolution, m.num_objects(), m.num_tets(), m.num_vertices(), steps, speed);
+    std::printf(
+        "moving scene: scenario %s r%d, %d objects, %d tets, %d vertices, %d steps, fastest vertex ~%.3g x mean "
+        "edge per step\n",
+        sc.shape.c_str(), sc.resolution, m.num_objects(), m.num_tets(), m.num_vertices(), steps, speed);
     long long reference_contacts = -1;
     for (double skin : {0.0, 0.05, 0.1, 0.2, 0.3, 0.5}) {
         double times[2] = {0, 0};
@@ -372,7 +384,7 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
             Detector det(p);
             det.set_topology(m);
             MovingScene scene(m, edge, speed, 11);
-            det.detect(scene.positions());   // warm-up (auto cell size, buffers): the first step
+            det.detect(scene.positions()); // warm-up (auto cell size, buffers): the first step
             std::vector<double> t;
             for (int s = 1; s < steps; ++s) {
                 scene.step();
@@ -383,7 +395,8 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
                                    : std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
             }
             double sum = 0;
-            for (double x : t) sum += x;
+            for (double x : t)
+                sum += x;
             times[k] = sum / static_cast<double>(t.size());
             if (threads_all == 1) {
                 times[1] = times[0];
@@ -443,19 +456,32 @@ int main(int argc, char** argv)
             }
             return argv[++i];
         };
-        if (a == "--repeat") repeat = std::max(1, std::stoi(next()));
-        else if (a == "--threads") threads = std::stoi(next());
-        else if (a == "--scenario") only = std::stoi(next());
-        else if (a == "--sweep") sweep = true;
-        else if (a == "--no-meshes") meshes = false;
-        else if (a == "--no-baseline") baseline = false;
-        else if (a == "--profile") profile = std::stoi(next());
-        else if (a == "--table-factor") g_table_factor = std::stod(next());
-        else if (a == "--cell-factor") cell_factor = std::stod(next());
-        else if (a == "--hash") hash = next();
-        else if (a == "--moving") moving = true;
-        else if (a == "--steps") steps = std::max(2, std::stoi(next()));
-        else if (a == "--speed") speed = std::stod(next());
+        if (a == "--repeat")
+            repeat = std::max(1, std::stoi(next()));
+        else if (a == "--threads")
+            threads = std::stoi(next());
+        else if (a == "--scenario")
+            only = std::stoi(next());
+        else if (a == "--sweep")
+            sweep = true;
+        else if (a == "--no-meshes")
+            meshes = false;
+        else if (a == "--no-baseline")
+            baseline = false;
+        else if (a == "--profile")
+            profile = std::stoi(next());
+        else if (a == "--table-factor")
+            g_table_factor = std::stod(next());
+        else if (a == "--cell-factor")
+            cell_factor = std::stod(next());
+        else if (a == "--hash")
+            hash = next();
+        else if (a == "--moving")
+            moving = true;
+        else if (a == "--steps")
+            steps = std::max(2, std::stoi(next()));
+        else if (a == "--speed")
+            speed = std::stod(next());
         else {
             std::fprintf(stderr,
                          "usage: tethash_bench [--repeat K] [--threads N] [--scenario 1..5] [--sweep] [--no-meshes] "
@@ -486,7 +512,8 @@ int main(int argc, char** argv)
             }
     }
     const char* simd = std::getenv("TETHASH_SIMD");
-    std::printf("scan kernel: %s\n\n", simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
+    std::printf("scan kernel: %s\n\n",
+                simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
 
     if (sweep) {
         std::printf("flatness sweep: copies of the scenario-5 object (551 tets) packed as in scenario 5, 1 thread\n");
@@ -510,7 +537,7 @@ int main(int argc, char** argv)
         return 0;
     }
 
-    if (profile > 0) {   // one scenario (default 5) at --threads (default 1), N detections, no statistics
+    if (profile > 0) { // one scenario (default 5) at --threads (default 1), N detections, no statistics
         const study::Scenario sc = study::teschner_scenario(only > 0 ? only - 1 : 4);
         DetectParams p = base;
         p.threads = threads > 0 ? threads : 1;
@@ -535,7 +562,8 @@ int main(int argc, char** argv)
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;
         if (std::filesystem::exists(dir)) {
             std::vector<std::filesystem::path> files;
-            for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path());
+            for (const auto& e : std::filesystem::directory_iterator(dir))
+                files.push_back(e.path());
             std::sort(files.begin(), files.end());
             for (const auto& f : files) {
                 if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;

@@ -27,7 +27,8 @@ void run_convert(const ConvertOptions& o)
     fmt::print("read {}: {} vertices, {} tets", o.in, mesh.num_vertices(), mesh.num_tets());
     if (notes.skipped_cells) fmt::print(" ({} non-tet cells skipped)", notes.skipped_cells);
     fmt::print("\n");
-    for (const std::string& m : notes.messages) fmt::print("  note: {}\n", m);
+    for (const std::string& m : notes.messages)
+        fmt::print("  note: {}\n", m);
     const ValidationReport report = validate(mesh);
     if (o.reorient) {
         const std::int64_t flipped = reorient_inverted(mesh);
@@ -42,15 +43,16 @@ void run_convert(const ConvertOptions& o)
         fmt::print("wrote {}: {} vertices, {} tets\n", o.out, mesh.num_vertices(), mesh.num_tets());
 }
 
-const Registrar reg{{"convert", "Convert a tet mesh between formats (chosen by file extension)", [](CLI::App& sub) {
-                         auto o = std::make_shared<ConvertOptions>();
-                         sub.add_option("IN", o->in, "Input tet mesh (.vtk .vtu .msh .node/.ele .mesh .veg)")->required();
-                         sub.add_option("OUT", o->out,
-                                        "Output (.vtu .vtk .msh .mesh .node/.ele, or a boundary surface .obj .ply .stl .gltf .glb)")
-                             ->required();
-                         sub.add_flag("--reorient", o->reorient, "Flip inverted (negative-volume) tets before writing");
-                         sub.callback([o] { run_convert(*o); });
-                     }}};
+const Registrar reg{
+    {"convert", "Convert a tet mesh between formats (chosen by file extension)", [](CLI::App& sub) {
+         auto o = std::make_shared<ConvertOptions>();
+         sub.add_option("IN", o->in, "Input tet mesh (.vtk .vtu .msh .node/.ele .mesh .veg)")->required();
+         sub.add_option("OUT", o->out,
+                        "Output (.vtu .vtk .msh .mesh .node/.ele, or a boundary surface .obj .ply .stl .gltf .glb)")
+             ->required();
+         sub.add_flag("--reorient", o->reorient, "Flip inverted (negative-volume) tets before writing");
+         sub.callback([o] { run_convert(*o); });
+     }}};
 
 } // namespace
 

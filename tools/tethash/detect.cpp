@@ -36,7 +36,9 @@ struct DetectOptions {
 void parse_cell_size(const std::string& s, DetectParams& p)
 {
     auto bad = [&] {
-        return Error("--cell-size: expected a positive length, 'auto' or 'xF' (F > 0, a factor of the mean edge length), got '" + s + "'");
+        return Error(
+            "--cell-size: expected a positive length, 'auto' or 'xF' (F > 0, a factor of the mean edge length), got '" +
+            s + "'");
     };
     if (s == "auto") {
         p.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
@@ -134,14 +136,17 @@ void run(const DetectOptions& o)
         const TetMesh& m = meshes[k];
         scene.positions.middleRows(v0, m.num_vertices()) = m.positions;
         scene.tets.middleRows(t0, m.num_tets()) = m.tets.array() + v0;
-        for (Index id : m.vertex_object) vobj.push_back(o0 + id);
-        for (Index id : m.tet_object) tobj.push_back(o0 + id);
+        for (Index id : m.vertex_object)
+            vobj.push_back(o0 + id);
+        for (Index id : m.tet_object)
+            tobj.push_back(o0 + id);
         v0 += m.num_vertices();
         t0 += m.num_tets();
         o0 += std::max<Index>(1, m.num_objects());
     }
     std::vector<ObjectOptions> objects(static_cast<std::size_t>(num_objects));
-    for (auto& ob : objects) ob.self_collision = !o.no_self;
+    for (auto& ob : objects)
+        ob.self_collision = !o.no_self;
     for (int s : o.static_objects) {
         if (s < 0 || s >= num_objects)
             throw Error("--static: object " + std::to_string(s) + " out of range [0, " + std::to_string(num_objects) +
@@ -153,7 +158,7 @@ void run(const DetectOptions& o)
     det.set_topology(scene.tets, nv, vobj, tobj, objects);
     DetectStats stats;
     std::vector<double> ms;
-    if (o.repeat > 1) det.detect(scene.positions);   // warm-up
+    if (o.repeat > 1) det.detect(scene.positions); // warm-up
     for (int r = 0; r < o.repeat; ++r) {
         const auto start = std::chrono::steady_clock::now();
         det.detect(scene.positions, &stats);
@@ -167,8 +172,9 @@ void run(const DetectOptions& o)
     fmt::print("scene: {} objects, {} vertices, {} tets\n", num_objects, nv, nt);
     fmt::print("grid: cell size {:.6g}, table size {}, hash {}, threads {}\n", stats.cell_size, stats.table_size,
                to_string(params.hash), stats.threads);
-    fmt::print("time: {:.3f} ms per detection (median of {}): vertices {:.3f}, tets {:.3f}, inside {:.3f}, sort {:.3f}\n",
-               median_ms, o.repeat, stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort);
+    fmt::print(
+        "time: {:.3f} ms per detection (median of {}): vertices {:.3f}, tets {:.3f}, inside {:.3f}, sort {:.3f}\n",
+        median_ms, o.repeat, stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort);
     fmt::print("work: {} cells, {} entries scanned ({} hash collisions, {} box rejections, {} own vertices), "
                "{} inside tests, {} exact fallbacks, {} degenerate tets\n",
                stats.cells_visited, stats.entries_scanned, stats.hash_collisions, stats.box_rejections,
@@ -178,21 +184,24 @@ void run(const DetectOptions& o)
     if (!o.contacts_path.empty()) {
         std::string csv = "vertex,tet,b0,b1,b2,b3\n";
         for (const Contact& c : contacts)
-            csv += fmt::format("{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex, c.tet, c.bary[0], c.bary[1], c.bary[2],
-                               c.bary[3]);
+            csv += fmt::format("{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex, c.tet, c.bary[0], c.bary[1],
+                               c.bary[2], c.bary[3]);
         io::write_text_file(o.contacts_path, csv);
     }
     if (!o.stats_path.empty()) {
         std::string msl;
-        for (std::size_t i = 0; i < ms.size(); ++i) msl += fmt::format("{}{:.6f}", i ? ", " : "", ms[i]);
+        for (std::size_t i = 0; i < ms.size(); ++i)
+            msl += fmt::format("{}{:.6f}", i ? ", " : "", ms[i]);
         std::string f = "{\n";
-        f += fmt::format("  \"objects\": {},\n  \"vertices\": {},\n  \"tets\": {},\n  \"contacts\": {},\n",
-                         num_objects, nv, nt, contacts.size());
+        f += fmt::format("  \"objects\": {},\n  \"vertices\": {},\n  \"tets\": {},\n  \"contacts\": {},\n", num_objects,
+                         nv, nt, contacts.size());
         f += fmt::format("  \"threads\": {},\n  \"cell_size\": {:.17g},\n  \"table_size\": {},\n  \"hash\": \"{}\",\n",
                          stats.threads, stats.cell_size, stats.table_size, to_string(params.hash));
-        f += fmt::format("  \"repeat\": {},\n  \"median_ms\": {:.6f},\n  \"run_ms\": [{}],\n", o.repeat, median_ms, msl);
-        f += fmt::format("  \"ms_vertices\": {:.6f},\n  \"ms_tets\": {:.6f},\n  \"ms_inside\": {:.6f},\n  \"ms_sort\": {:.6f},\n",
-                         stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort);
+        f +=
+            fmt::format("  \"repeat\": {},\n  \"median_ms\": {:.6f},\n  \"run_ms\": [{}],\n", o.repeat, median_ms, msl);
+        f += fmt::format(
+            "  \"ms_vertices\": {:.6f},\n  \"ms_tets\": {:.6f},\n  \"ms_inside\": {:.6f},\n  \"ms_sort\": {:.6f},\n",
+            stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort);
         f += fmt::format("  \"cells_visited\": {},\n  \"entries_scanned\": {},\n  \"hash_collisions\": {},\n",
                          stats.cells_visited, stats.entries_scanned, stats.hash_collisions);
         f += fmt::format("  \"box_rejections\": {},\n  \"own_vertex_skips\": {},\n  \"inside_tests\": {},\n",
@@ -206,28 +215,30 @@ void run(const DetectOptions& o)
     }
 }
 
-Registrar reg{{"detect", "Find every vertex inside a tet of another object or of its own (spatial hashing, exact)",
-               [](CLI::App& sub) {
-                   auto o = std::make_shared<DetectOptions>();
-                   sub.add_option("meshes", o->meshes, "Tet meshes; together one scene, each file an object")
-                       ->required();
-                   sub.add_option("--cell-size", o->cell_size, "Cell edge length: L, auto (the mean edge length) or xF (F × mean edge)")
-                       ->capture_default_str();
-                   sub.add_option("--table-size", o->table_size, "Hash table size: N ≥ 1 or auto (chosen from the vertex count)")
-                       ->capture_default_str();
-                   sub.add_option("--skin", o->skin,
-                                  "Candidate reuse between calls (--repeat): L (a length, 0 = off) or xF (F × cell size)")
-                       ->capture_default_str();
-                   sub.add_option("--hash", o->hash, "Hash function: column or teschner")->capture_default_str();
-                   sub.add_option("--threads", o->threads, "Threads (0 = all)")->capture_default_str();
-                   sub.add_option("--repeat", o->repeat, "Run K times after a warm-up; report the median")->capture_default_str();
-                   sub.add_option("--contacts", o->contacts_path, "Write contacts CSV (vertex,tet,b0,b1,b2,b3)");
-                   sub.add_option("--stats", o->stats_path, "Write statistics JSON");
-                   sub.add_flag("--no-self", o->no_self, "No self-collisions (only between objects)");
-                   sub.add_option("--static", o->static_objects, "Object index (file order, from 0) that never moves; repeatable");
-                   add_objects_from_labels_option(sub, o->objects_from_labels);
-                   sub.callback([o] { run(*o); });
-               }}};
+Registrar reg{
+    {"detect", "Find every vertex inside a tet of another object or of its own (spatial hashing, exact)",
+     [](CLI::App& sub) {
+         auto o = std::make_shared<DetectOptions>();
+         sub.add_option("meshes", o->meshes, "Tet meshes; together one scene, each file an object")->required();
+         sub.add_option("--cell-size", o->cell_size,
+                        "Cell edge length: L, auto (the mean edge length) or xF (F × mean edge)")
+             ->capture_default_str();
+         sub.add_option("--table-size", o->table_size, "Hash table size: N ≥ 1 or auto (chosen from the vertex count)")
+             ->capture_default_str();
+         sub.add_option("--skin", o->skin,
+                        "Candidate reuse between calls (--repeat): L (a length, 0 = off) or xF (F × cell size)")
+             ->capture_default_str();
+         sub.add_option("--hash", o->hash, "Hash function: column or teschner")->capture_default_str();
+         sub.add_option("--threads", o->threads, "Threads (0 = all)")->capture_default_str();
+         sub.add_option("--repeat", o->repeat, "Run K times after a warm-up; report the median")->capture_default_str();
+         sub.add_option("--contacts", o->contacts_path, "Write contacts CSV (vertex,tet,b0,b1,b2,b3)");
+         sub.add_option("--stats", o->stats_path, "Write statistics JSON");
+         sub.add_flag("--no-self", o->no_self, "No self-collisions (only between objects)");
+         sub.add_option("--static", o->static_objects,
+                        "Object index (file order, from 0) that never moves; repeatable");
+         add_objects_from_labels_option(sub, o->objects_from_labels);
+         sub.callback([o] { run(*o); });
+     }}};
 
 } // namespace
 } // namespace tethash::cli

@@ -17,7 +17,8 @@ std::string describe_made_mesh(const TetMesh& mesh)
 {
     double min_dihedral = 180, max_dihedral = 0;
     for (Index t = 0; t < mesh.num_tets(); ++t) {
-        const TetQuality q = tet_quality(mesh.positions, {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2), mesh.tets(t, 3)});
+        const TetQuality q =
+            tet_quality(mesh.positions, {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2), mesh.tets(t, 3)});
         min_dihedral = std::min(min_dihedral, q.min_dihedral_deg);
         max_dihedral = std::max(max_dihedral, q.max_dihedral_deg);
     }
@@ -25,8 +26,8 @@ std::string describe_made_mesh(const TetMesh& mesh)
     const auto [lo, hi] = bounding_box(mesh.positions);
     return fmt::format("{} vertices, {} tets, volume {:.6g}, bounding box {:.4g} x {:.4g} x {:.4g}, "
                        "dihedral angles {:.1f}..{:.1f} deg",
-                       mesh.num_vertices(), mesh.num_tets(), v.total, hi.x() - lo.x(), hi.y() - lo.y(),
-                       hi.z() - lo.z(), min_dihedral, max_dihedral);
+                       mesh.num_vertices(), mesh.num_tets(), v.total, hi.x() - lo.x(), hi.y() - lo.y(), hi.z() - lo.z(),
+                       min_dihedral, max_dihedral);
 }
 
 namespace {
@@ -61,12 +62,14 @@ void run_generate(const GenerateOptions& o)
     p.shape = o.shape;
     p.resolution = o.resolution;
     p.snap = !o.no_snap;
-    if (!(o.scale > 0) || !std::isfinite(o.scale)) throw Error(fmt::format("--scale {}: must be a positive number", o.scale));
+    if (!(o.scale > 0) || !std::isfinite(o.scale))
+        throw Error(fmt::format("--scale {}: must be a positive number", o.scale));
     p.scale = o.scale;
     if (!o.size.empty()) {
         for (double s : o.size)
             if (!(s > 0) || !std::isfinite(s))
-                throw Error(fmt::format("--size {} {} {}: every extent must be a positive number", o.size[0], o.size[1], o.size[2]));
+                throw Error(fmt::format("--size {} {} {}: every extent must be a positive number", o.size[0], o.size[1],
+                                        o.size[2]));
         p.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
     }
     const TetMesh mesh = io::generate(p);
@@ -75,19 +78,23 @@ void run_generate(const GenerateOptions& o)
                describe_made_mesh(mesh), o.out);
 }
 
-const Registrar reg{{"generate", "Make a tet mesh of a built-in shape (BCC lattice; see --list)", [](CLI::App& sub) {
-                         auto o = std::make_shared<GenerateOptions>();
-                         sub.add_option("shape", o->shape, "Shape name (see --list)");
-                         sub.add_option("-o,--output", o->out, "Output mesh (.vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
-                         sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent (1..1000)")
-                             ->capture_default_str();
-                         auto* size = sub.add_option("--size", o->size, "Bounding-box extents X Y Z (default: the shape's natural size)")
-                                          ->expected(3);
-                         sub.add_option("--scale", o->scale, "Multiply the size by S")->capture_default_str()->excludes(size);
-                         sub.add_flag("--no-snap", o->no_snap, "Keep the lattice staircase (do not move boundary vertices onto the surface)");
-                         sub.add_flag("--list", o->list, "List the shapes and exit");
-                         sub.callback([o] { run_generate(*o); });
-                     }}};
+const Registrar reg{
+    {"generate", "Make a tet mesh of a built-in shape (BCC lattice; see --list)", [](CLI::App& sub) {
+         auto o = std::make_shared<GenerateOptions>();
+         sub.add_option("shape", o->shape, "Shape name (see --list)");
+         sub.add_option("-o,--output", o->out,
+                        "Output mesh (.vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
+         sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent (1..1000)")
+             ->capture_default_str();
+         auto* size =
+             sub.add_option("--size", o->size, "Bounding-box extents X Y Z (default: the shape's natural size)")
+                 ->expected(3);
+         sub.add_option("--scale", o->scale, "Multiply the size by S")->capture_default_str()->excludes(size);
+         sub.add_flag("--no-snap", o->no_snap,
+                      "Keep the lattice staircase (do not move boundary vertices onto the surface)");
+         sub.add_flag("--list", o->list, "List the shapes and exit");
+         sub.callback([o] { run_generate(*o); });
+     }}};
 
 } // namespace
 } // namespace tethash::cli

@@ -55,12 +55,14 @@ Summary summarize(const std::string& name, const TetMesh& mesh, const io::ReadNo
     s.boundary_faces = boundary_faces(mesh.tets).rows();
     s.min_dihedral = mesh.num_tets() ? 180.0 : 0.0;
     for (Index t = 0; t < mesh.num_tets(); ++t) {
-        const TetQuality q = tet_quality(mesh.positions, {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2), mesh.tets(t, 3)});
+        const TetQuality q =
+            tet_quality(mesh.positions, {mesh.tets(t, 0), mesh.tets(t, 1), mesh.tets(t, 2), mesh.tets(t, 3)});
         s.min_dihedral = std::min(s.min_dihedral, q.min_dihedral_deg);
         s.max_dihedral = std::max(s.max_dihedral, q.max_dihedral_deg);
         if (std::isfinite(q.aspect_ratio)) s.max_aspect = std::max(s.max_aspect, q.aspect_ratio);
         std::size_t bin = 0;
-        while (bin + 1 < kDihedralEdges.size() && q.min_dihedral_deg >= kDihedralEdges[bin + 1]) ++bin;
+        while (bin + 1 < kDihedralEdges.size() && q.min_dihedral_deg >= kDihedralEdges[bin + 1])
+            ++bin;
         ++s.histogram[bin];
     }
     return s;
@@ -70,14 +72,20 @@ std::string json_string(const std::string& s)
 {
     std::string out = "\"";
     for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
-        else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", c);
-        else out += c;
+        if (c == '"' || c == '\\')
+            out += '\\', out += c;
+        else if (static_cast<unsigned char>(c) < 0x20)
+            out += fmt::format("\\u{:04x}", c);
+        else
+            out += c;
     }
     return out + "\"";
 }
 
-std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{}", v) : "null"; }
+std::string json_number(double v)
+{
+    return std::isfinite(v) ? fmt::format("{}", v) : "null";
+}
 
 std::string to_json(const Summary& s, const std::string& indent)
 {
@@ -114,10 +122,12 @@ std::string to_json(const Summary& s, const std::string& indent)
     kv("non_finite_vertices", std::to_string(r.non_finite));
     kv("non_manifold_faces", std::to_string(r.non_manifold_faces));
     std::string problems = "[";
-    for (std::size_t i = 0; i < r.problems().size(); ++i) problems += (i ? ", " : "") + json_string(r.problems()[i]);
+    for (std::size_t i = 0; i < r.problems().size(); ++i)
+        problems += (i ? ", " : "") + json_string(r.problems()[i]);
     kv("problems", problems + "]");
     std::string notes = "[";
-    for (std::size_t i = 0; i < s.notes.size(); ++i) notes += (i ? ", " : "") + json_string(s.notes[i]);
+    for (std::size_t i = 0; i < s.notes.size(); ++i)
+        notes += (i ? ", " : "") + json_string(s.notes[i]);
     kv("notes", notes + "]", true);
     return o + indent + "}";
 }
@@ -142,22 +152,27 @@ void print_text(const Summary& s)
                                       ? fmt::format("{:>3g}-{:<3g}°", kDihedralEdges[i], kDihedralEdges[i + 1])
                                       : fmt::format("{:>3g}+    ", kDihedralEdges[i]);
         const double frac = s.tets ? double(s.histogram[i]) / double(s.tets) : 0.0;
-        fmt::print("    {} {:>9} {}\n", range, s.histogram[i], std::string(static_cast<std::size_t>(frac * 40 + 0.5), '#'));
+        fmt::print("    {} {:>9} {}\n", range, s.histogram[i],
+                   std::string(static_cast<std::size_t>(frac * 40 + 0.5), '#'));
     }
     const auto problems = r.problems();
     if (problems.empty()) fmt::print("  problems: none\n");
-    for (const auto& p : problems) fmt::print("  problem: {}\n", p);
+    for (const auto& p : problems)
+        fmt::print("  problem: {}\n", p);
     if (!r.first_bad_tets.empty()) {
         std::string ids;
-        for (Index t : r.first_bad_tets) ids += " " + std::to_string(t);
+        for (Index t : r.first_bad_tets)
+            ids += " " + std::to_string(t);
         fmt::print("  first tets with problems:{}\n", ids);
     }
     if (!r.first_bad_vertices.empty()) {
         std::string ids;
-        for (Index v : r.first_bad_vertices) ids += " " + std::to_string(v);
+        for (Index v : r.first_bad_vertices)
+            ids += " " + std::to_string(v);
         fmt::print("  first vertices with problems:{}\n", ids);
     }
-    for (const auto& n : s.notes) fmt::print("  note: {}\n", n);
+    for (const auto& n : s.notes)
+        fmt::print("  note: {}\n", n);
 }
 
 void run(const InfoOptions& opt)
@@ -170,7 +185,8 @@ void run(const InfoOptions& opt)
     for (const auto& path : opt.meshes) {
         io::ReadNotes notes;
         TetMesh mesh = io::read_mesh(path, &notes);
-        if (!opt.objects_from_labels.empty()) notes.messages.push_back(objects_from_labels(mesh, path, opt.objects_from_labels));
+        if (!opt.objects_from_labels.empty())
+            notes.messages.push_back(objects_from_labels(mesh, path, opt.objects_from_labels));
         summaries.push_back(summarize(path, mesh, notes));
         scene.append(mesh);
         all_notes.skipped_cells += notes.skipped_cells;
@@ -182,28 +198,31 @@ void run(const InfoOptions& opt)
             out.pop_back(); // closing brace
             out.pop_back(); // newline before it: to_json ends with "\n}" -> reopen the object
             out += ",\n  \"files\": [";
-            for (std::size_t i = 0; i < summaries.size(); ++i) out += (i ? ", " : "") + to_json(summaries[i], "  ");
+            for (std::size_t i = 0; i < summaries.size(); ++i)
+                out += (i ? ", " : "") + to_json(summaries[i], "  ");
             out += "]\n}";
         }
         fmt::print("{}\n", out);
         return;
     }
     if (summaries.size() > 1 && opt.per_file)
-        for (const auto& s : summaries) print_text(s);
+        for (const auto& s : summaries)
+            print_text(s);
     print_text(total);
 }
 
-Registrar reg{{"info", "Print counts, bounding box, edge lengths, volume, quality and problems of tet meshes",
-               [](CLI::App& sub) {
-                   auto opt = std::make_shared<InfoOptions>();
-                   sub.add_option("meshes", opt->meshes, "Tet mesh files (.vtk .vtu .msh .node/.ele .mesh .veg); "
-                                                         "several files are one scene, one object each")
-                       ->required();
-                   sub.add_flag("--json", opt->json, "Print JSON for scripts");
-                   sub.add_flag("--per-file", opt->per_file, "With several files, also print each file");
-                   add_objects_from_labels_option(sub, opt->objects_from_labels);
-                   sub.callback([opt] { run(*opt); });
-               }}};
+Registrar reg{
+    {"info", "Print counts, bounding box, edge lengths, volume, quality and problems of tet meshes", [](CLI::App& sub) {
+         auto opt = std::make_shared<InfoOptions>();
+         sub.add_option("meshes", opt->meshes,
+                        "Tet mesh files (.vtk .vtu .msh .node/.ele .mesh .veg); "
+                        "several files are one scene, one object each")
+             ->required();
+         sub.add_flag("--json", opt->json, "Print JSON for scripts");
+         sub.add_flag("--per-file", opt->per_file, "With several files, also print each file");
+         add_objects_from_labels_option(sub, opt->objects_from_labels);
+         sub.callback([opt] { run(*opt); });
+     }}};
 
 } // namespace
 } // namespace tethash::cli

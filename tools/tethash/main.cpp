@@ -34,7 +34,10 @@ int set_threads(int n)
 #endif
 }
 
-bool stderr_is_terminal() { return isatty(fileno(stderr)) != 0; }
+bool stderr_is_terminal()
+{
+    return isatty(fileno(stderr)) != 0;
+}
 
 void add_objects_from_labels_option(CLI::App& sub, std::string& value)
 {
@@ -65,7 +68,8 @@ std::string objects_from_labels(TetMesh& mesh, const std::string& path, const st
     }
     std::string note = std::to_string(split.object_labels.size()) + " objects from tet labels";
     std::size_t joined = 0;
-    for (const auto& labels : split.object_labels) joined += labels.size() > 1;
+    for (const auto& labels : split.object_labels)
+        joined += labels.size() > 1;
     if (joined)
         note += " (" + std::to_string(split.shared_vertices) + " shared vertices joined labels into " +
                 std::to_string(joined) + " objects)";
@@ -116,8 +120,10 @@ int main(int argc, char** argv)
         if (argc > 1 && argv[1][0] != '-' &&
             std::none_of(commands.begin(), commands.end(), [&](const auto& c) { return c.name == argv[1]; })) {
             std::string names;
-            for (const auto& c : commands) names += (names.empty() ? "" : ", ") + c.name;
-            throw Error(std::string("unknown command '") + argv[1] + "' (commands: " + names + "; see 'tethash --help')");
+            for (const auto& c : commands)
+                names += (names.empty() ? "" : ", ") + c.name;
+            throw Error(std::string("unknown command '") + argv[1] + "' (commands: " + names +
+                        "; see 'tethash --help')");
         }
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

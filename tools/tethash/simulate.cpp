@@ -10,9 +10,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 namespace tethash::cli {
 namespace {
@@ -59,7 +59,8 @@ void run_simulate(const SimulateOptions& o)
     const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
 
     sim::Simulation sim(scene);
-    for (const std::string& w : sim.warnings()) std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
+    for (const std::string& w : sim.warnings())
+        std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
 
     std::error_code ec;
     std::filesystem::create_directories(o.out, ec);
@@ -77,10 +78,12 @@ void run_simulate(const SimulateOptions& o)
 
     const sim::Energy e0 = sim.energy();
     std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
-    std::fprintf(stdout, "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %d threads\n",
-                 static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
-                 static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt,
-                 scene.substeps, scene.steps, threads);
+    std::fprintf(
+        stdout,
+        "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %d threads\n",
+        static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
+        static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
+        scene.steps, threads);
     std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
     std::fflush(stdout);
 
@@ -110,13 +113,13 @@ void run_simulate(const SimulateOptions& o)
                     const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, scene.steps));
                     std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g   ",
                                  std::string(static_cast<size_t>(filled), '#').c_str(),
-                                 std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps, rate,
-                                 static_cast<long long>(st.contacts), st.max_depth);
+                                 std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps,
+                                 rate, static_cast<long long>(st.contacts), st.max_depth);
                     last_print = now;
                 }
             } else if ((s + 1) % plain_every == 0 || s + 1 == scene.steps) {
-                std::fprintf(stderr, "step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g\n", s + 1, scene.steps, rate,
-                             static_cast<long long>(st.contacts), st.max_depth);
+                std::fprintf(stderr, "step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g\n", s + 1, scene.steps,
+                             rate, static_cast<long long>(st.contacts), st.max_depth);
             }
         }
     } catch (const RunFailure&) {
@@ -130,26 +133,31 @@ void run_simulate(const SimulateOptions& o)
     std::fprintf(stdout, "steps: %d in %.3f s (%.2f ms/step: detection %.3f, response %.3f, integration %.3f)\n",
                  scene.steps, wall, 1e3 * wall / n, ms_detect / n, ms_response / n, ms_integrate / n);
     std::fprintf(stdout, "contacts per step: %.1f\n", static_cast<double>(contacts) / n);
-    if (iterations) std::fprintf(stdout, "linear solver: %.1f CG iterations per step\n", static_cast<double>(iterations) / n);
+    if (iterations)
+        std::fprintf(stdout, "linear solver: %.1f CG iterations per step\n", static_cast<double>(iterations) / n);
     std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
                  contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
-    std::fprintf(stdout, "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, contact %.4g)\n",
+    std::fprintf(stdout,
+                 "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
+                 "contact %.4g)\n",
                  e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
-    if (every > 0) std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView)\n", series.size(), o.out.c_str());
+    if (every > 0)
+        std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView)\n", series.size(), o.out.c_str());
 }
 
-Registrar reg{{"simulate", "Simulate a scene of deformable tet meshes (mass-spring) and write VTU frames",
-               [](CLI::App& sub) {
-                   auto o = std::make_shared<SimulateOptions>();
-                   sub.add_option("scene", o->scene, "Scene file (TOML); without it the built-in default scene runs");
-                   sub.add_option("--steps", o->steps, "Number of steps (overrides the scene)");
-                   sub.add_option("--dt", o->dt, "Time step in s (overrides the scene)");
-                   sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
-                   sub.add_option("--integrator", o->integrator, "symplectic_euler, implicit_euler or local_global");
-                   sub.add_option("--threads", o->threads, "Detector threads (default: the scene's [detector] threads, 1 if absent; 0: all cores)");
-                   sub.add_option("--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
-                   sub.callback([o] { run_simulate(*o); });
-               }}};
+Registrar reg{
+    {"simulate", "Simulate a scene of deformable tet meshes (mass-spring) and write VTU frames", [](CLI::App& sub) {
+         auto o = std::make_shared<SimulateOptions>();
+         sub.add_option("scene", o->scene, "Scene file (TOML); without it the built-in default scene runs");
+         sub.add_option("--steps", o->steps, "Number of steps (overrides the scene)");
+         sub.add_option("--dt", o->dt, "Time step in s (overrides the scene)");
+         sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
+         sub.add_option("--integrator", o->integrator, "symplectic_euler, implicit_euler or local_global");
+         sub.add_option("--threads", o->threads,
+                        "Detector threads (default: the scene's [detector] threads, 1 if absent; 0: all cores)");
+         sub.add_option("--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
+         sub.callback([o] { run_simulate(*o); });
+     }}};
 
 } // namespace
 } // namespace tethash::cli

@@ -10,8 +10,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -20,7 +20,10 @@ namespace tethash::cli {
 namespace {
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_sigint(int) { g_stop.store(true); }
+extern "C" void on_sigint(int)
+{
+    g_stop.store(true);
+}
 
 std::string shell_quote(const std::string& s)
 {
@@ -28,7 +31,8 @@ std::string shell_quote(const std::string& s)
                           std::string::npos)
         return s;
     std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    for (char c : s)
+        q += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return q + "'";
 }
 
@@ -116,7 +120,8 @@ void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool q
 
 void run(Args& a)
 {
-    if (a.positional.empty()) throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, integrator) or merge");
+    if (a.positional.empty())
+        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, integrator) or merge");
     const std::string what = a.positional.front();
     if (what == "merge") {
         std::vector<std::string> dirs(a.positional.begin() + 1, a.positional.end());
@@ -152,11 +157,11 @@ void run(Args& a)
             std::snprintf(buf, sizeof buf, "%.10g:%.10g:%d", a.from, a.to, a.points);
             o.cell_size = {buf};
             break;
-        case study::Sweep::table_size:   // factors of the vertex count
+        case study::Sweep::table_size: // factors of the vertex count
             std::snprintf(buf, sizeof buf, "x%.10g:x%.10g:%d", a.from, a.to, a.points);
             o.table_size = {buf};
             break;
-        case study::Sweep::integrator:   // time steps in seconds
+        case study::Sweep::integrator: // time steps in seconds
             std::snprintf(buf, sizeof buf, "%.10g:%.10g:%d", a.from, a.to, a.points);
             o.dt = {buf};
             break;
@@ -168,7 +173,7 @@ void run(Args& a)
 #ifdef TETHASH_CXX_FLAGS
     o.compiler_flags = TETHASH_CXX_FLAGS;
 #endif
-    auto plan = study::plan_study(o);   // every check happens here, before any measurement
+    auto plan = study::plan_study(o); // every check happens here, before any measurement
 
     g_stop.store(false);
     auto old_handler = std::signal(SIGINT, on_sigint);
@@ -199,48 +204,58 @@ void run(Args& a)
     if (!a.no_plot) make_figures(o.out_dir);
 }
 
-Registrar reg{{"study", "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, or the "
-                        "simulator's integrator x dt x substeps; CSV, JSON and figures",
-               [](CLI::App& sub) {
-                   auto a = std::make_shared<Args>();
-                   sub.add_option("sweep", a->positional,
-                                  "cell-size | table-size | hash | threads | grid | integrator, or: merge DIR...")
-                       ->required();
-                   sub.add_option("--mesh", a->o.meshes,
-                                  "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
-                   sub.add_option("--scene", a->o.scene_file, "simulator scene (TOML) for the integrator sweep");
-                   sub.add_flag("--teschner-scenarios", a->o.teschner, "the five scenarios of Teschner et al. 2003");
-                   sub.add_option("--scenarios", a->o.scenarios, "with or instead of --teschner-scenarios: which (1..5), e.g. 1,5")
-                       ->delimiter(',');
-                   sub.add_option("--cell-size", a->o.cell_size,
-                                  "cell sizes as factors of the mean edge: list '0.5,1,2' or log range FROM:TO:POINTS "
-                                  "(default: 0.125:8:13 when swept, 0.25:4:9 in a grid, else 1)");
-                   sub.add_option("--table-size", a->o.table_size,
-                                  "table sizes: N, auto, xF (F x vertices), or range xFROM:xTO:POINTS (primes and powers of two; "
-                                  "default: x0.01:x100:9 when swept, x0.03:x30:4 in a grid, else auto)");
-                   sub.add_option("--hash", a->o.hash, "hash functions: teschner, column, all (default: all when swept, else column)");
-                   sub.add_option("--threads", a->o.threads, "thread counts: list or FROM:TO (default 1; threads sweep: 1..cores)");
-                   sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
-                       ->delimiter(',');
-                   sub.add_option("--from", a->from, "range start of the swept parameter (cell factor, table factor of vertices, dt in s)");
-                   sub.add_option("--to", a->to, "range end");
-                   sub.add_option("--points", a->points, "number of log-spaced points");
-                   sub.add_option("--integrator", a->o.integrator, "integrators: symplectic_euler, implicit_euler, local_global, all (default: all)");
-                   sub.add_option("--dt", a->o.dt, "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5)");
-                   sub.add_option("--substeps", a->o.substeps, "substep counts (default: 1)");
-                   sub.add_option("--duration", a->o.duration, "simulated seconds (default: the scene's, at most 0.5)");
-                   sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken")->capture_default_str();
-                   sub.add_option("--reference-factor", a->o.reference_factor, "reference dt = smallest dt / this")->capture_default_str();
-                   sub.add_option("--repeat", a->repeat, "measured repeats per point (default 3; integrator: 1)");
-                   sub.add_option("--warmup", a->warmup, "unmeasured runs before the repeats (default 1; integrator: 0)");
-                   sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
-                   sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
-                   sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
-                   sub.add_option("--out", a->out, "output folder, made if missing (default: study)");
-                   sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
-                   sub.add_flag("--quiet", a->quiet, "no progress output");
-                   sub.callback([a]() { run(*a); });
-               }}};
+Registrar reg{
+    {"study",
+     "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, or the "
+     "simulator's integrator x dt x substeps; CSV, JSON and figures",
+     [](CLI::App& sub) {
+         auto a = std::make_shared<Args>();
+         sub.add_option("sweep", a->positional,
+                        "cell-size | table-size | hash | threads | grid | integrator, or: merge DIR...")
+             ->required();
+         sub.add_option("--mesh", a->o.meshes,
+                        "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
+         sub.add_option("--scene", a->o.scene_file, "simulator scene (TOML) for the integrator sweep");
+         sub.add_flag("--teschner-scenarios", a->o.teschner, "the five scenarios of Teschner et al. 2003");
+         sub.add_option("--scenarios", a->o.scenarios,
+                        "with or instead of --teschner-scenarios: which (1..5), e.g. 1,5")
+             ->delimiter(',');
+         sub.add_option("--cell-size", a->o.cell_size,
+                        "cell sizes as factors of the mean edge: list '0.5,1,2' or log range FROM:TO:POINTS "
+                        "(default: 0.125:8:13 when swept, 0.25:4:9 in a grid, else 1)");
+         sub.add_option("--table-size", a->o.table_size,
+                        "table sizes: N, auto, xF (F x vertices), or range xFROM:xTO:POINTS (primes and powers of two; "
+                        "default: x0.01:x100:9 when swept, x0.03:x30:4 in a grid, else auto)");
+         sub.add_option("--hash", a->o.hash,
+                        "hash functions: teschner, column, all (default: all when swept, else column)");
+         sub.add_option("--threads", a->o.threads,
+                        "thread counts: list or FROM:TO (default 1; threads sweep: 1..cores)");
+         sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
+             ->delimiter(',');
+         sub.add_option("--from", a->from,
+                        "range start of the swept parameter (cell factor, table factor of vertices, dt in s)");
+         sub.add_option("--to", a->to, "range end");
+         sub.add_option("--points", a->points, "number of log-spaced points");
+         sub.add_option("--integrator", a->o.integrator,
+                        "integrators: symplectic_euler, implicit_euler, local_global, all (default: all)");
+         sub.add_option("--dt", a->o.dt,
+                        "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5)");
+         sub.add_option("--substeps", a->o.substeps, "substep counts (default: 1)");
+         sub.add_option("--duration", a->o.duration, "simulated seconds (default: the scene's, at most 0.5)");
+         sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken")
+             ->capture_default_str();
+         sub.add_option("--reference-factor", a->o.reference_factor, "reference dt = smallest dt / this")
+             ->capture_default_str();
+         sub.add_option("--repeat", a->repeat, "measured repeats per point (default 3; integrator: 1)");
+         sub.add_option("--warmup", a->warmup, "unmeasured runs before the repeats (default 1; integrator: 0)");
+         sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
+         sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
+         sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
+         sub.add_option("--out", a->out, "output folder, made if missing (default: study)");
+         sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
+         sub.add_flag("--quiet", a->quiet, "no progress output");
+         sub.callback([a]() { run(*a); });
+     }}};
 
 } // namespace
 } // namespace tethash::cli

@@ -27,7 +27,7 @@ void run_tetrahedralize(const TetrahedralizeOptions& o)
         throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1 and at most 1000");
     if (io::is_tet_mesh_path(o.surface) && !io::is_surface_path(o.surface))
         throw Error(o.surface + ": is a tet mesh format, expected a closed surface (.obj .stl .ply .off .gltf ...); "
-                    "'tethash convert' changes the format of tet meshes");
+                                "'tethash convert' changes the format of tet meshes");
     io::check_mesh_output_file(o.out, "--output");
     const io::SurfaceMesh s = io::read_surface(o.surface);
     io::TetrahedralizeParams p;
@@ -50,7 +50,8 @@ const Registrar reg{{"tetrahedralize", "Fill a closed surface (OBJ, STL, PLY, OF
                          auto o = std::make_shared<TetrahedralizeOptions>();
                          sub.add_option("surface", o->surface, "Surface file (read through assimp)")->required();
                          sub.add_option("-o,--output", o->out, "Output mesh (.vtu .vtk .msh .mesh .node)")->required();
-                         sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent (1..1000)")
+                         sub.add_option("-r,--resolution", o->resolution,
+                                        "Lattice cells along the longest extent (1..1000)")
                              ->capture_default_str();
                          sub.add_flag("--no-snap", o->no_snap, "Do not move boundary vertices onto the surface");
                          sub.callback([o] { run_tetrahedralize(*o); });

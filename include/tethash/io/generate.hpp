@@ -19,20 +19,20 @@
 namespace tethash::io {
 
 struct GenerateParams {
-    std::string shape = "box";           ///< box, bar, sphere, torus, ... (see generate_shapes())
-    int resolution = 8;                  ///< lattice cells along the shape's longest extent (≥ 1)
+    std::string shape = "box"; ///< box, bar, sphere, torus, ... (see generate_shapes())
+    int resolution = 8;        ///< lattice cells along the shape's longest extent (≥ 1)
     /// Extents of the shape's bounding box (length units). A zero vector means the shape's natural
     /// size (shape_natural_size(), e.g. 4 × 1 × 1 for "bar"). Non-uniform sizes stretch the shape.
     Eigen::Vector3d size{0.0, 0.0, 0.0};
-    double scale = 1.0;                  ///< multiplies the size (natural or given); > 0
-    bool snap = true;                    ///< move boundary vertices onto the surface
+    double scale = 1.0; ///< multiplies the size (natural or given); > 0
+    bool snap = true;   ///< move boundary vertices onto the surface
 };
 
 /// A shape generate() knows.
 struct ShapeInfo {
     std::string name;
     std::string description;
-    Eigen::Vector3d natural_size;        ///< bounding-box extents at scale 1
+    Eigen::Vector3d natural_size; ///< bounding-box extents at scale 1
 };
 /// Every shape generate() knows, in a fixed order.
 const std::vector<ShapeInfo>& shape_catalog();
@@ -50,15 +50,14 @@ TetMesh generate(const GenerateParams& params);
 /// Throws Error for resolution < 1 or > 1000, an empty box, or when nothing is inside.
 /// `project(p, h)`, when given, is where boundary vertex p should go on a lattice of spacing h (per
 /// axis), e.g. onto the edges and corners of a box (a closest-point projection would cut them off).
-TetMesh tetrahedralize_sdf(const std::function<double(const Eigen::Vector3d&)>& sdf,
-                           const Eigen::Vector3d& box_min, const Eigen::Vector3d& box_max,
-                           int resolution, bool snap,
-                           const std::function<Eigen::Vector3d(const Eigen::Vector3d& p, const Eigen::Vector3d& h)>&
-                               project = {});
+TetMesh tetrahedralize_sdf(
+    const std::function<double(const Eigen::Vector3d&)>& sdf, const Eigen::Vector3d& box_min,
+    const Eigen::Vector3d& box_max, int resolution, bool snap,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d& p, const Eigen::Vector3d& h)>& project = {});
 
 struct TetrahedralizeParams {
-    int resolution = 16;                 ///< lattice cells along the surface's longest bounding-box extent
-    bool snap = true;                    ///< move boundary vertices to the closest point of the surface
+    int resolution = 16; ///< lattice cells along the surface's longest bounding-box extent
+    bool snap = true;    ///< move boundary vertices to the closest point of the surface
 };
 /// Closed (or nearly closed) surface to tets: inside test by generalized winding number (|w| > 1/2,
 /// so small holes, cracks and a globally inward orientation are tolerated), BCC lattice over the

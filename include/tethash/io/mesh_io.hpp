@@ -18,24 +18,25 @@ namespace tethash::io {
 /// A data array attached to points or cells for output (ParaView shows it by name).
 struct Field {
     std::string name;
-    int components = 1;           ///< 1 (scalar) or 3 (vector)
-    std::vector<double> values;   ///< size = count × components, row-major
+    int components = 1;         ///< 1 (scalar) or 3 (vector)
+    std::vector<double> values; ///< size = count × components, row-major
 };
 struct Fields {
-    std::vector<Field> point;     ///< one value per vertex
-    std::vector<Field> cell;      ///< one value per tet
+    std::vector<Field> point; ///< one value per vertex
+    std::vector<Field> cell;  ///< one value per tet
 };
 
 /// Notes a reader makes without failing (for example "skipped 12 cells of type 5").
 struct ReadNotes {
-    std::int64_t skipped_cells = 0;       ///< non-tet cells skipped
-    std::vector<std::string> messages;    ///< human-readable notes
+    std::int64_t skipped_cells = 0;    ///< non-tet cells skipped
+    std::vector<std::string> messages; ///< human-readable notes
 };
 
 /// Formats by extension: .vtk .vtu .msh .node/.ele (either name) .mesh .veg (tet meshes);
 /// surfaces (.obj .stl .ply .off .gltf .glb ...) are not tet meshes: use surface.hpp.
 TetMesh read_mesh(const std::string& path, ReadNotes* notes = nullptr);
-/// Writers by extension: .vtu .vtk .msh (4.1) .mesh .node/.ele; surfaces (.obj .ply .stl .gltf/.glb) write the boundary.
+/// Writers by extension: .vtu .vtk .msh (4.1) .mesh .node/.ele; surfaces (.obj .ply .stl .gltf/.glb) write the
+/// boundary.
 void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fields = {});
 /// True if `path` has an extension read_mesh knows.
 bool is_tet_mesh_path(const std::string& path);

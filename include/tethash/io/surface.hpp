@@ -7,8 +7,8 @@
 namespace tethash::io {
 
 struct SurfaceMesh {
-    Positions vertices;   ///< k × 3
-    Triangles triangles;  ///< t × 3
+    Positions vertices;  ///< k × 3
+    Triangles triangles; ///< t × 3
 };
 
 /// True when tethash was built with assimp.

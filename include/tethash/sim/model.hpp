@@ -16,31 +16,31 @@
 namespace tethash::sim {
 
 struct Springs {
-    Edges edges;                   ///< e × 2 vertex ids
-    std::vector<double> rest;      ///< e rest lengths
-    std::vector<double> k;         ///< e stiffnesses (force / length)
-    std::vector<double> c;         ///< e dashpot coefficients (force · s / length)
+    Edges edges;              ///< e × 2 vertex ids
+    std::vector<double> rest; ///< e rest lengths
+    std::vector<double> k;    ///< e stiffnesses (force / length)
+    std::vector<double> c;    ///< e dashpot coefficients (force · s / length)
 };
 
 struct VolumeTerms {
-    Tets tets;                     ///< tets of the dynamic objects
-    std::vector<double> rest;      ///< rest signed volumes (> 0 after orientation)
-    std::vector<double> k;         ///< stiffness: energy ½ k V0 ((V − V0)/V0)²
+    Tets tets;                ///< tets of the dynamic objects
+    std::vector<double> rest; ///< rest signed volumes (> 0 after orientation)
+    std::vector<double> k;    ///< stiffness: energy ½ k V0 ((V − V0)/V0)²
 };
 
 /// Energy split (force × length). `total()` = kinetic + elastic + volume + gravity + ground + contact.
 struct Energy {
     double kinetic = 0, spring = 0, volume = 0, gravity = 0, ground = 0, contact = 0;
     double total() const { return kinetic + spring + volume + gravity + ground + contact; }
-    double internal() const { return kinetic + spring + volume + ground + contact; }  ///< all ≥ 0
+    double internal() const { return kinetic + spring + volume + ground + contact; } ///< all ≥ 0
 };
 
 /// Everything computed once from the rest state.
 struct Model {
     Springs springs;
     VolumeTerms volumes;
-    std::vector<double> mass;      ///< n lumped masses (static objects: their own mass, unused)
-    std::vector<char> fixed;       ///< n: 1 = pinned or static (never moves)
+    std::vector<double> mass; ///< n lumped masses (static objects: their own mass, unused)
+    std::vector<char> fixed;  ///< n: 1 = pinned or static (never moves)
     Eigen::Vector3d gravity{0, 0, 0};
     Ground ground;
     /// Per-vertex ground penalty stiffness and damping (n each); empty: ground.stiffness / ground.damping
@@ -58,11 +58,12 @@ struct Model {
     struct ForceOptions {
         enum Part : unsigned { springs = 1, damping = 2, volume = 4, gravity = 8, ground = 16, all = 31 };
         unsigned parts = all;
-        double h = 0;                 ///< > 0: friction capped so that it cannot reverse a sliding velocity in one step of h
-        double volume_scale = 1;      ///< multiplies the volume term
-        double ground_scale = 1;      ///< multiplies the ground stiffness and damping
+        double h = 0;            ///< > 0: friction capped so that it cannot reverse a sliding velocity in one step of h
+        double volume_scale = 1; ///< multiplies the volume term
+        double ground_scale = 1; ///< multiplies the ground stiffness and damping
     };
-    /// f += spring, damping, volume, gravity and ground forces at (x, v); fixed vertices included (callers ignore them).
+    /// f += spring, damping, volume, gravity and ground forces at (x, v); fixed vertices included (callers ignore
+    /// them).
     void add_forces(const Positions& x, const Positions& v, Positions& f) const { add_forces(x, v, f, ForceOptions{}); }
     void add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const;
     /// Only the spring forces (elastic part, no damping).
@@ -96,13 +97,13 @@ struct Model {
     /// Products are gathered per vertex over its springs and tets (no write conflicts; serial: on the shared
     /// 2-core machine OpenMP regions per CG iteration measured 5-8× slower than one thread).
     struct Linearised {
-        std::vector<Eigen::Matrix3d> spring_block;         ///< per spring
-        std::vector<Eigen::Matrix<double, 4, 3>> grad;     ///< per volume term: ∇V scaled by sqrt(scale_k k_V / V0)
-        std::vector<double> ground;                        ///< per vertex scale_k k_g + scale_c c_g (0: not touching)
+        std::vector<Eigen::Matrix3d> spring_block;     ///< per spring
+        std::vector<Eigen::Matrix<double, 4, 3>> grad; ///< per volume term: ∇V scaled by sqrt(scale_k k_V / V0)
+        std::vector<double> ground;                    ///< per vertex scale_k k_g + scale_c c_g (0: not touching)
         // Vertex adjacency (built on the first update, reused while the model's sizes stay the same).
-        std::vector<Index> spring_start, spring_other, spring_id;   ///< CSR: vertex → (other end, spring)
-        std::vector<Index> tet_start, tet_slot;                     ///< CSR: vertex → 4 · volume term + corner
-        mutable std::vector<double> tet_dot;                        ///< scratch: ∇V · p per volume term
+        std::vector<Index> spring_start, spring_other, spring_id; ///< CSR: vertex → (other end, spring)
+        std::vector<Index> tet_start, tet_slot;                   ///< CSR: vertex → 4 · volume term + corner
+        mutable std::vector<double> tet_dot;                      ///< scratch: ∇V · p per volume term
         const Model* model = nullptr;
         /// Re-evaluates the blocks at x (the adjacency is kept).
         void update(const Model& m, const Positions& x, double scale_k, double scale_c);

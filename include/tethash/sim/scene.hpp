@@ -17,9 +17,9 @@
 namespace tethash::sim {
 
 enum class Integrator {
-    symplectic_euler,  ///< v += h M⁻¹ f(x, v); x += h v. Explicit: stable only below ~2/ω_max.
-    implicit_euler,    ///< backward Euler linearised once per step (Baraff & Witkin 1998), sparse solve.
-    local_global,      ///< Liu et al. 2013 "Fast Simulation of Mass-Spring Systems": prefactored global matrix.
+    symplectic_euler, ///< v += h M⁻¹ f(x, v); x += h v. Explicit: stable only below ~2/ω_max.
+    implicit_euler,   ///< backward Euler linearised once per step (Baraff & Witkin 1998), sparse solve.
+    local_global,     ///< Liu et al. 2013 "Fast Simulation of Mass-Spring Systems": prefactored global matrix.
 };
 /// "symplectic_euler" (alias "symplectic", "explicit"), "implicit_euler" (alias "implicit"),
 /// "local_global" (alias "liu", "projective"); throws Error naming the value otherwise.
@@ -32,61 +32,61 @@ const char* to_string(LinearSolver solver);
 
 /// Elastic material of one object.
 struct Material {
-    double density = 1000;          ///< mass per volume; vertex mass = Σ density · |V_tet| / 4
-    double stiffness = 0;           ///< > 0: every spring gets this stiffness (force / length)
-    double young = 1e5;             ///< used when stiffness == 0: spring k = young · rest length (force / area)
-    double damping = 0.01;          ///< spring damping as a time: dashpot c = damping · k (s)
-    double volume_stiffness = 1.0;  ///< per-tet volume term k_V = volume_stiffness · young (or · k / mean rest edge)
+    double density = 1000;         ///< mass per volume; vertex mass = Σ density · |V_tet| / 4
+    double stiffness = 0;          ///< > 0: every spring gets this stiffness (force / length)
+    double young = 1e5;            ///< used when stiffness == 0: spring k = young · rest length (force / area)
+    double damping = 0.01;         ///< spring damping as a time: dashpot c = damping · k (s)
+    double volume_stiffness = 1.0; ///< per-tet volume term k_V = volume_stiffness · young (or · k / mean rest edge)
 };
 
 /// One object of the scene.
 struct ObjectSpec {
-    std::string name;                  ///< for messages; default "object K"
-    std::string mesh;                  ///< tet mesh file, or closed surface file (tetrahedralized on load)
-    std::optional<io::GenerateParams> generate;   ///< built-in shape (used when `mesh` is empty)
-    std::optional<TetMesh> data;       ///< in-memory mesh (code only; used when mesh and generate are empty)
-    int surface_resolution = 16;       ///< lattice resolution when `mesh` is a surface
-    Eigen::Vector3d scale{1, 1, 1};    ///< applied first
-    Eigen::Vector3d rotate_deg{0, 0, 0};  ///< then rotations about x, y, z (degrees, in that order)
-    Eigen::Vector3d translate{0, 0, 0};   ///< then translation
-    Eigen::Vector3d velocity{0, 0, 0};    ///< initial velocity of every vertex
+    std::string name;                           ///< for messages; default "object K"
+    std::string mesh;                           ///< tet mesh file, or closed surface file (tetrahedralized on load)
+    std::optional<io::GenerateParams> generate; ///< built-in shape (used when `mesh` is empty)
+    std::optional<TetMesh> data;                ///< in-memory mesh (code only; used when mesh and generate are empty)
+    int surface_resolution = 16;                ///< lattice resolution when `mesh` is a surface
+    Eigen::Vector3d scale{1, 1, 1};             ///< applied first
+    Eigen::Vector3d rotate_deg{0, 0, 0};        ///< then rotations about x, y, z (degrees, in that order)
+    Eigen::Vector3d translate{0, 0, 0};         ///< then translation
+    Eigen::Vector3d velocity{0, 0, 0};          ///< initial velocity of every vertex
     Material material;
     bool self_collision = true;
-    bool is_static = false;            ///< never moves: an obstacle (hashed once by the detector)
+    bool is_static = false; ///< never moves: an obstacle (hashed once by the detector)
 };
 
 /// Vertices held fixed: by ids (local to `object`, or global when object < 0) and/or by a box.
 struct PinRegion {
-    int object = -1;                   ///< object index, or -1 for all objects
-    std::vector<Index> vertices;       ///< vertex ids (local to the object if object ≥ 0)
+    int object = -1;             ///< object index, or -1 for all objects
+    std::vector<Index> vertices; ///< vertex ids (local to the object if object ≥ 0)
     bool has_box = false;
-    Eigen::Vector3d box_min{0, 0, 0}, box_max{0, 0, 0};   ///< closed box, world coordinates at start
+    Eigen::Vector3d box_min{0, 0, 0}, box_max{0, 0, 0}; ///< closed box, world coordinates at start
 };
 
 /// Ground: the half space {x : n·x < height} is solid.
 struct Ground {
     bool enabled = false;
-    Eigen::Vector3d normal{0, 0, 1};   ///< normalised on load
+    Eigen::Vector3d normal{0, 0, 1}; ///< normalised on load
     double height = 0;
-    double stiffness = 0;              ///< penalty stiffness per vertex (force / length); 0 = automatic per vertex:
-                                       ///< contact.stiffness if given, else 10 × the stiffest spring of its object
-    double damping = 0;                ///< normal damping (force · s / length); 0 = per vertex sqrt(k · m) (half critical)
-    double friction = 0.5;             ///< Coulomb coefficient
+    double stiffness = 0;  ///< penalty stiffness per vertex (force / length); 0 = automatic per vertex:
+                           ///< contact.stiffness if given, else 10 × the stiffest spring of its object
+    double damping = 0;    ///< normal damping (force · s / length); 0 = per vertex sqrt(k · m) (half critical)
+    double friction = 0.5; ///< Coulomb coefficient
 };
 
 /// Contact response: penalty force f = k·d·r − c·(v_rel·r) r on the vertex, minus that with barycentric
 /// weights on the four vertices of the penetrated tet.
 struct ContactParams {
-    double stiffness = 0;      ///< force / length; 0 = automatic per pair of objects a, b: 10 × the harmonic mean
-                               ///< of their stiffest springs (a static object counts as stiff as its partner)
-    double damping = 0;        ///< force · s / length; 0 = automatic per contact: sqrt(k · reduced mass) (half critical)
-    double friction = 0;       ///< Coulomb coefficient (0: off)
-    bool in_matrix = true;     ///< implicit Euler: contact stiffness in the system matrix
+    double stiffness = 0;  ///< force / length; 0 = automatic per pair of objects a, b: 10 × the harmonic mean
+                           ///< of their stiffest springs (a static object counts as stiff as its partner)
+    double damping = 0;    ///< force · s / length; 0 = automatic per contact: sqrt(k · reduced mass) (half critical)
+    double friction = 0;   ///< Coulomb coefficient (0: off)
+    bool in_matrix = true; ///< implicit Euler: contact stiffness in the system matrix
 };
 
 struct Output {
-    int every = 1;                                  ///< write a frame every N steps (0: never)
-    std::vector<std::string> fields{"velocity", "contact", "depth", "object"};  ///< of these
+    int every = 1; ///< write a frame every N steps (0: never)
+    std::vector<std::string> fields{"velocity", "contact", "depth", "object"}; ///< of these
 };
 
 struct Scene {
@@ -94,13 +94,13 @@ struct Scene {
     Eigen::Vector3d gravity{0, 0, -9.81};
     Ground ground;
     std::vector<PinRegion> pins;
-    double dt = 1e-3;                  ///< time step (s), split into `substeps`
+    double dt = 1e-3; ///< time step (s), split into `substeps`
     int steps = 1000;
     int substeps = 1;
     Integrator integrator = Integrator::implicit_euler;
     LinearSolver solver = LinearSolver::cg;
-    int iterations = 10;               ///< local/global iterations per substep; CG: max iterations = 10 × this... see docs
-    double tolerance = 1e-6;           ///< CG relative residual
+    int iterations = 10;     ///< local/global iterations per substep; CG: max iterations = 10 × this... see docs
+    double tolerance = 1e-6; ///< CG relative residual
     ContactParams contact;
     /// Detector parameters. threads defaults to 1 here (not 0 = all cores): the detection of a simulation step
     /// is short, and on a shared 2-core machine the OpenMP workers spinning between steps slowed whole steps
@@ -115,7 +115,7 @@ struct Scene {
         return p;
     }();
     Output output;
-    std::string source = "<code>";     ///< file it was read from (messages)
+    std::string source = "<code>"; ///< file it was read from (messages)
 };
 
 /// Reads a TOML scene file. Relative mesh paths are relative to the scene file's folder.

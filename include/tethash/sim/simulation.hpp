@@ -37,7 +37,7 @@ struct StepStats {
 class SimulationImpl;
 
 class Simulation {
-public:
+  public:
     /// Builds objects (reads files / generates shapes), the model and the detector. Throws Error on bad
     /// input (missing file, zero-volume tet, pinned ids out of range...).
     explicit Simulation(const Scene& scene);
@@ -53,23 +53,23 @@ public:
     void step();
 
     const Scene& scene() const;
-    std::int64_t step_index() const;   ///< steps completed
-    double time() const;               ///< simulated time (s)
+    std::int64_t step_index() const; ///< steps completed
+    double time() const;             ///< simulated time (s)
 
     /// The whole scene as one mesh (objects in order, object ids set), positions = current positions.
     const TetMesh& mesh() const;
-    const Positions& positions() const;      ///< n × 3
-    const Positions& velocities() const;     ///< n × 3
+    const Positions& positions() const;  ///< n × 3
+    const Positions& velocities() const; ///< n × 3
     const Model& model() const;
     /// Vertex range [first, first + count) and tet range of object k in mesh().
     std::pair<Index, Index> object_vertices(int k) const;
     std::pair<Index, Index> object_tets(int k) const;
 
-    Energy energy() const;                   ///< at the current state (contact term from the last contacts)
-    Eigen::Vector3d momentum() const;        ///< Σ m v over non-fixed vertices
+    Energy energy() const;            ///< at the current state (contact term from the last contacts)
+    Eigen::Vector3d momentum() const; ///< Σ m v over non-fixed vertices
 
-    const std::vector<Contact>& contacts() const;   ///< of the last detection, depth/direction filled
-    double max_penetration() const;          ///< max depth over contacts() (0 if none)
+    const std::vector<Contact>& contacts() const; ///< of the last detection, depth/direction filled
+    double max_penetration() const;               ///< max depth over contacts() (0 if none)
     double mean_penetration() const;
     /// Exact distance of each contact's vertex to the penetrated object's boundary (for error studies).
     std::vector<double> exact_depths() const;
@@ -92,7 +92,7 @@ public:
     /// filtered by scene().output.fields.
     io::Fields output_fields() const;
 
-private:
+  private:
     std::unique_ptr<SimulationImpl> m_impl;
 };
 

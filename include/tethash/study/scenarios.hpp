@@ -15,11 +15,11 @@ namespace tethash::study {
 
 /// What the paper lists for one scenario.
 struct ScenarioSpec {
-    std::string name;       ///< "teschner1" .. "teschner5"
-    int objects = 0;        ///< number of objects
-    int tets = 0;           ///< total tets in the paper
-    int vertices = 0;       ///< total vertices in the paper
-    double paper_ms = 0;    ///< the paper's detection time (Pentium 4, 1.8 GHz), milliseconds
+    std::string name;    ///< "teschner1" .. "teschner5"
+    int objects = 0;     ///< number of objects
+    int tets = 0;        ///< total tets in the paper
+    int vertices = 0;    ///< total vertices in the paper
+    double paper_ms = 0; ///< the paper's detection time (Pentium 4, 1.8 GHz), milliseconds
 };
 
 /// The five scenarios of the paper's table: (100, 1000, 1200), (8, 4000, 1936), (20, 10000, 4840),
@@ -30,9 +30,9 @@ const std::vector<ScenarioSpec>& teschner_specs();
 /// (centre spacing 0.6 × the object's size) so that each object overlaps its neighbours.
 struct Scenario {
     ScenarioSpec spec;
-    TetMesh mesh;           ///< all objects; vertex_object / tet_object set (0 .. objects-1)
-    std::string shape;      ///< generator shape of each object
-    int resolution = 0;     ///< generator resolution of each object
+    TetMesh mesh;       ///< all objects; vertex_object / tet_object set (0 .. objects-1)
+    std::string shape;  ///< generator shape of each object
+    int resolution = 0; ///< generator resolution of each object
 };
 
 /// Scenario `index` (0 .. 4). Throws Error for an index out of range.

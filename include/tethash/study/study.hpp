@@ -38,31 +38,31 @@ struct StudyOptions {
     /// Scenes from mesh files: each entry is one scene; "a.vtu+b.vtu" joins files into one scene of several
     /// objects (vertex and tet ids in argument order).
     std::vector<std::string> meshes;
-    std::string scene_file;        ///< a simulator scene (TOML); needed by the integrator sweep
-    bool teschner = false;         ///< the five scenarios of Teschner 2003 (scenarios.hpp)
-    std::vector<int> scenarios;    ///< with `teschner`: which of them (1 .. 5); empty: all five
+    std::string scene_file;     ///< a simulator scene (TOML); needed by the integrator sweep
+    bool teschner = false;      ///< the five scenarios of Teschner 2003 (scenarios.hpp)
+    std::vector<int> scenarios; ///< with `teschner`: which of them (1 .. 5); empty: all five
 
-    std::vector<std::string> cell_size;   ///< specs (see above); empty: the sweep's default
+    std::vector<std::string> cell_size; ///< specs (see above); empty: the sweep's default
     std::vector<std::string> table_size;
     std::vector<std::string> hash;
     std::vector<std::string> threads;
-    std::vector<std::string> grid;        ///< for Sweep::grid: the two swept parameters (cell-size, table-size, hash, threads)
+    std::vector<std::string> grid; ///< for Sweep::grid: the two swept parameters (cell-size, table-size, hash, threads)
 
-    std::vector<std::string> integrator;  ///< simulator sweep
+    std::vector<std::string> integrator; ///< simulator sweep
     std::vector<std::string> dt;
     std::vector<std::string> substeps;
-    double duration = 0;                  ///< simulated seconds; 0: the scene's own duration
-    int samples = 4;                      ///< fixed times (evenly spaced, the last at the end) where errors are taken
-    double reference_factor = 16;         ///< the reference run uses dt / reference_factor (of the smallest dt)
+    double duration = 0;          ///< simulated seconds; 0: the scene's own duration
+    int samples = 4;              ///< fixed times (evenly spaced, the last at the end) where errors are taken
+    double reference_factor = 16; ///< the reference run uses dt / reference_factor (of the smallest dt)
 
-    int repeat = 3;                       ///< measured repeats per point (after one warm-up)
+    int repeat = 3; ///< measured repeats per point (after one warm-up)
     int warmup = 1;
     bool oracle = true;                   ///< compare every detection with the brute-force oracle
     bool penetration = true;              ///< measure the penetration-depth error (if available)
     int shard_index = 0, shard_count = 1; ///< run points with index % shard_count == shard_index
     std::string out_dir = "study";
-    std::string command_line;             ///< recorded in study.json
-    std::string compiler_flags;           ///< recorded in study.json
+    std::string command_line;   ///< recorded in study.json
+    std::string compiler_flags; ///< recorded in study.json
 };
 
 /// Parses "I/N" (0 ≤ I < N); throws Error naming the option otherwise.
@@ -73,10 +73,10 @@ struct PointInfo {
     std::int64_t index = 0;
     std::string scene;
     std::vector<std::pair<std::string, std::string>> params;
-    std::string label() const;   ///< "scene cell_factor=1 table_size=4096 ..." for progress lines
+    std::string label() const; ///< "scene cell_factor=1 table_size=4096 ..." for progress lines
 };
 
-struct StudyPlan;   // opaque: scenes, points, columns
+struct StudyPlan; // opaque: scenes, points, columns
 
 /// Validates every option and loads the scenes (no measurement yet). Throws Error on bad input
 /// (empty range, cell size ≤ 0, table size 0, unknown names, missing mesh, bad shard).

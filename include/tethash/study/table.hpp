@@ -31,7 +31,7 @@ bool is_timing_column(const std::string& name);
 
 /// Appends rows to a CSV file as they are measured; every row is flushed at once.
 class CsvWriter {
-public:
+  public:
     CsvWriter() = default;
     /// Without close(): removes the temporary file; an existing file at the path stays as it was.
     ~CsvWriter();
@@ -47,7 +47,7 @@ public:
     /// Drops the temporary file (what the destructor does when close() was not called).
     void abandon();
 
-private:
+  private:
     std::FILE* m_file = nullptr;
     std::string m_path;
     std::string m_tmp_path;
