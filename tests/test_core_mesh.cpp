@@ -1,5 +1,6 @@
 // The mesh model: validation, reorientation, derived data (edges, boundary, adjacency, statistics, quality).
 #include "tethash/error.hpp"
+#include "tethash/geometry.hpp"
 #include "tethash/mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -296,4 +297,18 @@ TEST(MeshLabels, JoinMergesOnlyLabelsThatTouch)
     EXPECT_EQ(m.vertex_object[9], 0);
     EXPECT_EQ(m.vertex_object[4], 1);
     EXPECT_EQ(s.shared_vertices, 3);
+}
+
+TEST(Geometry, ClosestPointOnTriangleRegions)
+{
+    const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+    EXPECT_TRUE(closest_point_on_triangle({-1, -1, 3}, a, b, c).isApprox(a));       // vertex region
+    EXPECT_TRUE(closest_point_on_triangle({2, -0.5, 0}, a, b, c).isApprox(b));      // vertex region
+    EXPECT_TRUE(closest_point_on_triangle({0.5, -2, 1}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0, 0))); // edge ab
+    EXPECT_TRUE(closest_point_on_triangle({1, 1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));  // edge bc
+    EXPECT_TRUE(closest_point_on_triangle({0.2, 0.3, -4}, a, b, c).isApprox(Eigen::Vector3d(0.2, 0.3, 0))); // face
+    // A zero-area triangle answers with a point of it, never NaN.
+    const Eigen::Vector3d q = closest_point_on_triangle({0.5, 1, 0}, a, b, Eigen::Vector3d(2, 0, 0));
+    EXPECT_TRUE(q.allFinite());
+    EXPECT_NEAR(q.y(), 0.0, 1e-12);
 }

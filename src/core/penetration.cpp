@@ -1,5 +1,7 @@
 #include "tethash/penetration.hpp"
 
+#include "tethash/geometry.hpp"
+
 #include "tethash/error.hpp"
 
 #include <Eigen/Geometry>
@@ -36,28 +38,6 @@ Vec3 outward_normal(const PositionsRef& x, const Face& f)
     if (n.dot(pos(x, f.opp) - a) > 0) n = -n;
     const double len = n.norm();
     return len > 0 ? Vec3(n / len) : Vec3::Zero();
-}
-
-/// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
-Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
-{
-    const Vec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0 && d2 <= 0) return a;
-    const Vec3 bp = p - b;
-    const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0 && d4 <= d3) return b;
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
-    const Vec3 cp = p - c;
-    const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0 && d5 <= d6) return c;
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
-    const double denom = 1.0 / (va + vb + vc);
-    return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
 /// Segment p + t (q − p), t ∈ [0, 1], against triangle abc (Möller–Trumbore, both sides). Returns t or −1.
@@ -148,7 +128,7 @@ class Bvh {
                     const Index f = m_order[static_cast<size_t>(k)];
                     const Face& fc = (*m_faces)[static_cast<size_t>(f)];
                     if (!accept(fc)) continue;
-                    const Vec3 c = closest_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+                    const Vec3 c = closest_point_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
                     const double d2 = (c - p).squaredNorm();
                     if (d2 < best_d2) {
                         best_d2 = d2;

@@ -3,6 +3,7 @@
 #include "tethash/io/generate.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/geometry.hpp"
 
 #include <Eigen/Geometry>
 
@@ -421,7 +422,7 @@ class SurfaceTree {
             if (nd.left < 0) {
                 for (int i = nd.begin; i < nd.end; ++i) {
                     const auto t = static_cast<std::size_t>(m_order[static_cast<std::size_t>(i)]);
-                    const Vec3 c = closest_on_triangle(q, vertex(t, 0), vertex(t, 1), vertex(t, 2));
+                    const Vec3 c = closest_point_on_triangle(q, vertex(t, 0), vertex(t, 1), vertex(t, 2));
                     const double d2 = (c - q).squaredNorm();
                     if (d2 < best) {
                         best = d2;
@@ -513,29 +514,6 @@ class SurfaceTree {
         const double num = a.dot(b.cross(c));
         const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
         return 2.0 * std::atan2(num, den);
-    }
-
-    /// Closest point to p on triangle (a, b, c), by the Voronoi regions of its vertices and edges.
-    static Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
-    {
-        const Vec3 ab = b - a, ac = c - a, ap = p - a;
-        const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-        if (d1 <= 0 && d2 <= 0) return a;
-        const Vec3 bp = p - b;
-        const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-        if (d3 >= 0 && d4 <= d3) return b;
-        const double vc = d1 * d4 - d3 * d2;
-        if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
-        const Vec3 cp = p - c;
-        const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-        if (d6 >= 0 && d5 <= d6) return c;
-        const double vb = d5 * d2 - d1 * d6;
-        if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
-        const double va = d3 * d6 - d5 * d4;
-        if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-        const double den = va + vb + vc;
-        if (!(den > 0)) return a; // degenerate triangle
-        return a + ab * (vb / den) + ac * (vc / den);
     }
 
     const SurfaceMesh& m_s;
