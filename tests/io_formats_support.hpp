@@ -19,16 +19,8 @@ inline std::filesystem::path data_file(const std::string& rel)
     return std::filesystem::path(TETHASH_SOURCE_DIR) / "tests" / "data" / rel;
 }
 
-/// Shell-quoted path. (Built by appending: GCC 12 warns falsely (-Wrestrict) about "'" + s + "'".)
-inline std::string q(const std::filesystem::path& p)
-{
-    std::string s;
-    s.reserve(p.native().size() + 2);
-    s += '\'';
-    s += p.native();
-    s += '\'';
-    return s;
-}
+/// Shell-quoted path (support.hpp's quote()).
+inline std::string q(const std::filesystem::path& p) { return quote(p); }
 
 /// 1-based number of the first line of `text` that contains `needle` (0 if none).
 inline int line_of(const std::string& text, const std::string& needle)
