@@ -17,6 +17,7 @@ Integrator parse_integrator(const std::string& name)
     if (name == "symplectic_euler" || name == "symplectic" || name == "explicit") return Integrator::symplectic_euler;
     if (name == "implicit_euler" || name == "implicit") return Integrator::implicit_euler;
     if (name == "local_global" || name == "liu" || name == "projective") return Integrator::local_global;
+    if (name == "vbd" || name == "block_descent") return Integrator::vbd;
     throw Error("integrator '" + name + "' unknown (symplectic_euler, implicit_euler, local_global)");
 }
 
@@ -29,6 +30,8 @@ const char* to_string(Integrator integrator)
         return "implicit_euler";
     case Integrator::local_global:
         return "local_global";
+    case Integrator::vbd:
+        return "vbd";
     }
     return "?";
 }

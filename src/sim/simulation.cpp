@@ -752,6 +752,7 @@ void Simulation::step()
         case Integrator::symplectic_euler:
             s.substep_symplectic(h);
             break;
+        case Integrator::vbd:
         case Integrator::implicit_euler:
             st.solver_iterations += s.substep_implicit(h);
             break;

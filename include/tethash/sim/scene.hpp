@@ -20,6 +20,7 @@ enum class Integrator {
     symplectic_euler, ///< v += h M⁻¹ f(x, v); x += h v. Explicit: stable only below ~2/ω_max.
     implicit_euler,   ///< backward Euler linearised once per step (Baraff & Witkin 1998), sparse solve.
     local_global,     ///< Liu et al. 2013 "Fast Simulation of Mass-Spring Systems": prefactored global matrix.
+    vbd,              ///< Vertex Block Descent (Chen et al. 2024): per-vertex Newton steps in colour order.
 };
 /// "symplectic_euler" (alias "symplectic", "explicit"), "implicit_euler" (alias "implicit"),
 /// "local_global" (alias "liu", "projective"); throws Error naming the value otherwise.

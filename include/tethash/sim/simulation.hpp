@@ -26,7 +26,8 @@ namespace tethash::sim {
 /// Timing and contact figures of one step (all its substeps). Times in milliseconds.
 struct StepStats {
     double ms_detect = 0;      ///< Detector::detect
-    double ms_response = 0;    ///< penetration depth + contact forces
+    double ms_depth = 0;       ///< penetration depth and direction (Penetration::compute)
+    double ms_response = 0;    ///< contact set-up: filtering, stiffness, damping, per-vertex lists
     double ms_integrate = 0;   ///< forces, matrix assembly, solve, update
     std::int64_t contacts = 0; ///< contacts at the last substep
     double max_depth = 0;      ///< largest penetration depth at the last substep (0 without contacts)
