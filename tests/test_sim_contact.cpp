@@ -66,7 +66,7 @@ double run(Simulation& sim, int steps)
 
 TEST(SimContact, BodyDroppedOnGroundComesToRestAtTheRightHeight)
 {
-    for (Integrator integ : {Integrator::implicit_euler, Integrator::local_global}) {
+    for (Integrator integ : {Integrator::implicit_euler, Integrator::vbd}) {
         Scene s;
         s.objects.push_back(box_object(0.5, {0, 0, 0.5}));
         s.ground.enabled = true;
@@ -250,16 +250,17 @@ TEST(SimContact, NearlyFlatTetsAtStartStayFinite)
 
 TEST(SimContact, FoldedBarEndsWithoutDeepSelfPenetration)
 {
-    // The shipped folding bar at a lower resolution: it buckles and folds onto itself (self-contacts).
+    // The shipped folding bar: it buckles and folds onto itself (self-contacts, most of them in the tight fold
+    // and so left to the elastic terms as local).
     Scene s = load_scene(std::string(TETHASH_SOURCE_DIR) + "/meshes/scenes/folding_bar.toml");
-    s.objects[0].generate->resolution = 12;
     s.output.every = 0;
     Simulation sim(s);
     std::int64_t self_contacts = 0;
-    for (int i = 0; i < 300; ++i) {
+    for (int i = 0; i < 400; ++i) {
         sim.step();
         for (const Contact& c : sim.contacts())
             self_contacts += c.vertex_object == c.tet_object ? 1 : 0;
+        self_contacts += sim.last_stats().ignored_local;
     }
     EXPECT_GT(self_contacts, 0);
     EXPECT_TRUE(sim.positions().allFinite());

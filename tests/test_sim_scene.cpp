@@ -28,7 +28,7 @@ TEST(SimScene, ReadsEveryKey)
 dt = 0.005
 steps = 12
 substeps = 3
-integrator = "local_global"
+integrator = "vbd"
 solver = "ldlt"
 iterations = 7
 tolerance = 1e-8
@@ -72,7 +72,7 @@ box_max = [1, 1, 1]
     EXPECT_EQ(s.dt, 0.005);
     EXPECT_EQ(s.steps, 12);
     EXPECT_EQ(s.substeps, 3);
-    EXPECT_EQ(s.integrator, Integrator::local_global);
+    EXPECT_EQ(s.integrator, Integrator::vbd);
     EXPECT_EQ(s.solver, LinearSolver::ldlt);
     EXPECT_EQ(s.iterations, 7);
     EXPECT_EQ(s.gravity.y(), -9.8);

@@ -34,6 +34,12 @@ double volume_and_gradient(const Positions& x, const Index* t, Eigen::Matrix<dou
     return ba.dot(ca.cross(da)) / 6.0;
 }
 
+/// Volume of the regular tet of edge length l: l³ / (6 √2).
+double regular_tet_volume(double l)
+{
+    return l * l * l / (6.0 * std::sqrt(2.0));
+}
+
 } // namespace
 
 Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
@@ -50,15 +56,20 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
             throw Error("model: no material for object " + std::to_string(o));
         return materials[static_cast<size_t>(o)];
     };
+    Index objects = 0;
+    m.vertex_object.assign(static_cast<size_t>(n), 0);
+    for (Index i = 0; i < n; ++i) {
+        m.vertex_object[static_cast<size_t>(i)] = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
+        objects = std::max(objects, m.vertex_object[static_cast<size_t>(i)] + 1);
+    }
+    objects = std::max<Index>(objects, static_cast<Index>(materials.size()));
 
     m.mass.assign(static_cast<size_t>(n), 0.0);
     m.fixed.assign(static_cast<size_t>(n), 0);
-    for (Index i = 0; i < n; ++i) {
-        const Index o = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
-        if (is_static(o)) m.fixed[static_cast<size_t>(i)] = 1;
-    }
+    for (Index i = 0; i < n; ++i)
+        if (is_static(m.vertex_object[static_cast<size_t>(i)])) m.fixed[static_cast<size_t>(i)] = 1;
 
-    // Dynamic tets: masses and volume terms. A per-vertex "young" for springs from their adjacent tets.
+    // Dynamic tets: rest volumes (oriented positive), lumped masses, volume terms.
     std::vector<Index> dyn;
     for (Index t = 0; t < mesh.num_tets(); ++t)
         if (!is_static(tet_obj(t))) dyn.push_back(t);
@@ -87,52 +98,102 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         const double young = mat.stiffness > 0 ? mat.stiffness / lmean : mat.young;
         for (int a = 0; a < 4; ++a)
             m.volumes.tets(static_cast<Index>(q), a) = v[a];
-        // Nearly flat rest tets would give a huge stiffness k/V0·|∇V|²; the volume scale is floored at
-        // 1e-3·l³ (a regular tet has ≈ 0.118·l³) so that slivers stay as stiff as an ordinary tet.
-        // Stored so that k/V0 = volume_stiffness·young / max(V0, 1e-3·l³).
+        // Energy ½ (volume_stiffness · young / V̂) (V − V0)² with V̂ = max(V0, 0.1 × the volume of the regular
+        // tet of this tet's mean edge): a sliver's volume term is no stiffer than a tenth-size regular tet's,
+        // so slivers neither dominate the stiffness-to-mass ratios nor get crushed. Stored as k with
+        // k / V0 = volume_stiffness · young / V̂.
+        const double vhat = std::max(vol, 0.1 * regular_tet_volume(lmean));
         m.volumes.rest[q] = vol;
-        m.volumes.k[q] = mat.volume_stiffness * young * vol / std::max(vol, 1e-3 * lmean * lmean * lmean);
+        m.volumes.k[q] = mat.volume_stiffness * young * vol / vhat;
     }
 
-    // Springs: unique edges of the dynamic tets.
+    // Springs: unique edges of the dynamic tets, Van Gelder stiffness k = young · ΣV_adjacent / L0².
     Tets dyn_tets(static_cast<Index>(dyn.size()), 4);
     for (size_t q = 0; q < dyn.size(); ++q)
-        dyn_tets.row(static_cast<Index>(q)) = mesh.tets.row(dyn[q]);
+        dyn_tets.row(static_cast<Index>(q)) = m.volumes.tets.row(static_cast<Index>(q));
     m.springs.edges = unique_edges(dyn_tets);
     const Index ne = static_cast<Index>(m.springs.edges.rows());
+    // Volume around each edge: per vertex a sorted list of (other end, edge), then every tet's six edges.
+    std::vector<double> edge_volume(static_cast<size_t>(ne), 0.0);
+    {
+        std::vector<Index> start(static_cast<size_t>(n + 1), 0);
+        for (Index e = 0; e < ne; ++e)
+            ++start[static_cast<size_t>(m.springs.edges(e, 0) + 1)];
+        for (Index i = 0; i < n; ++i)
+            start[static_cast<size_t>(i + 1)] += start[static_cast<size_t>(i)];
+        std::vector<Index> other(static_cast<size_t>(ne)), id(static_cast<size_t>(ne));
+        std::vector<Index> fill(start.begin(), start.end() - 1);
+        for (Index e = 0; e < ne; ++e) {
+            const size_t k = static_cast<size_t>(fill[static_cast<size_t>(m.springs.edges(e, 0))]++);
+            other[k] = m.springs.edges(e, 1);
+            id[k] = e;
+        }
+        auto find_edge = [&](Index a, Index b) {
+            if (a > b) std::swap(a, b);
+            for (Index k = start[static_cast<size_t>(a)]; k < start[static_cast<size_t>(a + 1)]; ++k)
+                if (other[static_cast<size_t>(k)] == b) return id[static_cast<size_t>(k)];
+            return Index{-1};
+        };
+        for (size_t q = 0; q < dyn.size(); ++q)
+            for (int a = 0; a < 4; ++a)
+                for (int b = a + 1; b < 4; ++b) {
+                    const Index e = find_edge(m.volumes.tets(static_cast<Index>(q), a), m.volumes.tets(static_cast<Index>(q), b));
+                    if (e >= 0) edge_volume[static_cast<size_t>(e)] += m.volumes.rest[q];
+                }
+    }
     m.springs.rest.resize(static_cast<size_t>(ne));
     m.springs.k.resize(static_cast<size_t>(ne));
     m.springs.c.resize(static_cast<size_t>(ne));
+    m.object_mean_edge.assign(static_cast<size_t>(objects), 0.0);
+    std::vector<double> edge_count(static_cast<size_t>(objects), 0.0);
+    std::vector<double> vertex_edge_sum(static_cast<size_t>(n), 0.0), vertex_edge_count(static_cast<size_t>(n), 0.0);
     for (Index e = 0; e < ne; ++e) {
         const Index i = m.springs.edges(e, 0), j = m.springs.edges(e, 1);
         const double len = (row(rest, i) - row(rest, j)).norm();
         if (!(len > 0))
             throw Error("model: edge (" + std::to_string(i) + ", " + std::to_string(j) + ") has zero rest length");
-        const Index o = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
+        const Index o = m.vertex_object[static_cast<size_t>(i)];
         const Material& mat = material(o);
-        const double k = mat.stiffness > 0 ? mat.stiffness : mat.young * len;
+        const double k = mat.stiffness > 0 ? mat.stiffness : mat.young * edge_volume[static_cast<size_t>(e)] / (len * len);
         m.springs.rest[static_cast<size_t>(e)] = len;
         m.springs.k[static_cast<size_t>(e)] = k;
         m.springs.c[static_cast<size_t>(e)] = mat.damping * k;
+        m.object_mean_edge[static_cast<size_t>(o)] += len;
+        edge_count[static_cast<size_t>(o)] += 1;
+        for (Index v : {i, j}) {
+            vertex_edge_sum[static_cast<size_t>(v)] += len;
+            vertex_edge_count[static_cast<size_t>(v)] += 1;
+        }
+    }
+    for (size_t o = 0; o < m.object_mean_edge.size(); ++o)
+        if (edge_count[o] > 0) m.object_mean_edge[o] /= edge_count[o];
+
+    // Mass floor: a vertex whose tets are all slivers lumps almost no mass while its edges are ordinary; it then
+    // sets the explicit limit and stalls the iterative solvers. Each free vertex gets at least a quarter of the
+    // volume of a tenth-size regular tet of its mean edge (the same V̂ floor as the volume term); the total mass
+    // of each object is then scaled back to density × volume.
+    {
+        std::vector<double> before(static_cast<size_t>(objects), 0.0), after(static_cast<size_t>(objects), 0.0);
+        for (Index i = 0; i < n; ++i) {
+            const size_t u = static_cast<size_t>(i);
+            const Index o = m.vertex_object[u];
+            if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
+            before[static_cast<size_t>(o)] += m.mass[u];
+            const double floor =
+                material(o).density * 0.25 * 0.1 * regular_tet_volume(vertex_edge_sum[u] / vertex_edge_count[u]);
+            m.mass[u] = std::max(m.mass[u], floor);
+            after[static_cast<size_t>(o)] += m.mass[u];
+        }
+        for (Index i = 0; i < n; ++i) {
+            const size_t u = static_cast<size_t>(i);
+            const size_t o = static_cast<size_t>(m.vertex_object[u]);
+            if (!m.fixed[u] && vertex_edge_count[u] > 0 && after[o] > 0) m.mass[u] *= before[o] / after[o];
+        }
     }
     for (Index i = 0; i < n; ++i)
         if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
             m.fixed[static_cast<size_t>(i)] = 1; // unreferenced vertex: nothing moves it
     return m;
-}
-
-void Model::add_spring_forces(const Positions& x, Positions& f) const
-{
-    const Index ne = static_cast<Index>(springs.edges.rows());
-    for (Index e = 0; e < ne; ++e) {
-        const Index i = springs.edges(e, 0), j = springs.edges(e, 1);
-        const Vec3 d = row(x, i) - row(x, j);
-        const double len = d.norm();
-        if (!(len > 0)) continue;
-        const Vec3 fi = -springs.k[static_cast<size_t>(e)] * (len - springs.rest[static_cast<size_t>(e)]) / len * d;
-        f.row(i) += fi.transpose();
-        f.row(j) -= fi.transpose();
-    }
 }
 
 void Model::add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const
@@ -248,11 +309,6 @@ double Model::omega_max_sq(const Positions& x) const
     for (size_t i = 0; i < mass.size(); ++i)
         if (!fixed[i]) w2 = std::max(w2, ksum[i] / mass[i]);
     return w2;
-}
-
-double Model::explicit_dt_limit(const Positions& x, double extra_k) const
-{
-    return explicit_dt_limit(x, std::vector<double>(mass.size(), extra_k), {});
 }
 
 double Model::explicit_dt_limit(const Positions& x, const std::vector<double>& extra_k,

@@ -16,9 +16,12 @@ Integrator parse_integrator(const std::string& name)
 {
     if (name == "symplectic_euler" || name == "symplectic" || name == "explicit") return Integrator::symplectic_euler;
     if (name == "implicit_euler" || name == "implicit") return Integrator::implicit_euler;
-    if (name == "local_global" || name == "liu" || name == "projective") return Integrator::local_global;
     if (name == "vbd" || name == "block_descent") return Integrator::vbd;
-    throw Error("integrator '" + name + "' unknown (symplectic_euler, implicit_euler, local_global)");
+    if (name == "local_global" || name == "liu" || name == "projective")
+        throw Error("integrator '" + name +
+                    "' was retired (it blew up on real meshes where implicit Euler held): use 'vbd', the default, "
+                    "which solves the same implicit step by per-vertex Newton iterations");
+    throw Error("integrator '" + name + "' unknown (vbd, implicit_euler, symplectic_euler)");
 }
 
 const char* to_string(Integrator integrator)
@@ -28,8 +31,6 @@ const char* to_string(Integrator integrator)
         return "symplectic_euler";
     case Integrator::implicit_euler:
         return "implicit_euler";
-    case Integrator::local_global:
-        return "local_global";
     case Integrator::vbd:
         return "vbd";
     }
@@ -287,7 +288,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     Scene s;
     s.source = source_name;
     r.check_keys(root, "",
-                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "gravity", "ground",
+                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance",
+                  "gravity", "ground",
                   "contact", "detector", "output", "object", "pin"});
     for (auto&& [k, v] : root) {
         const std::string key(k.str());
@@ -301,6 +303,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             s.iterations = static_cast<int>(r.integer_at_least(v, key, 1));
         else if (key == "tolerance")
             s.tolerance = r.positive(v, key);
+        else if (key == "sweep_tolerance")
+            s.sweep_tolerance = r.non_negative(v, key);
         else if (key == "gravity")
             s.gravity = r.vec3(v, key);
         else if (key == "integrator") {
@@ -496,7 +500,7 @@ const std::string& default_scene_text()
         R"(# tethash default scene: a soft bar, a ball and a ring dropped onto a static block and the ground.
 dt = 2e-3
 steps = 400
-integrator = "implicit_euler"
+integrator = "vbd"
 gravity = [0, 0, -9.81]
 
 [ground]

@@ -153,7 +153,7 @@ void plan_sim_study(StudyPlan& plan)
             if (it.empty()) throw Error("--integrator: empty value in '" + spec + "'");
             if (it == "all") {
                 integrators.insert(integrators.end(), {sim::Integrator::symplectic_euler,
-                                                       sim::Integrator::implicit_euler, sim::Integrator::local_global});
+                                                       sim::Integrator::implicit_euler, sim::Integrator::vbd});
             } else {
                 integrators.push_back(sim::parse_integrator(it));
             }

@@ -237,7 +237,7 @@ Registrar reg{
          sub.add_option("--to", a->to, "range end");
          sub.add_option("--points", a->points, "number of log-spaced points");
          sub.add_option("--integrator", a->o.integrator,
-                        "integrators: symplectic_euler, implicit_euler, local_global, all (default: all)");
+                        "integrators: vbd, implicit_euler, symplectic_euler, all (default: all)");
          sub.add_option("--dt", a->o.dt,
                         "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5)");
          sub.add_option("--substeps", a->o.substeps, "substep counts (default: 1)");

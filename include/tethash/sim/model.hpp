@@ -1,19 +1,46 @@
 #pragma once
 /// \file sim/model.hpp
-/// The mass-spring model: one spring per unique tet edge, one volume term per tet, lumped masses,
-/// plus gravity and ground. Positions and velocities are n × 3 row-major (Positions).
+/// The mass-spring model, built once from the rest state: one spring per unique tet edge, one volume term per
+/// tet, lumped masses, plus gravity and ground. Positions and velocities are n × 3 row-major (Positions).
 /// Forces are accumulated (+=) into n × 3 arrays; energies in force × length.
+///
+/// Why the constants do not depend on the mesh's slivers (Van Gelder 1998, "Approximate simulation of elastic
+/// membranes by triangulated spring meshes"): a spring's stiffness is young × (the volume of the tets around its
+/// edge) / (rest length)², so a sliver (small volume) gets a small spring and a big tet a stiff one; under a
+/// uniform dilation the springs then store the bulk energy of a linear-elastic solid of Poisson ratio 1/4 on any
+/// mesh. Masses are lumped from the same volumes, so the stiffness-to-mass ratio of a vertex is ≈ 12 young /
+/// (density · edge²) whatever the tets' shapes; vertices whose lumped mass is tiny against their edges (all
+/// their tets slivers) get a floor (see Model::build).
 
 #include "tethash/mesh.hpp"
-#include "tethash/sim/scene.hpp"
 
+#include <Eigen/Core>
 #include <Eigen/Sparse>
 
 #include <cmath>
-
 #include <vector>
 
 namespace tethash::sim {
+
+/// Elastic material of one object.
+struct Material {
+    double density = 1000; ///< mass per volume (kg/m³); vertex mass = Σ density · |V_tet| / 4 (floored, see build)
+    double stiffness = 0;  ///< > 0: every spring gets this stiffness (force / length), young = stiffness / mean edge
+    double young = 1e5;    ///< used when stiffness == 0 (force / area): spring k = young · ΣV_adjacent / L0²
+    double damping = 0.01; ///< damping as a time (s): dashpot c = damping · k on springs and volume terms
+    double volume_stiffness = 1.0; ///< per-tet volume term ½ (volume_stiffness · young / V̂) (V − V0)²
+};
+
+/// Ground: the half space {x : n·x < height} is solid.
+struct Ground {
+    bool enabled = false;
+    Eigen::Vector3d normal{0, 0, 1}; ///< normalised on load
+    double height = 0;
+    double stiffness = 0;  ///< penalty stiffness per vertex (force / length); 0 = automatic per vertex:
+                           ///< contact.stiffness if given, else 10 × the stiffest spring of its object
+    double damping = 0;    ///< normal damping (force · s / length); 0 = per vertex sqrt(k · m) (half critical)
+    double friction = 0.5; ///< Coulomb coefficient
+};
 
 struct Springs {
     Edges edges;              ///< e × 2 vertex ids
@@ -39,6 +66,8 @@ struct Energy {
 struct Model {
     Springs springs;
     VolumeTerms volumes;
+    std::vector<Index> vertex_object;      ///< n: object of each vertex
+    std::vector<double> object_mean_edge;  ///< per object: mean rest length of its unique edges (0: static)
     std::vector<double> mass; ///< n lumped masses (static objects: their own mass, unused)
     std::vector<char> fixed;  ///< n: 1 = pinned or static (never moves)
     Eigen::Vector3d gravity{0, 0, 0};
@@ -66,17 +95,14 @@ struct Model {
     /// them).
     void add_forces(const Positions& x, const Positions& v, Positions& f) const { add_forces(x, v, f, ForceOptions{}); }
     void add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const;
-    /// Only the spring forces (elastic part, no damping).
-    void add_spring_forces(const Positions& x, Positions& f) const;
     /// Energies (contact left 0: see Simulation).
     Energy energy(const Positions& x, const Positions& v) const;
     /// Largest eigenvalue bound of M⁻¹K over springs and volume terms (Gershgorin, rest state): ω_max².
     double omega_max_sq(const Positions& x) const;
     /// Explicit (symplectic Euler) stability limit (s) per vertex from the Gershgorin bounds of ω² and of the
     /// damping rate γ: h < (−γ + sqrt(γ² + 4ω²)) / ω² (= 2/ω without damping); minimum over free vertices.
-    /// `extra_k` adds a stiffness per vertex (e.g. contact or ground penalty); `extra_k_per_vertex` (n, or empty)
-    /// adds one per vertex, and `extra_c_per_vertex` a damping. +inf when nothing is stiff.
-    double explicit_dt_limit(const Positions& x, double extra_k = 0) const;
+    /// `extra_k_per_vertex` (n, or empty) adds a stiffness per vertex (contact or ground penalty) and
+    /// `extra_c_per_vertex` a damping. +inf when nothing is stiff.
     double explicit_dt_limit(const Positions& x, const std::vector<double>& extra_k_per_vertex,
                              const std::vector<double>& extra_c_per_vertex) const;
     /// Adds the (positive semi-definite) stiffness −∂f/∂x of springs (+ volume Gauss–Newton part) and the

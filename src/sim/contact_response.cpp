@@ -1,0 +1,268 @@
+#include "contact_response.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace tethash::sim {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+/// A self-contact whose tet lies within this many mean edge lengths of the vertex in the rest state is local
+/// inversion (a fold of the vertex's own neighbourhood), left to the elastic and volume terms: pushing the
+/// vertex out through the nearest face of a neighbouring tet inverts the mesh further.
+constexpr double local_contact_edges = 2.0;
+
+} // namespace
+
+void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model& model,
+                            const std::vector<ObjectOptions>& options)
+{
+    m_mesh = &mesh;
+    m_model = &model;
+    m_params = scene.contact;
+    m_mu = scene.contact.friction;
+    m_object_k.assign(scene.objects.size(), 0.0);
+    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
+        double& ko = m_object_k[static_cast<size_t>(model.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
+        ko = std::max(ko, model.springs.k[static_cast<size_t>(e)]);
+    }
+    int dynamic_objects = 0;
+    bool self = false;
+    for (const ObjectSpec& o : scene.objects) {
+        dynamic_objects += o.is_static ? 0 : 1;
+        self = self || (!o.is_static && o.self_collision);
+    }
+    m_enabled = dynamic_objects > 0 && (self || scene.objects.size() >= 2);
+    if (m_enabled) {
+        m_detector.set_params(scene.detect);
+        m_detector.set_topology(mesh, options);
+        m_penetration.set_topology(mesh);
+    }
+}
+
+double ContactResponse::pair_stiffness(Index a, Index b) const
+{
+    // 10 × the harmonic mean of the stiffest springs of the two objects: dominated by the softer one, so a
+    // very stiff object pressing on a soft one gets a contact about as stiff as the soft one can bear. A static
+    // object (no springs) counts as stiff as its partner.
+    if (m_params.stiffness > 0) return m_params.stiffness;
+    double ka = m_object_k[static_cast<size_t>(a)], kb = m_object_k[static_cast<size_t>(b)];
+    if (!(ka > 0)) ka = kb;
+    if (!(kb > 0)) kb = ka;
+    if (!(ka > 0)) return 1e4; // two objects without springs (cannot happen for a contact the detector reports)
+    return 10 * 2 * ka * kb / (ka + kb);
+}
+
+void ContactResponse::update(const Positions& x, StepStats& stats)
+{
+    m_contacts.clear();
+    m_weight.clear();
+    m_k.clear();
+    m_c.clear();
+    m_mred.clear();
+    m_ignored_local = 0;
+    if (!m_enabled) return;
+    auto t0 = Clock::now();
+    const std::vector<Contact>& found = m_detector.detect(x);
+    stats.ms_detect += ms_since(t0);
+
+    t0 = Clock::now();
+    const TetMesh& mesh = *m_mesh;
+    const Model& model = *m_model;
+    const Positions& rest = mesh.rest();
+    m_contacts.reserve(found.size());
+    for (const Contact& c : found) {
+        if (c.vertex_object == c.tet_object) {
+            const double reach = local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.tet_object)];
+            double nearest = std::numeric_limits<double>::infinity();
+            for (int k = 0; k < 4; ++k)
+                nearest = std::min(nearest, (rest.row(c.vertex) - rest.row(mesh.tets(c.tet, k))).squaredNorm());
+            if (nearest < reach * reach) {
+                ++m_ignored_local;
+                continue;
+            }
+        }
+        m_contacts.push_back(c);
+    }
+    stats.ms_response += ms_since(t0);
+
+    t0 = Clock::now();
+    m_penetration.compute(x, m_contacts);
+    stats.ms_depth += ms_since(t0);
+
+    t0 = Clock::now();
+    const size_t nc = m_contacts.size();
+    m_k.resize(nc);
+    m_c.resize(nc);
+    m_mred.resize(nc);
+    m_weight.assign(nc, 1.0);
+    for (size_t q = 0; q < nc; ++q) {
+        const Contact& c = m_contacts[q];
+        m_k[q] = pair_stiffness(c.vertex_object, c.tet_object);
+        // Reduced mass of the vertex and the penetrated tet's point (fixed vertices have infinite mass).
+        const double inv_v =
+            model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
+        double mt = 0;
+        bool tet_fixed = false;
+        for (int k = 0; k < 4; ++k) {
+            const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
+            if (model.fixed[j] && c.bary[k] > 0.25) tet_fixed = true;
+            mt += c.bary[k] * model.mass[j];
+        }
+        const double inv_t = tet_fixed || !(mt > 0) ? 0.0 : 1.0 / mt;
+        const double inv = inv_v + inv_t;
+        m_mred[q] = inv > 0 ? 1.0 / inv : 0.0;
+        m_c[q] = m_params.damping > 0 ? m_params.damping : std::sqrt(m_k[q] * m_mred[q]);
+    }
+    // Weight: a vertex inside k tets of one object (on shared faces) gets 1/k of the response from each.
+    for (size_t a = 0; a < nc;) {
+        size_t b = a;
+        while (b < nc && m_contacts[b].vertex == m_contacts[a].vertex)
+            ++b;
+        for (size_t i = a; i < b; ++i) {
+            int same = 0;
+            for (size_t j = a; j < b; ++j)
+                same += m_contacts[j].tet_object == m_contacts[i].tet_object ? 1 : 0;
+            m_weight[i] = 1.0 / same;
+        }
+        a = b;
+    }
+    stats.ms_response += ms_since(t0);
+}
+
+void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
+{
+    const Contact& c = m_contacts[q];
+    node[0] = c.vertex;
+    coef[0] = 1.0;
+    for (int k = 0; k < 4; ++k) {
+        node[k + 1] = m_mesh->tets(c.tet, k);
+        coef[k + 1] = -c.bary[k];
+    }
+}
+
+void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, bool cap) const
+{
+    for (size_t q = 0; q < m_contacts.size(); ++q) {
+        const Contact& c = m_contacts[q];
+        if (!(c.depth > 0)) continue;
+        Index node[5];
+        double coef[5];
+        stencil(q, node, coef);
+        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+        Vec3 vrel = Vec3::Zero();
+        for (int a = 0; a < 5; ++a)
+            vrel += coef[a] * vel.row(node[a]).transpose();
+        const double vn = vrel.dot(nrm);
+        const double w = m_weight[q];
+        double scale = 1.0;
+        if (cap && m_k[q] > 0) scale = std::min(1.0, 0.5 * m_mred[q] / (h * h * m_k[q]));
+        const double fn = w * std::max(0.0, scale * (m_k[q] * c.depth - m_c[q] * vn));
+        Vec3 force = fn * nrm;
+        if (m_mu > 0 && fn > 0) {
+            // Coulomb friction along the relative tangential velocity, smoothed below 1 mm/s and capped so
+            // that it cannot reverse the relative sliding in one step.
+            const Vec3 vt = vrel - vn * nrm;
+            const double speed = vt.norm();
+            double ft = m_mu * fn * std::min(1.0, speed / 1e-3);
+            if (h > 0 && m_mred[q] > 0) ft = std::min(ft, w * m_mred[q] * speed / h);
+            if (speed > 0) force -= ft * vt / speed;
+        }
+        for (int a = 0; a < 5; ++a)
+            f.row(node[a]) += coef[a] * force.transpose();
+    }
+}
+
+void ContactResponse::add_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const
+{
+    const std::vector<char>& fixed = m_model->fixed;
+    for (size_t q = 0; q < m_contacts.size(); ++q) {
+        const Contact& c = m_contacts[q];
+        if (!(c.depth > 0)) continue;
+        Index node[5];
+        double coef[5];
+        stencil(q, node, coef);
+        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+        const Mat3 nn = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]) * nrm * nrm.transpose();
+        for (int a = 0; a < 5; ++a) {
+            if (fixed[static_cast<size_t>(node[a])]) continue;
+            for (int b = 0; b < 5; ++b) {
+                if (fixed[static_cast<size_t>(node[b])]) continue;
+                const Mat3 blk = coef[a] * coef[b] * nn;
+                for (int r = 0; r < 3; ++r)
+                    for (int s = 0; s < 3; ++s)
+                        if (blk(r, s) != 0) out.emplace_back(3 * node[a] + r, 3 * node[b] + s, blk(r, s));
+            }
+        }
+    }
+}
+
+void ContactResponse::apply(double scale_k, double scale_c, const Eigen::VectorXd& p, Eigen::VectorXd& out) const
+{
+    const std::vector<char>& fixed = m_model->fixed;
+    for (size_t q = 0; q < m_contacts.size(); ++q) {
+        const Contact& c = m_contacts[q];
+        if (!(c.depth > 0)) continue;
+        Index node[5];
+        double coef[5];
+        stencil(q, node, coef);
+        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+        double jp = 0;
+        for (int a = 0; a < 5; ++a)
+            if (!fixed[static_cast<size_t>(node[a])]) jp += coef[a] * nrm.dot(p.segment<3>(3 * node[a]));
+        const Vec3 y = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]) * jp * nrm;
+        for (int a = 0; a < 5; ++a)
+            if (!fixed[static_cast<size_t>(node[a])]) out.segment<3>(3 * node[a]) += coef[a] * y;
+    }
+}
+
+void ContactResponse::add_diagonal(double scale_k, double scale_c, Eigen::VectorXd& diag) const
+{
+    const std::vector<char>& fixed = m_model->fixed;
+    for (size_t q = 0; q < m_contacts.size(); ++q) {
+        const Contact& c = m_contacts[q];
+        if (!(c.depth > 0)) continue;
+        Index node[5];
+        double coef[5];
+        stencil(q, node, coef);
+        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+        const double s = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]);
+        for (int a = 0; a < 5; ++a)
+            if (!fixed[static_cast<size_t>(node[a])])
+                diag.segment<3>(3 * node[a]) += coef[a] * coef[a] * s * nrm.cwiseProduct(nrm);
+    }
+}
+
+double ContactResponse::energy() const
+{
+    double e = 0;
+    for (size_t q = 0; q < m_contacts.size(); ++q)
+        if (m_contacts[q].depth > 0) e += 0.5 * m_weight[q] * m_k[q] * m_contacts[q].depth * m_contacts[q].depth;
+    return e;
+}
+
+double ContactResponse::max_depth() const
+{
+    double d = 0;
+    for (const Contact& c : m_contacts)
+        if (c.depth > d) d = c.depth;
+    return d;
+}
+
+std::vector<double> ContactResponse::exact_depths(const Positions& x) const
+{
+    if (!m_enabled) return {};
+    return m_penetration.exact_depths(x, m_contacts);
+}
+
+} // namespace tethash::sim

@@ -1,0 +1,70 @@
+#pragma once
+// Contacts of one step and their penalty response (private to tethash::sim): detection, the local
+// self-contacts left to the elastic terms, penetration depth and direction, per-contact stiffness,
+// damping and weights, and the forces and matrix terms every integrator uses.
+
+#include "tethash/detect.hpp"
+#include "tethash/penetration.hpp"
+#include "tethash/sim/model.hpp"
+#include "tethash/sim/scene.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <Eigen/Sparse>
+
+#include <vector>
+
+namespace tethash::sim {
+
+class ContactResponse {
+  public:
+    /// Builds the detector and penetration topology when some pair of objects can collide; stiffest spring per
+    /// object for the automatic contact stiffness.
+    void setup(const Scene& scene, const TetMesh& mesh, const Model& model, const std::vector<ObjectOptions>& options);
+    bool enabled() const { return m_enabled; }
+
+    /// Detects at `x`, drops the local self-contacts, fills depth/direction and the coefficients. Adds its times
+    /// to `stats` (ms_detect, ms_depth, ms_response).
+    void update(const Positions& x, StepStats& stats);
+
+    /// Contact penalty stiffness between a vertex of object a and a tet of object b (see simulation.hpp).
+    double pair_stiffness(Index a, Index b) const;
+
+    /// The contacts the response uses (sorted by vertex, tet), with depth and direction.
+    const std::vector<Contact>& contacts() const { return m_contacts; }
+    std::int64_t ignored_local() const { return m_ignored_local; }
+    /// Per contact: weight (1 / contacts of the vertex with that object), stiffness, damping, reduced mass.
+    const std::vector<double>& weight() const { return m_weight; }
+    const std::vector<double>& stiffness() const { return m_k; }
+    const std::vector<double>& damping() const { return m_c; }
+    double friction() const { return m_mu; }
+    /// The five nodes of contact q (its vertex, then the tet's four) and their coefficients (1, −b0 … −b3):
+    /// the gap along the direction changes by −n · Σ coef_a Δx_a.
+    void stencil(size_t q, Index node[5], double coef[5]) const;
+
+    /// f += penalty + friction forces at velocities `vel` for a step h (friction capped so that it cannot reverse
+    /// a sliding velocity within h). `cap`: stiffness and damping capped at the explicit limit of h.
+    void add_forces(const Positions& vel, Positions& f, double h, bool cap) const;
+    void add_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const;
+    void apply(double scale_k, double scale_c, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+    void add_diagonal(double scale_k, double scale_c, Eigen::VectorXd& diag) const;
+    double energy() const;
+    double max_depth() const;
+
+    /// Exact distances of the contacts' vertices to the penetrated boundaries (error studies).
+    std::vector<double> exact_depths(const Positions& x) const;
+
+  private:
+    const TetMesh* m_mesh = nullptr;
+    const Model* m_model = nullptr;
+    bool m_enabled = false;
+    ContactParams m_params;
+    Detector m_detector;
+    Penetration m_penetration;
+    std::vector<Contact> m_contacts;
+    std::vector<double> m_weight, m_k, m_c, m_mred;
+    std::vector<double> m_object_k; // stiffest spring per object (0: static)
+    double m_mu = 0;
+    std::int64_t m_ignored_local = 0;
+};
+
+} // namespace tethash::sim

@@ -1,0 +1,41 @@
+#pragma once
+// Blow-up checks (private to tethash::sim): a cheap O(n) test after every substep and an energy test after every
+// step, with the likely cause named in the message.
+
+#include "contact_response.hpp"
+
+#include "tethash/sim/model.hpp"
+#include "tethash/sim/scene.hpp"
+
+#include <string>
+
+namespace tethash::sim {
+
+class FailureCheck {
+  public:
+    /// Reference energy: all the energy the scene can draw on at start (initial energy plus the gravity drop over
+    /// the scene's height), and the speed no vertex can reach on it.
+    void setup(const Model& model, const Positions& x, const Positions& v, double contact_energy);
+
+    /// Empty when the state after a substep ending at time t_end is sane; else what is wrong: a non-finite
+    /// vertex, a vertex farther from the scene than the energy at start can carry it, an exploded kinetic energy.
+    std::string check_substep(const Model& model, const Positions& x, const Positions& v, double t_end) const;
+    /// Empty when the internal energy after a step is below 1000 × the reference; else what is wrong.
+    std::string check_energy(double internal) const;
+    /// The likely cause of a failure at substep length h, for the message.
+    std::string likely_cause(const Scene& scene, double h, double dt_limit, const ContactResponse& contacts) const;
+
+    double energy_ref() const { return m_energy_ref; }
+
+  private:
+    double m_energy_ref = 0;
+    double m_msum = 0;
+    Eigen::Vector3d m_centre0{0, 0, 0};
+    double m_radius0 = 0;
+    double m_speed_bound = 0;
+};
+
+/// Short number for messages (3 significant digits).
+std::string short_number(double v);
+
+} // namespace tethash::sim

@@ -1,0 +1,47 @@
+#pragma once
+// One interface for the time integrators (private to tethash::sim); one file per integrator.
+
+#include "contact_response.hpp"
+
+#include "tethash/sim/model.hpp"
+#include "tethash/sim/scene.hpp"
+
+#include <memory>
+
+namespace tethash::sim {
+
+/// What an integrator reads: the scene's settings, the mesh (tets, rest state), the fixed model and the contacts
+/// of the current substep (updated by the caller before each substep). All outlive the integrator.
+struct StepContext {
+    const Scene& scene;
+    const TetMesh& mesh;
+    const Model& model;
+    const ContactResponse& contacts;
+};
+
+class StepIntegrator {
+  public:
+    virtual ~StepIntegrator() = default;
+    /// Advances positions x and velocities v (n × 3; fixed vertices untouched) by one substep h. Returns the
+    /// solver iterations it took (0 for a direct method).
+    virtual int substep(Positions& x, Positions& v, double h) = 0;
+};
+
+std::unique_ptr<StepIntegrator> make_symplectic_euler(const StepContext& ctx);
+std::unique_ptr<StepIntegrator> make_implicit_euler(const StepContext& ctx);
+std::unique_ptr<StepIntegrator> make_block_descent(const StepContext& ctx);
+
+inline std::unique_ptr<StepIntegrator> make_integrator(const StepContext& ctx)
+{
+    switch (ctx.scene.integrator) {
+    case Integrator::symplectic_euler:
+        return make_symplectic_euler(ctx);
+    case Integrator::implicit_euler:
+        return make_implicit_euler(ctx);
+    case Integrator::vbd:
+        break;
+    }
+    return make_block_descent(ctx);
+}
+
+} // namespace tethash::sim
