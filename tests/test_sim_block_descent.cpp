@@ -284,3 +284,43 @@ TEST(SimBlockDescent, TwoArmadillosThrownIntoEachOther)
     // Deepest estimated penetration between the bodies: below a tenth of the body size (1 m).
     EXPECT_LT(deepest, 0.1);
 }
+
+TEST(SimBlockDescent, StiffAndExtremeCasesFinishCleanOrStopWithTheReason)
+{
+    // Two armadillo_4k bodies dropped onto each other: young 1e3 / 1e9 × dt 1e-3 / 1/60 × mass ratio 1 / 1e6 ×
+    // every integrator. Each cell either completes with a finite, uncrumpled pair (inverted tets ≤ 1 %) or stops
+    // with the run failure message (step and likely cause); none silently produces garbage.
+    const auto path = test::shared_mesh("armadillo_4k.node");
+    if (!path) GTEST_SKIP() << "../shared/meshes absent";
+    const TetMesh mesh = io::read_mesh(path->string());
+    int completed = 0;
+    for (Integrator integ : {Integrator::vbd, Integrator::implicit_euler, Integrator::symplectic_euler})
+        for (double young : {1e3, 1e9})
+            for (double dt : {1e-3, 1.0 / 60})
+                for (double ratio : {1.0, 1e6}) {
+                    Scene s;
+                    for (int k = 0; k < 2; ++k) {
+                        ObjectSpec o = placed(mesh, 1.0, 0.05 + 1.1 * k);
+                        o.material.young = young;
+                        o.material.density = k == 1 ? 1000 * ratio : 1000;
+                        s.objects.push_back(o);
+                    }
+                    s.ground.enabled = true;
+                    s.integrator = integ;
+                    s.dt = dt;
+                    s.output.every = 0;
+                    const std::string cell = std::string(to_string(integ)) + " young " + std::to_string(young) +
+                                             " dt " + std::to_string(dt) + " ratio " + std::to_string(ratio);
+                    Simulation sim(s);
+                    const std::string failure = run_for(sim, 0.1);
+                    ASSERT_TRUE(sim.positions().allFinite()) << cell;
+                    if (!failure.empty()) {
+                        EXPECT_NE(failure.find("blew up at step "), std::string::npos) << cell << ": " << failure;
+                        EXPECT_NE(failure.find("likely cause"), std::string::npos) << cell << ": " << failure;
+                        continue;
+                    }
+                    ++completed;
+                    EXPECT_LE(inverted(sim.mesh()), sim.mesh().num_tets() / 100) << cell;
+                }
+    EXPECT_GE(completed, 8); // vbd and implicit Euler complete their cells
+}
