@@ -1,0 +1,269 @@
+// tethash_sim_bench: the simulator on the meshes people load. Drops every mesh of ../shared/meshes (scaled to
+// 1 m, 0.2 m above the ground, density 1000, young 1e5) and throws two armadillo_4k into each other at 2 m/s, for
+// each integrator and time step asked; prints per scene the median ms per step split into detection / depth /
+// response / integration, solver iterations, contacts, inverted tets and far self-penetrations at the end, and
+// the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step.
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/io/mesh_io.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <thread>
+
+using namespace tethash;
+
+namespace {
+
+struct Row {
+    std::string scene, integrator;
+    double dt = 0;
+    Index vertices = 0, tets = 0;
+    double ms = 0, detect = 0, depth = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
+    std::int64_t inverted = 0, far_self = 0;
+    bool stable = false;
+    std::string failure;
+};
+
+double median(std::vector<double> v)
+{
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+std::int64_t inverted(const TetMesh& m, const Positions& start)
+{
+    std::int64_t count = 0;
+    for (Index t = 0; t < m.num_tets(); ++t) {
+        auto vol = [&](const Positions& p) {
+            const Eigen::Vector3d a = p.row(m.tets(t, 0)).transpose();
+            return (p.row(m.tets(t, 1)).transpose() - a)
+                .dot((p.row(m.tets(t, 2)).transpose() - a).cross(p.row(m.tets(t, 3)).transpose() - a));
+        };
+        count += (vol(start) > 0) != (vol(m.positions) > 0) ? 1 : 0;
+    }
+    return count;
+}
+
+std::int64_t far_self(const TetMesh& m, const Positions& start)
+{
+    Detector det;
+    det.set_topology(m);
+    const double reach = 3 * mean_edge_length(start, m.tets);
+    std::set<Index> far;
+    for (const Contact& c : det.detect(m.positions)) {
+        if (c.vertex_object != c.tet_object) continue;
+        double nearest = 1e300;
+        for (int k = 0; k < 4; ++k)
+            nearest = std::min(nearest, (start.row(c.vertex) - start.row(m.tets(c.tet, k))).norm());
+        if (nearest > reach) far.insert(c.vertex);
+    }
+    return static_cast<std::int64_t>(far.size());
+}
+
+sim::ObjectSpec placed(const TetMesh& mesh, double lift)
+{
+    const auto [lo, hi] = bounding_box(mesh.positions);
+    sim::ObjectSpec o;
+    const double s = 1.0 / (hi - lo).maxCoeff();
+    o.scale = Eigen::Vector3d::Constant(s);
+    o.translate = Eigen::Vector3d(-s * 0.5 * (lo.x() + hi.x()), -s * 0.5 * (lo.y() + hi.y()), lift - s * lo.z());
+    o.data = mesh;
+    o.material.density = 1000;
+    o.material.young = 1e5;
+    return o;
+}
+
+Row run(const std::string& name, sim::Scene scene, int steps)
+{
+    Row r;
+    r.scene = name;
+    r.integrator = sim::to_string(scene.integrator);
+    r.dt = scene.dt;
+    sim::Simulation s(scene);
+    r.vertices = s.mesh().num_vertices();
+    r.tets = s.mesh().num_tets();
+    const Positions start = s.positions();
+    std::vector<double> ms, det, dep, resp, integ, sw, con;
+    try {
+        for (int i = 0; i < steps; ++i) {
+            const auto t0 = std::chrono::steady_clock::now();
+            s.step();
+            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            const sim::StepStats& st = s.last_stats();
+            det.push_back(st.ms_detect);
+            dep.push_back(st.ms_depth);
+            resp.push_back(st.ms_response);
+            integ.push_back(st.ms_integrate);
+            sw.push_back(st.solver_iterations);
+            con.push_back(static_cast<double>(st.contacts));
+        }
+    } catch (const RunFailure& e) {
+        r.failure = e.what();
+        r.failure = r.failure.substr(0, r.failure.find(':'));
+    }
+    r.ms = median(ms);
+    r.detect = median(det);
+    r.depth = median(dep);
+    r.response = median(resp);
+    r.integrate = median(integ);
+    r.sweeps = median(sw);
+    double csum = 0;
+    for (double c : con)
+        csum += c;
+    r.contacts = con.empty() ? 0 : csum / static_cast<double>(con.size());
+    r.inverted = inverted(s.mesh(), start);
+    r.far_self = far_self(s.mesh(), start);
+    r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
+    return r;
+}
+
+double parse_dt(const std::string& v)
+{
+    const auto slash = v.find('/');
+    try {
+        if (slash != std::string::npos) return std::stod(v.substr(0, slash)) / std::stod(v.substr(slash + 1));
+        return std::stod(v);
+    } catch (const std::exception&) {
+        throw Error("--dt: '" + v + "' is not a time step (seconds, or a fraction such as 1/240)");
+    }
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"tethash_sim_bench: the simulator on the shared real meshes (drops and a collision)"};
+    std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
+    std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
+    double seconds = 0.5;
+    int threads = 1;
+    app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
+    app.add_option("--scenes", filter, "only scenes whose name contains this");
+    app.add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")->delimiter(',');
+    app.add_option("--dt", dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
+    app.add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
+    app.add_option("--threads", threads, "detector and solver threads")->capture_default_str();
+    app.add_option("--csv", csv, "write the rows as CSV to this file");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+    try {
+        std::vector<double> steps_dt;
+        for (const std::string& d : dts) {
+            const double v = parse_dt(d);
+            if (!(v > 0)) throw Error("--dt must be positive, found '" + d + "'");
+            steps_dt.push_back(v);
+        }
+        std::vector<sim::Integrator> integ;
+        for (const std::string& i : integrators)
+            integ.push_back(sim::parse_integrator(i));
+        if (!(seconds > 0)) throw Error("--seconds must be positive");
+        if (threads < 1 || threads > 256) throw Error("--threads must be in 1..256");
+        if (!std::filesystem::is_directory(meshes_dir)) {
+            std::printf("shared meshes not found at %s: nothing to run\n", meshes_dir.c_str());
+            return 0;
+        }
+        double load[3] = {0, 0, 0};
+        if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+            if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
+            std::fclose(f);
+        }
+        std::printf("tethash_sim_bench: %s, flags '%s', %u hardware threads, %d thread(s), load %.2f %.2f %.2f\n",
+                    TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), threads, load[0],
+                    load[1], load[2]);
+        std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", seconds).c_str());
+
+        std::vector<std::pair<std::string, sim::Scene>> scenes;
+        const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh",
+                                                "raptorTetra_8418.vtu", "32770_octocat.msh", "hand.mesh",
+                                                "mat100x100t40.msh", "quintupleTorus.veg"};
+        for (const std::string& file : files) {
+            const std::filesystem::path p = std::filesystem::path(meshes_dir) / file;
+            if (!std::filesystem::exists(p)) continue;
+            const TetMesh mesh = io::read_mesh(p.string());
+            sim::Scene s;
+            s.objects.push_back(placed(mesh, 0.2));
+            s.ground.enabled = true;
+            s.output.every = 0;
+            scenes.emplace_back("drop " + p.stem().string(), s);
+            if (file == "armadillo_4k.node") {
+                sim::Scene two;
+                for (int k = 0; k < 2; ++k) {
+                    sim::ObjectSpec o = placed(mesh, 0.3);
+                    o.translate.x() += k == 0 ? -0.7 : 0.7;
+                    o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
+                    two.objects.push_back(o);
+                }
+                two.ground.enabled = true;
+                two.output.every = 0;
+                scenes.emplace_back("two armadillos at 2 m/s", two);
+            }
+        }
+        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %6s %8s %7s %5s %10s  %s\n", "scene", "integrator",
+                    "dt", "verts", "tets", "ms/step", "detect", "depth", "resp", "integr", "iters", "contacts",
+                    "invert", "far", "dt/ms", "failure");
+        std::vector<Row> rows;
+        for (auto& [name, scene] : scenes) {
+            if (!filter.empty() && name.find(filter) == std::string::npos) continue;
+            for (sim::Integrator i : integ)
+                for (double dt : steps_dt) {
+                    scene.integrator = i;
+                    scene.dt = dt;
+                    scene.detect.threads = threads;
+                    const Row r = run(name, scene, std::max(1, static_cast<int>(std::lround(seconds / dt))));
+                    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %6.1f %8.1f %7lld %5lld %10.3g  %s\n",
+                                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.detect,
+                                r.depth, r.response, r.integrate, r.sweeps, r.contacts,
+                                static_cast<long long>(r.inverted), static_cast<long long>(r.far_self),
+                                r.stable ? r.dt / r.ms : 0.0, r.failure.c_str());
+                    std::fflush(stdout);
+                    rows.push_back(r);
+                }
+        }
+        // Teschner et al. 2004: the largest stable dt of those run, divided by the cost per step at that dt.
+        std::map<std::pair<std::string, std::string>, std::pair<double, double>> best;
+        for (const Row& r : rows)
+            if (r.stable) {
+                auto& b = best[{r.scene, r.integrator}];
+                if (r.dt > b.first) b = {r.dt, r.ms};
+            }
+        std::printf("\nlargest stable dt / ms per step (Teschner et al. 2004), over the dt run:\n");
+        for (const auto& [key, v] : best)
+            std::printf("  %-26s %-16s dt %.5f s at %.2f ms/step: %.3g s/ms\n", key.first.c_str(), key.second.c_str(),
+                        v.first, v.second, v.first / v.second);
+        if (!csv.empty()) {
+            const std::string tmp = csv + ".partial";
+            {
+                std::ofstream out(tmp);
+                if (!out) throw Error("--csv: cannot write '" + tmp + "'");
+                out << "scene,integrator,dt,vertices,tets,ms_step,ms_detect,ms_depth,ms_response,ms_integrate,"
+                       "iterations,contacts,inverted,far_self,stable,failure\n";
+                for (const Row& r : rows)
+                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{},\"{}\"\n",
+                                       r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth,
+                                       r.response, r.integrate, r.sweeps, r.contacts, r.inverted, r.far_self,
+                                       r.stable ? 1 : 0, r.failure);
+            }
+            std::filesystem::rename(tmp, csv);
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "tethash_sim_bench: %s\n", e.what());
+        return 2;
+    }
+    return 0;
+}
