@@ -186,6 +186,54 @@ material = { density = 500, young = 1e4 }
     }
 }
 
+TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
+{
+    // Two copies of a small box thrown into each other: every cell of the matrix either completes with at most
+    // 1 % inverted tets ("ok") or stops with the simulator's message ("stopped", naming the step); "crumpled"
+    // (completed but garbage) must never appear.
+    const auto dir = test::temp_dir();
+    io::GenerateParams p;
+    p.shape = "box";
+    p.resolution = 3;
+    io::write_mesh((dir / "box.vtu").string(), io::generate(p));
+    const auto r = run_tethash("study stability --mesh " + quote(dir / "box.vtu") +
+                               " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all --duration 0.6 "
+                               "--no-plot --quiet --out " + quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction",
+                            "far_self", "ms_per_step"})
+        ASSERT_GE(t.index_of(col), 0) << col;
+    ASSERT_EQ(t.rows.size(), 24u);
+    int ok = 0, stopped = 0;
+    for (const auto& row : t.rows) {
+        const std::string verdict = row[t.index_of("verdict")], status = row[t.index_of("status")];
+        if (verdict == "ok") {
+            ++ok;
+            EXPECT_LE(std::stod(row[t.index_of("inverted_fraction")]), 0.01);
+        } else {
+            EXPECT_EQ(verdict, "stopped") << status;
+            EXPECT_NE(status.find("step"), std::string::npos) << status;
+            EXPECT_NE(status.find("likely cause"), std::string::npos) << status;
+            ++stopped;
+        }
+    }
+    // The implicit integrators complete the stiff, equal-mass cells; young 1e3 cannot carry a 1 m body's weight
+    // (ρ g h / E ≈ 10) and must stop saying so.
+    for (const auto& row : t.rows) {
+        const std::string integ = row[t.index_of("integrator")], young = row[t.index_of("young")];
+        if (integ != "symplectic_euler" && young == "1000000000" && row[t.index_of("mass_ratio")] == "1") {
+            EXPECT_EQ(row[t.index_of("verdict")], "ok") << integ;
+        }
+        if (young == "1000" && row[t.index_of("verdict")] == "stopped" &&
+            row[t.index_of("status")].find("crumpled") != std::string::npos) {
+            EXPECT_NE(row[t.index_of("status")].find("cannot carry its own weight"), std::string::npos);
+        }
+    }
+    EXPECT_GT(ok, 4);
+    EXPECT_GT(stopped, 0);
+}
+
 TEST(CliStudy, BadInputExitsTwoBeforeAnyWork)
 {
     const auto dir = test::temp_dir();
@@ -207,6 +255,9 @@ TEST(CliStudy, BadInputExitsTwoBeforeAnyWork)
         {"study integrator --mesh " + mesh, "integrator sweep"},
         {"study integrator --dt 0", "--dt"},
         {"study integrator --scene " + quote(dir / "none.toml"), "file not found"},
+        {"study stability", "give --mesh"},
+        {"study stability --mesh " + quote(dir / "a.vtu") + " --mass-ratio 0", "--mass-ratio"},
+        {"study stability --mesh " + quote(dir / "a.vtu") + " --dt 1/0", "--dt"},
     };
     for (const auto& [args, message] : cases) {
         const auto r = run_tethash(args + " --out " + out + " --no-plot");

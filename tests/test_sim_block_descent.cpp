@@ -9,53 +9,17 @@
 #include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/sim/quality.hpp"
 #include "tethash/sim/simulation.hpp"
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <set>
 
 using namespace tethash;
 using namespace tethash::sim;
 
 namespace {
-
-/// Tets whose signed volume changed sign against `start` (the positions at the start of the run).
-std::int64_t inverted(const TetMesh& m, const Positions& start)
-{
-    std::int64_t count = 0;
-    for (Index t = 0; t < m.num_tets(); ++t) {
-        auto vol = [&](const Positions& p) {
-            const Eigen::Vector3d a = p.row(m.tets(t, 0)).transpose();
-            return (p.row(m.tets(t, 1)).transpose() - a)
-                .dot((p.row(m.tets(t, 2)).transpose() - a).cross(p.row(m.tets(t, 3)).transpose() - a));
-        };
-        const double v0 = vol(start), v = vol(m.positions);
-        count += (v0 > 0) != (v > 0) ? 1 : 0;
-    }
-    return count;
-}
-
-/// Distinct vertices inside a tet of their own object whose nearest vertex lay more than 3 mean edges away at
-/// `start` (a fold through a distant part of the body), by the exact detector. (A simulation's mesh() holds no
-/// separate rest positions: its rest() is the current state, so the start is passed in.)
-std::int64_t far_self_penetrations(const TetMesh& m, const Positions& start)
-{
-    Detector det;
-    det.set_topology(m);
-    const std::vector<Contact>& contacts = det.detect(m.positions);
-    const double reach = 3 * mean_edge_length(start, m.tets);
-    std::set<Index> far;
-    for (const Contact& c : contacts) {
-        if (c.vertex_object != c.tet_object) continue;
-        double nearest = INFINITY;
-        for (int k = 0; k < 4; ++k)
-            nearest = std::min(nearest, (start.row(c.vertex) - start.row(m.tets(c.tet, k))).norm());
-        if (nearest > reach) far.insert(c.vertex);
-    }
-    return static_cast<std::int64_t>(far.size());
-}
 
 /// `mesh` scaled so that its longest extent is `size`, lowest point at height `lift`.
 ObjectSpec placed(TetMesh mesh, double size, double lift)
@@ -188,6 +152,50 @@ TEST(SimBlockDescent, SameBodyMeshedCoarseAndFineSagsTheSame)
     EXPECT_NEAR(fine / coarse, 1.0, 0.1) << "coarse " << coarse << ", fine " << fine;
 }
 
+TEST(SimBlockDescent, ChebyshevAccelerationBringsFewSweepsCloserToTheConvergedStep)
+{
+    // A cantilever dropping under gravity for 0.25 s at dt 1/240: the tip with 6 accelerated sweeps per step must
+    // be closer to the tip with 60 plain sweeps (the converged implicit step) than with 6 plain sweeps, which
+    // leave the body too soft.
+    auto tip = [](int sweeps, double rho) {
+        Scene s;
+        ObjectSpec o;
+        io::GenerateParams g;
+        g.shape = "box";
+        g.resolution = 8;
+        g.size = Eigen::Vector3d(1.0, 0.2, 0.2);
+        o.generate = g;
+        o.material.young = 1e6;
+        o.material.density = 1000;
+        o.self_collision = false;
+        s.objects.push_back(o);
+        PinRegion pin;
+        pin.has_box = true;
+        pin.box_min = Eigen::Vector3d(-1, -1, -1);
+        pin.box_max = Eigen::Vector3d(-0.499, 1, 1);
+        s.pins.push_back(pin);
+        s.dt = 1.0 / 240;
+        s.iterations = sweeps;
+        s.acceleration = rho;
+        s.output.every = 0;
+        Simulation sim(s);
+        const Positions start = sim.positions();
+        EXPECT_EQ(run_for(sim, 0.25), "");
+        double z = 0;
+        int count = 0;
+        for (Index i = 0; i < start.rows(); ++i)
+            if (start(i, 0) > 0.49) {
+                z += sim.positions()(i, 2) - start(i, 2);
+                ++count;
+            }
+        return z / count;
+    };
+    const double converged = tip(60, 0), plain = tip(6, 0), accelerated = tip(6, 0.9);
+    EXPECT_LT(converged, -1e-3); // it does bend
+    EXPECT_LT(std::abs(accelerated - converged), 0.5 * std::abs(plain - converged))
+        << "converged " << converged << ", plain " << plain << ", accelerated " << accelerated;
+}
+
 TEST(SimBlockDescent, RealMeshAndItsRegularRemeshSagTheSame)
 {
     // armadillo_4k (a mesh made by another tool, with its slivers) against tethash's regular tetrahedralization of
@@ -237,8 +245,8 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
     // The small shared meshes (the larger ones are in tethash_sim_bench) dropped 0.2 m with self-collision on:
     // no blow-up at dt 1/240 or 1/60 and a finite state that reached the ground. At 1/240 at most 1 % inverted tets
     // and, except on the P1 lattice, no vertex folded through a distant part of its body. What does not hold yet
-    // (P1's folds; screw and P1 above 1 % inverted at 1/60) is listed as open in docs/simulator.md with the
-    // benchmark's numbers.
+    // (P1's folds; screw and P1 crumple at 1/60, which the run must report) is listed as open in
+    // docs/simulator.md with the benchmark's numbers.
     int ran = 0;
     for (const char* name : {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh"}) {
         const auto path = test::shared_mesh(name);
@@ -248,13 +256,19 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
             Simulation sim(drop(mesh, dt));
             const Positions start = sim.positions();
             const std::string failure = run_for(sim, 0.6);
+            if (!failure.empty() && dt > 1.0 / 200 && (std::string(name) == "screw.msh" || std::string(name) == "P1.msh")) {
+                // Open (docs/simulator.md): these crumple at 1/60; what must hold is that the run says so.
+                EXPECT_NE(failure.find("crumpled"), std::string::npos) << name << ": " << failure;
+                continue;
+            }
             EXPECT_EQ(failure, "") << name << " dt " << dt;
+            EXPECT_LE(count_inverted(sim.mesh(), start), mesh.num_tets() / 100) << name << " dt " << dt;
             EXPECT_TRUE(sim.positions().allFinite()) << name << " dt " << dt;
             EXPECT_LT(sim.positions().col(2).minCoeff(), 0.05) << name << " dt " << dt << ": did not land";
             if (dt > 1.0 / 200) continue;
-            EXPECT_LE(inverted(sim.mesh(), start), mesh.num_tets() / 100) << name << " dt " << dt;
+            EXPECT_LE(count_inverted(sim.mesh(), start), mesh.num_tets() / 100) << name << " dt " << dt;
             if (std::string(name) != "P1.msh") {
-                EXPECT_EQ(far_self_penetrations(sim.mesh(), start), 0) << name << " dt " << dt;
+                EXPECT_EQ(count_far_self_penetrations(sim.mesh(), start), 0) << name << " dt " << dt;
             }
             ++ran;
         }
@@ -288,7 +302,7 @@ TEST(SimBlockDescent, TwoArmadillosThrownIntoEachOther)
         deepest = std::max(deepest, sim.max_penetration());
     }
     EXPECT_GT(between, 0); // they did collide
-    EXPECT_LE(inverted(sim.mesh(), start), 2 * mesh.num_tets() / 100);
+    EXPECT_LE(count_inverted(sim.mesh(), start), 2 * mesh.num_tets() / 100);
     // Far self-penetrations are not yet 0 here (7 vertices of 2,360 at the end): open, docs/simulator.md.
     // Deepest estimated penetration between the bodies: below a tenth of the body size (1 m).
     EXPECT_LT(deepest, 0.1);
@@ -330,7 +344,7 @@ TEST(SimBlockDescent, StiffAndExtremeCasesFinishCleanOrStopWithTheReason)
                         continue;
                     }
                     ++completed;
-                    EXPECT_LE(inverted(sim.mesh(), start), sim.mesh().num_tets() / 100) << cell;
+                    EXPECT_LE(count_inverted(sim.mesh(), start), sim.mesh().num_tets() / 100) << cell;
                 }
     EXPECT_GE(completed, 8); // vbd and implicit Euler complete their cells
 }

@@ -31,6 +31,7 @@ substeps = 3
 integrator = "vbd"
 solver = "ldlt"
 iterations = 7
+acceleration = 0.75
 tolerance = 1e-8
 gravity = [0, -9.8, 0]
 [ground]
@@ -75,6 +76,7 @@ box_max = [1, 1, 1]
     EXPECT_EQ(s.integrator, Integrator::vbd);
     EXPECT_EQ(s.solver, LinearSolver::ldlt);
     EXPECT_EQ(s.iterations, 7);
+    EXPECT_EQ(s.acceleration, 0.75);
     EXPECT_EQ(s.gravity.y(), -9.8);
     EXPECT_TRUE(s.ground.enabled);
     EXPECT_NEAR(s.ground.normal.y(), 1.0, 1e-15);
@@ -130,6 +132,7 @@ TEST(SimScene, WrongTypesAndValuesNameKeyAndLine)
         {"[detector]\ncell_size = \"big\"\n" + kObject, "detector.cell_size", "s.toml:2"},
         {"[[object]]\nname = \"x\"\n", "object[0]", "s.toml:"},
         {"dt = = 1\n", "TOML", "s.toml:1"},
+        {"\nacceleration = 1\n" + kObject, "'acceleration'", "s.toml:2"},
     };
     for (const Case& c : cases) {
         const std::string e = error_of(c.text);

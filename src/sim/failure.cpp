@@ -1,5 +1,7 @@
 #include "failure.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -35,6 +37,89 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
     m_energy_ref = std::max(m_energy_ref, 1e-12 * std::max(1.0, m_msum));
     // Fastest any vertex can move if all the energy the blow-up test allows went into it.
     m_speed_bound = std::sqrt(2 * 1e3 * m_energy_ref / min_mass);
+    // Each object's height along gravity (for ρ g h / E, the strain its own weight causes).
+    const double gn = model.gravity.norm();
+    m_object_height.clear();
+    std::vector<double> lo_h, hi_h;
+    for (size_t i = 0; i < model.mass.size(); ++i) {
+        const size_t o = static_cast<size_t>(model.vertex_object[i]);
+        if (o >= lo_h.size()) {
+            lo_h.resize(o + 1, std::numeric_limits<double>::infinity());
+            hi_h.resize(o + 1, -std::numeric_limits<double>::infinity());
+        }
+        if (model.fixed[i] || !(gn > 0)) continue;
+        const double z = -model.gravity.dot(x.row(static_cast<Index>(i)).transpose()) / gn;
+        lo_h[o] = std::min(lo_h[o], z);
+        hi_h[o] = std::max(hi_h[o], z);
+    }
+    for (size_t o = 0; o < lo_h.size(); ++o)
+        m_object_height.push_back(hi_h[o] > lo_h[o] ? hi_h[o] - lo_h[o] : 0.0);
+}
+
+std::string FailureCheck::check_inverted(const Model& model, const Scene& scene, const Positions& x, double h, double t,
+                                         double dt_limit)
+{
+    const Index nt = static_cast<Index>(model.volumes.tets.rows());
+    std::int64_t inverted = 0;
+    for (Index t = 0; t < nt; ++t) {
+        const auto tet = model.volumes.tets.row(t);
+        const Eigen::Vector3d a = x.row(tet(0)).transpose();
+        const double w = (x.row(tet(1)).transpose() - a)
+                             .dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
+        inverted += w > 0 ? 0 : 1;
+    }
+    if (inverted * 100 <= nt) {
+        m_inverted_since = -1;
+        return {};
+    }
+    if (m_inverted_since < 0) m_inverted_since = t - h;
+    const double lasting = t - m_inverted_since;
+    if (inverted * 10 <= nt && lasting < 0.1 - 1e-9) return {};
+    std::string what = short_number(static_cast<double>(inverted)) + " of " + std::to_string(nt) + " tets (" +
+                       short_number(100.0 * static_cast<double>(inverted) / static_cast<double>(nt)) +
+                       " %) are inverted" +
+                       (inverted * 10 > nt ? std::string() : ", more than 1 % for " + short_number(lasting) + " s") +
+                       ": the body crumpled";
+    // Likely cause, most specific first.
+    const double g = model.gravity.norm();
+    double worst = 0, densest = 0, lightest = std::numeric_limits<double>::infinity();
+    size_t worst_o = 0, dense_o = 0, light_o = 0;
+    for (size_t o = 0; o < scene.objects.size() && o < m_object_height.size(); ++o) {
+        const ObjectSpec& spec = scene.objects[o];
+        if (spec.is_static || m_object_height[o] <= 0) continue;
+        const Material& m = spec.material;
+        const double strain = m.density * g * m_object_height[o] / m.young;
+        if (strain > worst) {
+            worst = strain;
+            worst_o = o;
+        }
+        if (m.density > densest) {
+            densest = m.density;
+            dense_o = o;
+        }
+        if (m.density < lightest) {
+            lightest = m.density;
+            light_o = o;
+        }
+    }
+    auto name = [&](size_t o) {
+        return scene.objects[o].name.empty() ? "object " + std::to_string(o) : "'" + scene.objects[o].name + "'";
+    };
+    std::string cause;
+    if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
+        cause = "the time step " + short_number(h) + " s exceeds the explicit stability limit ≈ " +
+                short_number(dt_limit) + " s (stiffness/mass too high for symplectic_euler): use substeps, a smaller "
+                "dt or vbd";
+    else if (worst > 0.3)
+        cause = name(worst_o) + " cannot carry its own weight: density × g × height / young = " + short_number(worst) +
+                " (a strain; above ~0.3 the body flattens): raise its young or lower its density";
+    else if (densest > 100 * lightest)
+        cause = name(dense_o) + " is " + short_number(densest / lightest) + " times denser than " + name(light_o) +
+                ", which it crushes: raise the lighter body's young or lower the density ratio";
+    else
+        cause = "the time step " + short_number(h) + " s is too large for this material and its contacts: lower dt, "
+                "raise substeps or (vbd) iterations";
+    return what + "; likely cause: " + cause;
 }
 
 std::string FailureCheck::check_substep(const Model& model, const Positions& x, const Positions& v, double t_end) const

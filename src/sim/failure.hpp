@@ -8,6 +8,7 @@
 #include "tethash/sim/scene.hpp"
 
 #include <string>
+#include <vector>
 
 namespace tethash::sim {
 
@@ -22,6 +23,13 @@ class FailureCheck {
     std::string check_substep(const Model& model, const Positions& x, const Positions& v, double t_end) const;
     /// Empty when the internal energy after a step is below 1000 × the reference; else what is wrong.
     std::string check_energy(double internal) const;
+    /// Called after every step ending at time t. Empty unless the body crumpled: more than 1 % of the dynamic tets
+    /// inverted (signed volume ≤ 0; rest volumes are positive) for 0.1 s of simulated time without a break, or
+    /// more than 10 % at once (an impact inverts a few tets for a few steps; they recover). Else how many, and
+    /// the likely cause: a material too soft to carry its own weight, a much denser body crushing a lighter one,
+    /// or a time step too large for the material.
+    std::string check_inverted(const Model& model, const Scene& scene, const Positions& x, double h, double t,
+                               double dt_limit);
     /// The likely cause of a failure at substep length h, for the message.
     std::string likely_cause(const Scene& scene, double h, double dt_limit, const ContactResponse& contacts) const;
 
@@ -33,6 +41,8 @@ class FailureCheck {
     Eigen::Vector3d m_centre0{0, 0, 0};
     double m_radius0 = 0;
     double m_speed_bound = 0;
+    double m_inverted_since = -1; ///< time at which more than 1 % of the tets became inverted (−1: not now)
+    std::vector<double> m_object_height; ///< per object: extent along gravity at start (0: static or none)
 };
 
 /// Short number for messages (3 significant digits).

@@ -118,6 +118,12 @@ class Reader {
         if (!(v >= 0) || !std::isfinite(v)) fail(&n, key, "must be ≥ 0 and finite, found " + fmt(v));
         return v;
     }
+    double fraction_below_one(const toml::node& n, const std::string& key) const
+    {
+        const double v = number(n, key);
+        if (!(v >= 0 && v < 1)) fail(&n, key, "must be in [0, 1), found " + fmt(v));
+        return v;
+    }
     std::int64_t integer(const toml::node& n, const std::string& key) const
     {
         if (!n.is_integer()) fail(&n, key, std::string("expected an integer, found ") + type_name(n));
@@ -288,7 +294,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     Scene s;
     s.source = source_name;
     r.check_keys(root, "",
-                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance",
+                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance", "acceleration",
                   "gravity", "ground",
                   "contact", "detector", "output", "object", "pin"});
     for (auto&& [k, v] : root) {
@@ -303,6 +309,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             s.iterations = static_cast<int>(r.integer_at_least(v, key, 1));
         else if (key == "tolerance")
             s.tolerance = r.positive(v, key);
+        else if (key == "acceleration")
+            s.acceleration = r.fraction_below_one(v, key);
         else if (key == "sweep_tolerance")
             s.sweep_tolerance = r.non_negative(v, key);
         else if (key == "gravity")

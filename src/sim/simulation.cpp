@@ -147,15 +147,17 @@ void Simulation::step()
     StepStats st;
     const std::int64_t step_no = s.steps_done + 1;
     int sub = 0;
-    auto fail = [&](const std::string& what) {
+    auto fail = [&](const std::string& what, bool with_cause = true) {
         x = s.x_save;
         s.v = s.v_save;
         const std::string where = s.scene.substeps > 1 && sub < s.scene.substeps
                                       ? ", substep " + std::to_string(sub + 1) + "/" + std::to_string(s.scene.substeps)
                                       : std::string();
-        throw RunFailure("simulation blew up at step " + std::to_string(step_no) + where + " (t = " +
+        throw RunFailure("simulation " + std::string(with_cause ? "blew up" : "failed") + " at step " +
+                         std::to_string(step_no) + where + " (t = " +
                          short_number(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) + " s): " + what +
-                         "; likely cause: " + s.failure.likely_cause(s.scene, h, s.dt_limit, s.contacts));
+                         (with_cause ? "; likely cause: " + s.failure.likely_cause(s.scene, h, s.dt_limit, s.contacts)
+                                     : std::string()));
     };
     for (; sub < s.scene.substeps; ++sub) {
         try {
@@ -174,6 +176,8 @@ void Simulation::step()
     const Energy e = s.model.energy(x, s.v);
     const std::string bad = s.failure.check_energy(e.internal() + s.contacts.energy());
     if (!bad.empty()) fail(bad);
+    const std::string crumpled = s.failure.check_inverted(s.model, s.scene, x, h, s.t + s.scene.dt, s.dt_limit);
+    if (!crumpled.empty()) fail(crumpled, false);
     st.contacts = static_cast<std::int64_t>(s.contacts.contacts().size());
     st.ignored_local = s.contacts.ignored_local();
     double sum = 0;

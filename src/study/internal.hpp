@@ -36,6 +36,11 @@ struct SimPlanDeleter {
     void operator()(SimPlan* p) const;
 };
 
+struct StabilityPlan; // stability_study.cpp
+struct StabilityPlanDeleter {
+    void operator()(StabilityPlan* p) const;
+};
+
 struct StudyPlan {
     StudyOptions options;
     std::vector<std::string> columns;
@@ -43,6 +48,7 @@ struct StudyPlan {
     std::vector<SceneData> scenes;
     std::vector<DetectPoint> detect_points;       ///< same indices as points (detection sweeps)
     std::unique_ptr<SimPlan, SimPlanDeleter> sim; ///< integrator sweep
+    std::unique_ptr<StabilityPlan, StabilityPlanDeleter> stability; ///< stability sweep
     std::vector<std::string> notes;
 };
 
@@ -51,7 +57,11 @@ void plan_sim_study(StudyPlan& plan);
 /// Measures point `index` of an integrator sweep: returns its rows (one per repeat; fewer when stopped).
 std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHooks& hooks);
 
-/// Helpers shared by both sweeps.
+/// Stability sweep (integrator × young × dt × mass ratio on two colliding copies of each --mesh).
+void plan_stability_study(StudyPlan& plan);
+std::vector<Row> run_stability_point(StudyPlan& plan, std::int64_t index, const RunHooks& hooks);
+
+/// Helpers shared by the sweeps.
 std::vector<double> parse_real_list(const std::vector<std::string>& specs, const std::string& option,
                                     double scale_for_x, bool log_ranges);
 std::vector<int> parse_int_list(const std::vector<std::string>& specs, const std::string& option);

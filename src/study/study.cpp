@@ -152,6 +152,12 @@ double parse_scaled(const std::string& text, const std::string& option, double s
         if (scale <= 0) throw Error(option + ": 'x' factors are not allowed here, found '" + text + "'");
         return parse_number(text.substr(1), option) * scale;
     }
+    // A fraction such as 1/240 (time steps are usually given so).
+    if (const auto slash = text.find('/'); slash != std::string::npos) {
+        const double den = parse_number(text.substr(slash + 1), option);
+        if (!(den != 0)) throw Error(option + ": division by zero in '" + text + "'");
+        return parse_number(text.substr(0, slash), option) / den;
+    }
     return parse_number(text, option);
 }
 
@@ -247,8 +253,9 @@ Sweep parse_sweep(const std::string& name)
     if (name == "threads") return Sweep::threads;
     if (name == "grid") return Sweep::grid;
     if (name == "integrator") return Sweep::integrator;
+    if (name == "stability") return Sweep::stability;
     throw Error("sweep: unknown sweep '" + name +
-                "' (expected cell-size, table-size, hash, threads, grid or integrator)");
+                "' (expected cell-size, table-size, hash, threads, grid, integrator or stability)");
 }
 
 const char* to_string(Sweep s)
@@ -266,6 +273,8 @@ const char* to_string(Sweep s)
         return "grid";
     case Sweep::integrator:
         return "integrator";
+    case Sweep::stability:
+        return "stability";
     }
     return "?";
 }
@@ -717,7 +726,9 @@ std::shared_ptr<StudyPlan> plan_study(const StudyOptions& options)
                     std::to_string(o.shard_count));
     if (o.out_dir.empty()) throw Error("--out: empty folder name");
     check_out_dir(o.out_dir);
-    if (o.sweep == Sweep::integrator) {
+    if (o.sweep == Sweep::stability) {
+        plan_stability_study(*plan);
+    } else if (o.sweep == Sweep::integrator) {
         if (!o.meshes.empty() || o.teschner || !o.scenarios.empty())
             throw Error(
                 "integrator sweep: takes --scene FILE (or the default scene), not --mesh / --teschner-scenarios");
@@ -846,8 +857,9 @@ StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)
             break;
         }
         if (hooks.on_point) hooks.on_point(k, res.points_planned, plan.points[static_cast<std::size_t>(i)]);
-        std::vector<Row> rows =
-            o.sweep == Sweep::integrator ? run_sim_point(plan, i, hooks) : run_detect_point(plan, i, hooks);
+        std::vector<Row> rows = o.sweep == Sweep::integrator  ? run_sim_point(plan, i, hooks)
+                                : o.sweep == Sweep::stability ? run_stability_point(plan, i, hooks)
+                                                              : run_detect_point(plan, i, hooks);
         for (Row& r : rows) {
             csv.write(r);
             table.rows.push_back(std::move(r));

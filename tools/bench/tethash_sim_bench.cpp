@@ -2,11 +2,18 @@
 // 1 m, 0.2 m above the ground, density 1000, young 1e5) and throws two armadillo_4k into each other at 2 m/s, for
 // each integrator and time step asked; prints per scene the median ms per step split into detection / depth /
 // response / integration, solver iterations, contacts, inverted tets and far self-penetrations at the end, and
-// the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step.
+// the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step. When built
+// with Bullet (libbullet-dev found), each scene and dt also runs with Bullet's soft bodies in the same process
+// (rows "bullet"), so the ratio to the peer comes from one run.
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/sim/quality.hpp"
 #include "tethash/sim/simulation.hpp"
+
+#ifdef TETHASH_HAVE_BULLET
+#include "bullet_peer.hpp"
+#endif
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -19,7 +26,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <set>
 #include <thread>
 
 using namespace tethash;
@@ -32,6 +38,7 @@ struct Row {
     Index vertices = 0, tets = 0;
     double ms = 0, detect = 0, depth = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
     std::int64_t inverted = 0, far_self = 0;
+    double mean_z = 0; ///< mean height of the vertices at the end (how far the body sagged or sank)
     bool stable = false;
     std::string failure;
 };
@@ -41,36 +48,6 @@ double median(std::vector<double> v)
     if (v.empty()) return 0;
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
-}
-
-std::int64_t inverted(const TetMesh& m, const Positions& start)
-{
-    std::int64_t count = 0;
-    for (Index t = 0; t < m.num_tets(); ++t) {
-        auto vol = [&](const Positions& p) {
-            const Eigen::Vector3d a = p.row(m.tets(t, 0)).transpose();
-            return (p.row(m.tets(t, 1)).transpose() - a)
-                .dot((p.row(m.tets(t, 2)).transpose() - a).cross(p.row(m.tets(t, 3)).transpose() - a));
-        };
-        count += (vol(start) > 0) != (vol(m.positions) > 0) ? 1 : 0;
-    }
-    return count;
-}
-
-std::int64_t far_self(const TetMesh& m, const Positions& start)
-{
-    Detector det;
-    det.set_topology(m);
-    const double reach = 3 * mean_edge_length(start, m.tets);
-    std::set<Index> far;
-    for (const Contact& c : det.detect(m.positions)) {
-        if (c.vertex_object != c.tet_object) continue;
-        double nearest = 1e300;
-        for (int k = 0; k < 4; ++k)
-            nearest = std::min(nearest, (start.row(c.vertex) - start.row(m.tets(c.tet, k))).norm());
-        if (nearest > reach) far.insert(c.vertex);
-    }
-    return static_cast<std::int64_t>(far.size());
 }
 
 sim::ObjectSpec placed(const TetMesh& mesh, double lift)
@@ -124,10 +101,59 @@ Row run(const std::string& name, sim::Scene scene, int steps)
     for (double c : con)
         csum += c;
     r.contacts = con.empty() ? 0 : csum / static_cast<double>(con.size());
-    r.inverted = inverted(s.mesh(), start);
-    r.far_self = far_self(s.mesh(), start);
+    r.inverted = sim::count_inverted(s.mesh(), start);
+    r.far_self = sim::count_far_self_penetrations(s.mesh(), start);
+    r.mean_z = s.mesh().positions.col(2).mean();
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
     return r;
+}
+
+#ifdef TETHASH_HAVE_BULLET
+/// The same scene with Bullet's soft bodies: each object placed as tethash places it, same density, velocity,
+/// dt and duration; inverted tets and far self-penetrations measured on its end state the same way.
+Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int iterations)
+{
+    Row r;
+    r.scene = name;
+    r.integrator = "bullet";
+    r.dt = scene.dt;
+    std::vector<TetMesh> placed_meshes;
+    for (const sim::ObjectSpec& o : scene.objects) {
+        TetMesh m = *o.data;
+        for (Index i = 0; i < m.num_vertices(); ++i)
+            m.positions.row(i) = (o.scale.cwiseProduct(m.positions.row(i).transpose()) + o.translate).transpose();
+        placed_meshes.push_back(std::move(m));
+    }
+    std::vector<bench::PeerBody> bodies;
+    for (size_t k = 0; k < placed_meshes.size(); ++k)
+        bodies.push_back({&placed_meshes[k], scene.objects[k].material.density, scene.objects[k].velocity});
+    const bench::PeerResult p = bench::run_bullet(bodies, scene.dt, steps, iterations);
+    r.ms = median(p.ms);
+    r.integrate = r.ms;
+    r.sweeps = iterations;
+    r.failure = p.failure;
+    for (size_t k = 0; k < placed_meshes.size(); ++k) {
+        TetMesh end = placed_meshes[k];
+        end.positions = p.final[k];
+        r.vertices += end.num_vertices();
+        r.tets += end.num_tets();
+        r.inverted += sim::count_inverted(end, placed_meshes[k].positions);
+        r.far_self += sim::count_far_self_penetrations(end, placed_meshes[k].positions);
+        r.mean_z += end.positions.col(2).sum();
+    }
+    r.mean_z /= static_cast<double>(std::max<Index>(1, r.vertices));
+    r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
+    return r;
+}
+#endif
+
+void print(const Row& r)
+{
+    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %6.1f %8.1f %7lld %5lld %7.4f %10.3g  %s\n",
+                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth, r.response,
+                r.integrate, r.sweeps, r.contacts, static_cast<long long>(r.inverted),
+                static_cast<long long>(r.far_self), r.mean_z, r.stable ? r.dt / r.ms : 0.0, r.failure.c_str());
+    std::fflush(stdout);
 }
 
 double parse_dt(const std::string& v)
@@ -149,7 +175,9 @@ int main(int argc, char** argv)
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     double seconds = 0.5;
-    int threads = 1;
+    int threads = 1, peer_iterations = 10, iterations = 0;
+    double skin = -1, sweep_tolerance = -1, rho = -1;
+    bool no_peer = false;
     app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
     app.add_option("--scenes", filter, "only scenes whose name contains this");
     app.add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")->delimiter(',');
@@ -157,6 +185,12 @@ int main(int argc, char** argv)
     app.add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
     app.add_option("--threads", threads, "detector and solver threads")->capture_default_str();
     app.add_option("--csv", csv, "write the rows as CSV to this file");
+    app.add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
+    app.add_option("--sweep-tolerance", sweep_tolerance, "vbd early stop (fraction of the mean edge); default: scene's");
+    app.add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1); default: scene's");
+    app.add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size; default: scene's");
+    app.add_flag("--no-peer", no_peer, "do not run the peer (Bullet soft bodies) even when built with it");
+    app.add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -187,6 +221,13 @@ int main(int argc, char** argv)
                     TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), threads, load[0],
                     load[1], load[2]);
         std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", seconds).c_str());
+#ifdef TETHASH_HAVE_BULLET
+        std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
+                    bench::bullet_version() / 100, bench::bullet_version() % 100, peer_iterations, no_peer ? " (off: --no-peer)" : "");
+#else
+        std::printf("peer: Bullet not found at build time (install libbullet-dev and rebuild to compare)\n");
+        no_peer = true;
+#endif
 
         std::vector<std::pair<std::string, sim::Scene>> scenes;
         const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh",
@@ -214,9 +255,9 @@ int main(int argc, char** argv)
                 scenes.emplace_back("two armadillos at 2 m/s", two);
             }
         }
-        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %6s %8s %7s %5s %10s  %s\n", "scene", "integrator",
+        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %6s %8s %7s %5s %7s %10s  %s\n", "scene", "integrator",
                     "dt", "verts", "tets", "ms/step", "detect", "depth", "resp", "integr", "iters", "contacts",
-                    "invert", "far", "dt/ms", "failure");
+                    "invert", "far", "mean_z", "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!filter.empty() && name.find(filter) == std::string::npos) continue;
@@ -225,15 +266,28 @@ int main(int argc, char** argv)
                     scene.integrator = i;
                     scene.dt = dt;
                     scene.detect.threads = threads;
-                    const Row r = run(name, scene, std::max(1, static_cast<int>(std::lround(seconds / dt))));
-                    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %6.1f %8.1f %7lld %5lld %10.3g  %s\n",
-                                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.detect,
-                                r.depth, r.response, r.integrate, r.sweeps, r.contacts,
-                                static_cast<long long>(r.inverted), static_cast<long long>(r.far_self),
-                                r.stable ? r.dt / r.ms : 0.0, r.failure.c_str());
-                    std::fflush(stdout);
+                    if (iterations > 0) scene.iterations = iterations;
+                    if (sweep_tolerance >= 0) scene.sweep_tolerance = sweep_tolerance;
+                    if (rho >= 0) scene.acceleration = rho;
+                    if (skin >= 0) {
+                        scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
+                        scene.detect.skin = skin;
+                    }
+                    const int steps = std::max(1, static_cast<int>(std::lround(seconds / dt)));
+                    const Row r = run(name, scene, steps);
+                    print(r);
                     rows.push_back(r);
                 }
+#ifdef TETHASH_HAVE_BULLET
+            if (!no_peer)
+                for (double dt : steps_dt) {
+                    scene.dt = dt;
+                    const Row r = run_peer(name, scene, std::max(1, static_cast<int>(std::lround(seconds / dt))),
+                                           peer_iterations);
+                    print(r);
+                    rows.push_back(r);
+                }
+#endif
         }
         // Teschner et al. 2004: the largest stable dt of those run, divided by the cost per step at that dt.
         std::map<std::pair<std::string, std::string>, std::pair<double, double>> best;
@@ -252,12 +306,12 @@ int main(int argc, char** argv)
                 std::ofstream out(tmp);
                 if (!out) throw Error("--csv: cannot write '" + tmp + "'");
                 out << "scene,integrator,dt,vertices,tets,ms_step,ms_detect,ms_depth,ms_response,ms_integrate,"
-                       "iterations,contacts,inverted,far_self,stable,failure\n";
+                       "iterations,contacts,inverted,far_self,mean_z,stable,failure\n";
                 for (const Row& r : rows)
-                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{},\"{}\"\n",
+                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{:.5g},{},\"{}\"\n",
                                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth,
                                        r.response, r.integrate, r.sweeps, r.contacts, r.inverted, r.far_self,
-                                       r.stable ? 1 : 0, r.failure);
+                                       r.mean_z, r.stable ? 1 : 0, r.failure);
             }
             std::filesystem::rename(tmp, csv);
         }

@@ -140,8 +140,9 @@ void run(Args& a)
     o.sweep = study::parse_sweep(what);
     if (!a.out.empty()) o.out_dir = a.out;
     if (!a.shard.empty()) study::parse_shard(a.shard, o.shard_index, o.shard_count);
-    o.repeat = a.repeat != Args::kUnset ? a.repeat : (o.sweep == study::Sweep::integrator ? 1 : 3);
-    o.warmup = a.warmup != Args::kUnset ? a.warmup : (o.sweep == study::Sweep::integrator ? 0 : 1);
+    const bool simulates = o.sweep == study::Sweep::integrator || o.sweep == study::Sweep::stability;
+    o.repeat = a.repeat != Args::kUnset ? a.repeat : (simulates ? 1 : 3);
+    o.warmup = a.warmup != Args::kUnset ? a.warmup : (simulates ? 0 : 1);
     if (o.repeat < 1) throw Error("--repeat: must be >= 1, found " + std::to_string(o.repeat));
     if (o.warmup < 0) throw Error("--warmup: must be >= 0, found " + std::to_string(o.warmup));
     o.oracle = !a.no_oracle;
@@ -207,11 +208,11 @@ void run(Args& a)
 Registrar reg{
     {"study",
      "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, or the "
-     "simulator's integrator x dt x substeps; CSV, JSON and figures",
+     "simulator's integrator x dt x substeps, or its stability matrix; CSV, JSON and figures",
      [](CLI::App& sub) {
          auto a = std::make_shared<Args>();
          sub.add_option("sweep", a->positional,
-                        "cell-size | table-size | hash | threads | grid | integrator, or: merge DIR...")
+                        "cell-size | table-size | hash | threads | grid | integrator | stability, or: merge DIR...")
              ->required();
          sub.add_option("--mesh", a->o.meshes,
                         "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
@@ -239,8 +240,13 @@ Registrar reg{
          sub.add_option("--integrator", a->o.integrator,
                         "integrators: vbd, implicit_euler, symplectic_euler, all (default: all)");
          sub.add_option("--dt", a->o.dt,
-                        "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5)");
+                        "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5; "
+                        "stability: 1e-3,1/240,1/60 where xF = F x 1/240)");
          sub.add_option("--substeps", a->o.substeps, "substep counts (default: 1)");
+         sub.add_option("--young", a->o.young,
+                        "stability sweep: Young's moduli in Pa, list or FROM:TO:POINTS (default: 1e3,1e5,1e7,1e9)");
+         sub.add_option("--mass-ratio", a->o.mass_ratio,
+                        "stability sweep: density of the first body over the second (default: 1,1e3,1e6)");
          sub.add_option("--duration", a->o.duration, "simulated seconds (default: the scene's, at most 0.5)");
          sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken")
              ->capture_default_str();

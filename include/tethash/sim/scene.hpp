@@ -81,7 +81,11 @@ struct Scene {
     int substeps = 1;
     Integrator integrator = Integrator::vbd;
     LinearSolver solver = LinearSolver::cg;
-    int iterations = 10;     ///< vbd: largest number of sweeps over all vertices per substep
+    int iterations = 6;      ///< vbd: largest number of sweeps over all vertices per substep
+    /// vbd: Chebyshev acceleration of the sweeps (Wang 2015, as in the VBD paper): the estimated spectral radius
+    /// ρ of one sweep, in [0, 1); 0 = off. Hand drop at 1/240: 6 sweeps with ρ 0.9 sag closer to the converged
+    /// answer than 10 plain sweeps, at 0.6 of the cost (docs/simulator.md).
+    double acceleration = 0.9;
     double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep and overstated its friction by 36 %); 0 = always `iterations` sweeps
     double tolerance = 1e-6; ///< CG relative residual
     ContactParams contact;

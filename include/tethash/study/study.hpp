@@ -27,8 +27,8 @@
 
 namespace tethash::study {
 
-enum class Sweep { cell_size, table_size, hash, threads, grid, integrator };
-/// "cell-size", "table-size", "hash", "threads", "grid", "integrator"; throws Error for anything else.
+enum class Sweep { cell_size, table_size, hash, threads, grid, integrator, stability };
+/// "cell-size", "table-size", "hash", "threads", "grid", "integrator", "stability"; throws Error for anything else.
 Sweep parse_sweep(const std::string& name);
 const char* to_string(Sweep s);
 
@@ -51,6 +51,8 @@ struct StudyOptions {
     std::vector<std::string> integrator; ///< simulator sweep
     std::vector<std::string> dt;
     std::vector<std::string> substeps;
+    std::vector<std::string> young;      ///< stability sweep: Young's moduli (Pa)
+    std::vector<std::string> mass_ratio; ///< stability sweep: density of the first body over the second
     double duration = 0;          ///< simulated seconds; 0: the scene's own duration
     int samples = 4;              ///< fixed times (evenly spaced, the last at the end) where errors are taken
     double reference_factor = 16; ///< the reference run uses dt / reference_factor (of the smallest dt)
