@@ -323,6 +323,34 @@ def plot_detection(pts, meta, args, sweep):
             finish(fig, meta, scene, "depth_error" + tag, args)
 
 
+def plot_stability(pts, meta, args):
+    """One panel per integrator: young (rows) × dt and mass ratio (columns), each cell coloured by its verdict."""
+    colours = {"ok": "#4caf50", "stopped": "#ff9800", "crumpled": "#d32f2f"}
+    for scene in sorted({p["scene"] for p in pts}):
+        sp = [p for p in pts if p["scene"] == scene]
+        integs = sorted({p["integrator"] for p in sp})
+        youngs = sorted({num(p["young"]) for p in sp})
+        cols = sorted({(num(p["dt"]), num(p["mass_ratio"])) for p in sp})
+        fig, axes = plt.subplots(1, len(integs), figsize=(4.5 * len(integs), 0.5 * len(youngs) + 2.2), squeeze=False)
+        for ax, integ in zip(axes[0], integs):
+            for p in sp:
+                if p["integrator"] != integ:
+                    continue
+                x = cols.index((num(p["dt"]), num(p["mass_ratio"])))
+                y = youngs.index(num(p["young"]))
+                ax.add_patch(plt.Rectangle((x, y), 1, 1, color=colours.get(p["verdict"], "#9e9e9e")))
+                ax.text(x + 0.5, y + 0.5, p["verdict"][:4], ha="center", va="center", fontsize=6)
+            ax.set_xlim(0, len(cols))
+            ax.set_ylim(0, len(youngs))
+            ax.set_xticks([i + 0.5 for i in range(len(cols))])
+            ax.set_xticklabels(["dt %.3g\nratio %g" % c for c in cols], fontsize=5)
+            ax.set_yticks([i + 0.5 for i in range(len(youngs))])
+            ax.set_yticklabels(["%g" % y for y in youngs], fontsize=6)
+            ax.set_ylabel("young (Pa)")
+            ax.set_title("%s: %s" % (scene, integ), fontsize=8)
+        finish(fig, meta, scene, "stability", args)
+
+
 def plot_integrator(pts, meta, args):
     scene = pts[0]["scene"] if pts else "?"
     ok = [p for p in pts if p["status"] == "ok" and p["err_rms"] != ""]
@@ -400,6 +428,8 @@ def main():
         sweep = rows[0].get("sweep", meta.get("sweep", ""))
         if sweep == "integrator":
             plot_integrator(pts, meta, args)
+        elif sweep == "stability":
+            plot_stability(pts, meta, args)
         else:
             plot_detection(pts, meta, args, sweep)
     except OSError as e:
