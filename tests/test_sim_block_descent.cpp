@@ -21,6 +21,29 @@ using namespace tethash::sim;
 
 namespace {
 
+/// A 1 m bar of square section `thickness` along x, meshed at `resolution`, its x = −0.5 end pinned.
+Scene cantilever(int resolution, double thickness, double young)
+{
+    Scene s;
+    ObjectSpec o;
+    io::GenerateParams g;
+    g.shape = "box";
+    g.resolution = resolution;
+    g.size = Eigen::Vector3d(1.0, thickness, thickness);
+    o.generate = g;
+    o.material.young = young;
+    o.material.density = 1000;
+    o.self_collision = false;
+    s.objects.push_back(o);
+    PinRegion pin;
+    pin.has_box = true;
+    pin.box_min = Eigen::Vector3d(-1, -1, -1);
+    pin.box_max = Eigen::Vector3d(-0.499, 1, 1);
+    s.pins.push_back(pin);
+    s.output.every = 0;
+    return s;
+}
+
 /// `mesh` scaled so that its longest extent is `size`, lowest point at height `lift`.
 ObjectSpec placed(TetMesh mesh, double size, double lift)
 {
@@ -115,23 +138,8 @@ TEST(SimBlockDescent, SameBodyMeshedCoarseAndFineSagsTheSame)
     // must agree within 10 % (springs from the volumes around each edge; implicit Euler with strong damping
     // reaches the equilibrium, so the solver does not enter the comparison).
     auto sag = [](int resolution) {
-        Scene s;
-        ObjectSpec o;
-        io::GenerateParams g;
-        g.shape = "box";
-        g.resolution = resolution;
-        g.size = Eigen::Vector3d(1.0, 0.4, 0.4);
-        o.generate = g;
-        o.material.young = 2e6;
-        o.material.density = 1000;
-        o.material.damping = 0.05;
-        o.self_collision = false;
-        s.objects.push_back(o);
-        PinRegion pin;
-        pin.has_box = true;
-        pin.box_min = Eigen::Vector3d(-1, -1, -1);
-        pin.box_max = Eigen::Vector3d(-0.499, 1, 1);
-        s.pins.push_back(pin);
+        Scene s = cantilever(resolution, 0.4, 2e6);
+        s.objects[0].material.damping = 0.05;
         s.integrator = Integrator::implicit_euler;
         s.dt = 0.01;
         s.output.every = 0;
@@ -158,22 +166,7 @@ TEST(SimBlockDescent, ChebyshevAccelerationBringsFewSweepsCloserToTheConvergedSt
     // be closer to the tip with 60 plain sweeps (the converged implicit step) than with 6 plain sweeps, which
     // leave the body too soft.
     auto tip = [](int sweeps, double rho) {
-        Scene s;
-        ObjectSpec o;
-        io::GenerateParams g;
-        g.shape = "box";
-        g.resolution = 8;
-        g.size = Eigen::Vector3d(1.0, 0.2, 0.2);
-        o.generate = g;
-        o.material.young = 1e6;
-        o.material.density = 1000;
-        o.self_collision = false;
-        s.objects.push_back(o);
-        PinRegion pin;
-        pin.has_box = true;
-        pin.box_min = Eigen::Vector3d(-1, -1, -1);
-        pin.box_max = Eigen::Vector3d(-0.499, 1, 1);
-        s.pins.push_back(pin);
+        Scene s = cantilever(8, 0.2, 1e6);
         s.dt = 1.0 / 240;
         s.iterations = sweeps;
         s.acceleration = rho;
