@@ -234,3 +234,22 @@ TEST(IoMalformed, SceneSyntaxErrorsAreCleanErrors)
         EXPECT_FALSE(fs::exists(dir / "out"));
     }
 }
+
+TEST(IoMalformed, FuzzFindingsFailCleanly)
+{
+    // tests/data/fuzz: inputs on which a harness of tests/fuzz once crashed (docs/robustness.md).
+    // Each must now give exit status 2 and a message naming the file.
+    const auto dir = temp_dir();
+    const fs::path findings = fs::path(TETHASH_SOURCE_DIR) / "tests" / "data" / "fuzz";
+    int count = 0;
+    for (const auto& entry : fs::directory_iterator(findings)) {
+        const fs::path p = entry.path();
+        const std::string ext = p.extension().string();
+        const bool surface = ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".off";
+        const std::string args =
+            surface ? "tetrahedralize " + quote(p) + " -o " + quote(dir / "out.vtu") : "info " + quote(p);
+        expect_bounded_error(args, {p.string()});
+        ++count;
+    }
+    EXPECT_GT(count, 0);
+}
