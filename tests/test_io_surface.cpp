@@ -200,3 +200,85 @@ TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
     }
     EXPECT_THROW(io::tetrahedralize(sphere_surface(4), {0, true}), Error);
 }
+
+TEST(Surface, PlyIsReadByTethashInEveryEncoding)
+{
+    // .ply does not go through assimp (its 5.2 importer crashes on broken files): ASCII, both binary
+    // byte orders, polygons fanned into triangles, extra properties and elements skipped.
+    SKIP_WITHOUT_ASSIMP();
+    const auto dir = temp_dir();
+    const std::string header = "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                               "property uchar red\nelement face 1\nproperty list uchar int vertex_indices\n"
+                               "element edge 1\nproperty int a\nproperty int b\nend_header\n";
+    const auto expect_square = [](const io::SurfaceMesh& s) {
+        ASSERT_EQ(s.vertices.rows(), 4);
+        ASSERT_EQ(s.triangles.rows(), 2);
+        EXPECT_EQ(s.vertices(2, 0), 1.0);
+        EXPECT_EQ(s.vertices(2, 1), 1.0);
+        EXPECT_EQ(s.triangles(1, 0), 0);
+        EXPECT_EQ(s.triangles(1, 1), 2);
+        EXPECT_EQ(s.triangles(1, 2), 3);
+    };
+    test::write_text(dir / "a.ply", "ply\nformat ascii 1.0\ncomment a square\n" + header +
+                                        "0 0 0 9\n1 0 0 9\n1 1 0 9\n0 1 0 9\n4 0 1 2 3\n0 1\n");
+    expect_square(io::read_surface((dir / "a.ply").string()));
+    for (const bool big : {false, true}) {
+        std::string body;
+        const auto put = [&](const void* p, std::size_t n) {
+            const auto* b = static_cast<const char*>(p);
+            for (std::size_t k = 0; k < n; ++k)
+                body += b[big ? n - 1 - k : k];
+        };
+        const float xy[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        for (const auto& v : xy) {
+            const float z = 0;
+            put(&v[0], 4), put(&v[1], 4), put(&z, 4);
+            body += '\x09';
+        }
+        body += '\x04';
+        for (std::int32_t i = 0; i < 4; ++i)
+            put(&i, 4);
+        const std::int32_t edge[2] = {0, 1};
+        put(&edge[0], 4), put(&edge[1], 4);
+        const auto p = dir / (big ? "be.ply" : "le.ply");
+        test::write_text(p, std::string("ply\nformat binary_") + (big ? "big" : "little") + "_endian 1.0\n" + header +
+                                body);
+        expect_square(io::read_surface(p.string()));
+        // Cut inside the faces: an error naming the byte, not a read past the end.
+        test::write_text(p, std::string("ply\nformat binary_") + (big ? "big" : "little") + "_endian 1.0\n" + header +
+                                body.substr(0, body.size() - 12));
+        try {
+            io::read_surface(p.string());
+            ADD_FAILURE() << "no error for a truncated " << p;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(p.string() + ": byte "), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("found the end of the file"), std::string::npos) << e.what();
+        }
+    }
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement "
+         "face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n3 0 0 7\n",
+         ":11: face 0: face refers to vertex 7, but there are 1 vertices"},
+        {"ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n",
+         ":3: element vertex declares 99999999999 items, more than the file"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n",
+         ":3: element vertex has no x, y and z properties"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+         "end_header\n0 nan 0\n",
+         ":8: vertex 0: vertex has a non-finite y coordinate"},
+        {"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+         "end_header\n0 0\n0 0 0\n",
+         ":8: vertex 0: expected a number, found the end of the line"},
+        {"ply\nformat ascii 1.0\nelement vertex 1\nproperty fl\xff x\nend_header\n",
+         ":4: expected 'property TYPE NAME'"},
+    };
+    for (const auto& [text, fragment] : bad) {
+        test::write_text(dir / "bad.ply", text);
+        try {
+            io::read_surface((dir / "bad.ply").string());
+            ADD_FAILURE() << "no error for\n" << text;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find((dir / "bad.ply").string() + fragment), std::string::npos) << e.what();
+        }
+    }
+}

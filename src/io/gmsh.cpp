@@ -268,15 +268,26 @@ class MshReader {
     }
     std::int64_t read_tag(std::string_view what) { return m_version == 41 ? read_size(what) : read_int(what); }
 
-    /// Checks that `count` items of `bytes_each` bytes fit in what is left of a binary file.
-    void check_room(std::int64_t count, std::size_t bytes_each, const std::string& what)
+    /// Checks that `count` items fit in what is left of the file: `bytes_each` bytes each in a binary
+    /// file, `values_each` numbers each in an ASCII one (at least a byte each: the loose bound leaves a
+    /// merely truncated file to the reader's precise message). Division only, so that no declared count
+    /// overflows; products of `count` are then safe and loops over it bounded.
+    void check_room(std::int64_t count, std::size_t bytes_each, std::size_t values_each, const std::string& what)
     {
-        if (!binary()) return;
         const std::size_t left = m_r.size() - m_r.offset();
-        if (count > 0 && static_cast<std::uint64_t>(count) > left / bytes_each)
-            m_r.fail_at_byte(m_r.offset(), "expected " + std::to_string(count) + " " + what + " (" +
-                                               std::to_string(static_cast<std::uint64_t>(count) * bytes_each) +
-                                               " bytes), found end of file after " + std::to_string(left) + " bytes");
+        if (count <= 0) return;
+        if (binary()) {
+            if (static_cast<std::uint64_t>(count) > left / bytes_each)
+                m_r.fail_at_byte(m_r.offset(), "expected " + std::to_string(count) + " " + what + " (" +
+                                                   std::to_string(static_cast<std::uint64_t>(count)) + " × " +
+                                                   std::to_string(bytes_each) + " bytes), found end of file after " +
+                                                   std::to_string(left) + " bytes");
+            return;
+        }
+        if (static_cast<std::uint64_t>(count) > left / values_each)
+            m_r.fail_message("expected " + std::to_string(count) + " " + what + " (" + std::to_string(values_each) +
+                             " numbers each), but only " + std::to_string(left) +
+                             " bytes remain in the file, too few to hold them");
     }
 
     /// One coordinate of node `tag`.
@@ -337,7 +348,7 @@ class MshReader {
                         m_r.next_double_any("a bounding box value of entity " + std::to_string(tag));
                 }
                 const std::int64_t nphys = read_size("the number of physical tags of entity " + std::to_string(tag));
-                check_room(nphys, 4, "physical tags");
+                check_room(nphys, 4, 1, "physical tags");
                 for (std::int64_t k = 0; k < nphys; ++k) {
                     const std::int64_t p = read_int("a physical tag of entity " + std::to_string(tag));
                     if (k == 0) m_entity_physical[d].emplace(tag, p);
@@ -345,7 +356,7 @@ class MshReader {
                 if (d > 0) {
                     const std::int64_t nb =
                         read_size("the number of bounding entities of entity " + std::to_string(tag));
-                    check_room(nb, 4, "bounding entity tags");
+                    check_room(nb, 4, 1, "bounding entity tags");
                     for (std::int64_t k = 0; k < nb; ++k)
                         read_int("a bounding entity tag");
                 }
@@ -361,7 +372,7 @@ class MshReader {
         read_size("the smallest node tag");
         read_size("the largest node tag");
         if (total > k_max_int32) m_r.fail("at most 2^31-1 nodes", std::to_string(total));
-        check_room(total, 3 * sizeof(double) + m_size_t, "nodes");
+        check_room(total, 3 * sizeof(double) + m_size_t, 4, "nodes");
         const auto reserve = static_cast<std::size_t>(std::min<std::int64_t>(total, m_r.size()));
         m_node_tags.reserve(reserve);
         m_xyz.reserve(3 * reserve);
@@ -389,7 +400,8 @@ class MshReader {
                 m_r.fail_message(msg);
             }
             const int extra = parametric ? static_cast<int>(dim) : 0;
-            check_room(count, m_size_t + (3 + static_cast<std::size_t>(extra)) * sizeof(double), "nodes");
+            check_room(count, m_size_t + (3 + static_cast<std::size_t>(extra)) * sizeof(double),
+                       4 + static_cast<std::size_t>(extra), "nodes");
             block_tags.clear();
             for (std::int64_t i = 0; i < count; ++i)
                 block_tags.push_back(read_size("a node tag"));
@@ -456,7 +468,7 @@ class MshReader {
             }
             const int nn = nodes_per_element(type);
             if (type == 4) {
-                check_room(count, 5 * m_size_t, "tets");
+                check_room(count, 5 * m_size_t, 5, "tets");
                 const std::int64_t label = label_of(dim, entity);
                 for (std::int64_t e = 0; e < count; ++e) {
                     const std::int64_t etag = read_size("an element tag");
@@ -468,7 +480,8 @@ class MshReader {
                     m_labels.push_back(static_cast<Index>(label));
                 }
             } else if (nn > 0) {
-                check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, "elements");
+                check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn),
+                           "elements");
                 if (binary()) {
                     m_r.skip_bytes(static_cast<std::size_t>(count) * static_cast<std::size_t>(1 + nn) * m_size_t,
                                    "elements of type " + std::to_string(type));
@@ -481,6 +494,7 @@ class MshReader {
                 if (binary())
                     m_r.fail_at_byte(type_at, "element type " + std::to_string(type) +
                                                   " is unknown, so its block cannot be skipped in a binary file");
+                check_room(count, 1, 1, "element lines of type " + std::to_string(type));
                 m_r.skip_rest_of_line();
                 for (std::int64_t e = 0; e < count; ++e) {
                     bool eof = false;
@@ -517,7 +531,7 @@ class MshReader {
     {
         const std::int64_t total = m_r.next_int_in("the number of nodes", 0, k_max_int32);
         m_r.skip_rest_of_line();
-        check_room(total, 4 + 3 * sizeof(double), "nodes");
+        check_room(total, 4 + 3 * sizeof(double), 4, "nodes");
         const auto reserve = static_cast<std::size_t>(std::min<std::int64_t>(total, m_r.size()));
         m_node_tags.reserve(reserve);
         m_xyz.reserve(3 * reserve);
@@ -558,6 +572,7 @@ class MshReader {
         const std::int64_t total = m_r.next_int_in("the number of elements", 0, k_max_count);
         m_r.skip_rest_of_line();
         if (!binary()) {
+            check_room(total, 1, 3, "elements"); // a tag, a type and a number of tags at least
             for (std::int64_t e = 0; e < total; ++e) {
                 const std::int64_t etag = m_r.next_int("an element tag");
                 const std::int64_t type = m_r.next_int("the type of element " + std::to_string(etag));
@@ -587,7 +602,8 @@ class MshReader {
                                                  std::to_string(total) + " in all), found " + std::to_string(count));
                 if (ntags < 0 || ntags > 1000)
                     m_r.fail_at_byte(at + 8, "expected a number of tags 0..1000, found " + std::to_string(ntags));
-                check_room(count, 4 * static_cast<std::size_t>(1 + ntags + nn), "elements");
+                check_room(count, 4 * static_cast<std::size_t>(1 + ntags + nn),
+                           static_cast<std::size_t>(1 + ntags + nn), "elements");
                 for (std::int64_t e = 0; e < count; ++e) {
                     const std::int64_t etag = read_int("an element tag");
                     read_element22(type, ntags, etag);

@@ -2,12 +2,14 @@
 // export: one mesh, written through a private folder so side files get their final names).
 #include "tethash/io/surface.hpp"
 
+#include "ply.hpp"
 #include "tethash/error.hpp"
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -63,11 +65,19 @@ bool have_assimp()
 
 namespace {
 
-void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, std::vector<double>& xyz,
-             std::vector<Index>& tri)
+/// Deepest node nesting followed (surface formats use a few levels; the walk is recursive).
+constexpr int k_max_node_depth = 256;
+
+void collect(const std::string& path, const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, int depth,
+             std::vector<double>& xyz, std::vector<Index>& tri)
 {
+    if (depth > k_max_node_depth)
+        throw Error(path + ": the scene nests nodes more than " + std::to_string(k_max_node_depth) + " deep");
     const aiMatrix4x4 m = parent * node->mTransformation;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+        if (node->mMeshes[i] >= scene->mNumMeshes)
+            throw Error(path + ": a node refers to mesh " + std::to_string(node->mMeshes[i]) + ", but the file has " +
+                        std::to_string(scene->mNumMeshes));
         const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
         const auto base = static_cast<Index>(xyz.size() / 3);
         for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
@@ -77,12 +87,29 @@ void collect(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
             if (face.mNumIndices != 3) continue; // points and lines
-            for (int k = 0; k < 3; ++k)
+            for (int k = 0; k < 3; ++k) {
+                if (face.mIndices[k] >= mesh->mNumVertices)
+                    throw Error(path + ": face " + std::to_string(f) + " refers to vertex " +
+                                std::to_string(face.mIndices[k]) + ", but its mesh has " +
+                                std::to_string(mesh->mNumVertices) + " vertices");
                 tri.push_back(base + static_cast<Index>(face.mIndices[k]));
+            }
         }
     }
     for (unsigned c = 0; c < node->mNumChildren; ++c)
-        collect(scene, node->mChildren[c], m, xyz, tri);
+        collect(path, scene, node->mChildren[c], m, depth + 1, xyz, tri);
+}
+
+/// Every triangle of the scene with its node transform applied, as a soup (vertices per mesh).
+void import_with_assimp(const std::string& path, std::vector<double>& xyz, std::vector<Index>& tri)
+{
+    Assimp::Importer importer;
+    // Validation runs before the other steps: without it a face index past the vertices crashes inside
+    // assimp's post-processing.
+    const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                                       aiProcess_JoinIdenticalVertices);
+    if (!scene || !scene->mRootNode) throw Error(path + ": cannot read surface: " + importer.GetErrorString());
+    collect(path, scene, scene->mRootNode, aiMatrix4x4(), 0, xyz, tri);
 }
 
 } // namespace
@@ -91,13 +118,17 @@ SurfaceMesh read_surface(const std::string& path)
 {
     if (!std::filesystem::exists(path)) throw Error(path + ": no such file");
     if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a surface file");
-    Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
-    if (!scene || !scene->mRootNode) throw Error(path + ": cannot read surface: " + importer.GetErrorString());
     std::vector<double> xyz;
     std::vector<Index> tri;
-    collect(scene, scene->mRootNode, aiMatrix4x4(), xyz, tri);
+    if (extension_of(path) == ".ply")
+        detail::read_ply(path, xyz, tri); // assimp 5.2's PLY importer crashes on broken files
+    else
+        import_with_assimp(path, xyz, tri);
     if (tri.empty()) throw Error(path + ": no triangles in the file");
+    // Before the join: NaN compares unequal to itself, which stalled the loop below (and breaks the sort).
+    for (std::size_t i = 0; i < xyz.size(); ++i)
+        if (!std::isfinite(xyz[i]))
+            throw Error(path + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
     // Join vertices at identical positions (assimp keeps STL corners apart: they differ in their normals),
     // keeping the first occurrence's order.
     const std::size_t nv = xyz.size() / 3;
@@ -125,7 +156,6 @@ SurfaceMesh read_surface(const std::string& path)
     for (std::size_t t = 0; t < tri.size(); ++t)
         s.triangles(static_cast<Eigen::Index>(t / 3), static_cast<Eigen::Index>(t % 3)) =
             new_id[rep[static_cast<std::size_t>(tri[t])]];
-    if (!s.vertices.allFinite()) throw Error(path + ": non-finite vertex coordinate");
     return s;
 }
 

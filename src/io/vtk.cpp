@@ -382,12 +382,27 @@ void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arra
             r[t] = static_cast<Index>(a.values[static_cast<std::size_t>(tet_cells[t])]);
         return r;
     };
+    // Object ids number objects from 0 and every object holds at least one cell or point, so an id
+    // must be below their count: larger ones (2147483647) would overflow the object count.
+    const auto check_object_ids = [&](const NamedArray& a, const char* element) {
+        for (std::size_t i = 0; i < a.values.size(); ++i)
+            if (a.values[i] >= static_cast<double>(a.values.size()))
+                throw Error(a.where + ": array '" + a.name + "' gives " + element + " " + std::to_string(i) +
+                            " object id " + std::to_string(static_cast<std::int64_t>(a.values[i])) +
+                            ", expected an id below the number of " + element + "s (" +
+                            std::to_string(a.values.size()) + "): objects are numbered from 0");
+    };
     const std::size_t cells = num_cells_in_file;
-    if (const NamedArray* a = pick(cell_arrays, k_object_names, 0, cells, "object ids")) mesh.tet_object = per_tet(*a);
+    if (const NamedArray* a = pick(cell_arrays, k_object_names, 0, cells, "object ids")) {
+        check_object_ids(*a, "cell");
+        mesh.tet_object = per_tet(*a);
+    }
     if (const NamedArray* a = pick(cell_arrays, k_cell_label_names, -2147483648.0, cells, "tet labels"))
         mesh.tet_label = per_tet(*a);
-    if (const NamedArray* a = pick(point_arrays, k_object_names, 0, n, "object ids"))
+    if (const NamedArray* a = pick(point_arrays, k_object_names, 0, n, "object ids")) {
+        check_object_ids(*a, "point");
         mesh.vertex_object.assign(a->values.begin(), a->values.end());
+    }
     if (const NamedArray* a = pick(point_arrays, k_point_label_names, -2147483648.0, n, "vertex labels"))
         mesh.vertex_label.assign(a->values.begin(), a->values.end());
 
@@ -551,15 +566,48 @@ bool zlib_inflate(const unsigned char* src, std::size_t size, std::size_t expect
 {
 #ifdef TETHASH_HAVE_ZLIB
     (void)where;
+    // The output grows with what the stream actually yields (never to the declared size up front),
+    // so that a header declaring gigabytes costs only what its data inflate to.
     const std::size_t start = out.size();
-    out.resize(start + expected);
-    uLongf dest_len = static_cast<uLongf>(expected);
-    const int rc = ::uncompress(out.data() + start, &dest_len, src, static_cast<uLong>(size));
-    if (rc != Z_OK || dest_len != expected) {
-        out.resize(start);
-        return false;
+    z_stream zs{};
+    if (inflateInit(&zs) != Z_OK) return false;
+    zs.next_in = const_cast<Bytef*>(src);
+    zs.avail_in = static_cast<uInt>(std::min<std::size_t>(size, std::numeric_limits<uInt>::max()));
+    std::size_t produced = 0;
+    bool ok = false;
+    for (;;) {
+        if (zs.avail_in == 0 && size > 0) { // feed the rest of a block larger than 4 GiB
+            const std::size_t used = static_cast<std::size_t>(zs.next_in - src);
+            zs.avail_in = static_cast<uInt>(std::min<std::size_t>(size - used, std::numeric_limits<uInt>::max()));
+        }
+        if (produced == expected) {
+            // All expected bytes are there: the stream must end without yielding another byte.
+            unsigned char extra = 0;
+            int rc = Z_OK;
+            do {
+                zs.next_out = &extra;
+                zs.avail_out = 1;
+                rc = inflate(&zs, Z_NO_FLUSH);
+            } while (rc == Z_OK && zs.avail_out == 1);
+            ok = rc == Z_STREAM_END && zs.avail_out == 1;
+            break;
+        }
+        const std::size_t grow = std::min(
+            {expected - produced, std::max<std::size_t>(std::size_t(1) << 16, produced), std::size_t(1) << 30});
+        out.resize(start + produced + grow);
+        zs.next_out = out.data() + start + produced;
+        zs.avail_out = static_cast<uInt>(grow);
+        const int rc = inflate(&zs, Z_NO_FLUSH);
+        produced += grow - zs.avail_out;
+        if (rc == Z_STREAM_END) {
+            ok = produced == expected;
+            break;
+        }
+        if (rc != Z_OK) break; // corrupt, or the input ended before the stream did
     }
-    return true;
+    inflateEnd(&zs);
+    out.resize(ok ? start + expected : start);
+    return ok;
 #else
     (void)src, (void)size, (void)expected, (void)out;
     throw Error(where + ": zlib-compressed data (vtkZLibDataCompressor), but tethash was built without zlib");

@@ -114,6 +114,7 @@ class Base64Reader {
 };
 
 /// Inflates one zlib block into `out` (appended); false on a corrupt block or a size mismatch.
+/// `out` grows with the data actually inflated, never to `expected` before the stream yields it.
 /// Throws Error(`where` ...) if tethash was built without zlib.
 bool zlib_inflate(const unsigned char* src, std::size_t size, std::size_t expected, std::vector<unsigned char>& out,
                   const std::string& where);

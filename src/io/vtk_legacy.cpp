@@ -418,6 +418,10 @@ TetMesh LegacyReader::read()
             if (num_points > 2147483647)
                 fail(at_token(), "too many points for tethash (" + std::to_string(num_points) + ")");
             const Scalar type = expect_type("POINTS");
+            // A bit holds no coordinate, and decoding bits costs a double per bit (64 times the file).
+            if (type == Scalar::Bit)
+                fail(at_token(), "expected the data type of POINTS to be a number type (float, double, int, ...), "
+                                 "found bit");
             coords = read_values<double>(3 * static_cast<std::size_t>(num_points), type,
                                          "POINTS (" + std::to_string(num_points) + " points × 3)", &coords_place);
             have_points = true;
@@ -431,11 +435,15 @@ TetMesh LegacyReader::read()
                 // Version 5.x layout: OFFSETS (a values) then CONNECTIVITY (b values).
                 next_token();
                 const Scalar ot = expect_type("OFFSETS");
+                if (ot == Scalar::Bit)
+                    fail(at_token(), "expected the data type of OFFSETS to be an integer type, found bit");
                 ArrayPlace offsets_place;
                 offsets = read_values<std::int64_t>(static_cast<std::size_t>(a), ot, "OFFSETS", &offsets_place);
                 next_token();
                 if (lower(m_tok) != "connectivity") fail(at_token(), "expected CONNECTIVITY, found " + found_token());
                 const Scalar ct = expect_type("CONNECTIVITY");
+                if (ct == Scalar::Bit)
+                    fail(at_token(), "expected the data type of CONNECTIVITY to be an integer type, found bit");
                 conn = read_values<std::int64_t>(static_cast<std::size_t>(b), ct, "CONNECTIVITY", &conn_place);
                 num_cells = a > 0 ? a - 1 : 0;
                 if (a == 0) offsets.push_back(0);

@@ -88,6 +88,9 @@ struct XmlDocument {
     std::int64_t appended_line = 0;
 };
 
+/// Deepest element nesting the parser accepts (VTK files use fewer than ten levels).
+constexpr std::size_t k_max_xml_depth = 256;
+
 class XmlParser {
   public:
     XmlParser(const std::string& path, const std::string& data) : m_path(path), m_data(data) {}
@@ -286,7 +289,14 @@ XmlDocument XmlParser::parse()
                 stack.back()->children.push_back(std::move(el));
                 added = &stack.back()->children.back();
             }
-            if (!empty) stack.push_back(added);
+            if (!empty) {
+                // VTK files nest a few levels; the limit keeps a hostile file from exhausting the
+                // stack in the (recursive) destruction of the element tree.
+                if (stack.size() >= k_max_xml_depth)
+                    fail("expected at most " + std::to_string(k_max_xml_depth) + " nested elements, found <" +
+                         added->name + "> nested deeper");
+                stack.push_back(added);
+            }
         }
     }
     if (!have_root) fail("expected an XML element, found " + found());
@@ -473,6 +483,9 @@ struct Base64Source {
     }
 };
 
+/// The most a deflate stream can expand (258-byte matches coded in 2 bits, rounded up).
+constexpr std::size_t k_max_inflate_ratio = 1032;
+
 template <class Source>
 std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& da, std::size_t expected_bytes,
                                                  const std::string& what)
@@ -532,7 +545,6 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
                                                                std::to_string(nblocks) +
                                                                " blocks, more than the file can hold");
     const auto sizes = header_words(static_cast<std::size_t>(nblocks));
-    out.reserve(std::min(expected_bytes, 4 * m_data.size()));
     std::vector<unsigned char> comp;
     for (std::int64_t b = 0; b < nblocks; ++b) {
         const std::int64_t cs = sizes[static_cast<std::size_t>(b)];
@@ -543,6 +555,14 @@ std::vector<unsigned char> VtuReader::read_block(Source& src, const XmlElement& 
         const std::size_t block_pos = src.pos;
         if (!src.take(static_cast<std::size_t>(cs), comp)) short_data(static_cast<std::size_t>(cs), "compressed data");
         const std::size_t expect = static_cast<std::size_t>(b + 1 == nblocks ? last : block_size);
+        // Deflate expands at most ~1032:1; a block that cannot hold what its header declares fails
+        // here, before any output is allocated.
+        if (expect / k_max_inflate_ratio > static_cast<std::size_t>(cs) + 1)
+            fail(raw ? at_byte(block_pos) : at_line(da.line),
+                 what + ": zlib block " + std::to_string(b) + " of " + std::to_string(nblocks) + " has " +
+                     std::to_string(cs) + " compressed bytes, which cannot inflate to the " + std::to_string(expect) +
+                     " bytes its header declares (zlib inflates at most " + std::to_string(k_max_inflate_ratio) +
+                     " times)");
         if (!zlib_inflate(comp.data(), comp.size(), expect, out, raw ? at_byte(block_pos) : at_line(da.line)))
             fail(raw ? at_byte(block_pos) : at_line(da.line),
                  what + ": zlib block " + std::to_string(b) + " of " + std::to_string(nblocks) +
@@ -664,8 +684,9 @@ TetMesh VtuReader::read()
         const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
         if (nc > (std::int64_t(1) << 40))
             fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
-        if (total_points + np > 2147483647)
-            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points + np) + ")");
+        if (np > 2147483647 - total_points)
+            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points) + " + " +
+                                          std::to_string(np) + ", at most 2147483647)");
         const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
 
         // Points

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace tethash::sim {
@@ -50,6 +51,9 @@ const char* to_string(LinearSolver solver)
 }
 
 namespace {
+
+/// Largest lattice resolution of generated and tetrahedralized objects (io::generate's limit).
+constexpr std::int64_t k_max_resolution = 1000;
 
 /// Reads one TOML table, checking every key is known and every value has the right type.
 class Reader {
@@ -135,6 +139,20 @@ class Reader {
         if (v < lo) fail(&n, key, "must be ≥ " + std::to_string(lo) + ", found " + std::to_string(v));
         return v;
     }
+    /// An integer in [lo, hi], checked before it is narrowed (4294967297 must not become 1).
+    std::int64_t integer_in(const toml::node& n, const std::string& key, std::int64_t lo, std::int64_t hi) const
+    {
+        const std::int64_t v = integer(n, key);
+        if (v < lo || v > hi)
+            fail(&n, key,
+                 "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + std::to_string(v));
+        return v;
+    }
+    /// An int in [lo, INT_MAX].
+    int int_at_least(const toml::node& n, const std::string& key, int lo) const
+    {
+        return static_cast<int>(integer_in(n, key, lo, std::numeric_limits<int>::max()));
+    }
     bool boolean(const toml::node& n, const std::string& key) const
     {
         if (!n.is_boolean()) fail(&n, key, std::string("expected true or false, found ") + type_name(n));
@@ -214,7 +232,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
         else if (key == "mesh")
             o.mesh = r.path(r.string(v, full));
         else if (key == "surface_resolution")
-            o.surface_resolution = static_cast<int>(r.integer_at_least(v, full, 1));
+            o.surface_resolution = static_cast<int>(r.integer_in(v, full, 1, k_max_resolution));
         else if (key == "scale") {
             if (v.is_number())
                 o.scale.setConstant(r.positive(v, full));
@@ -255,7 +273,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
                         r.fail(&gv, gfull, "unknown shape '" + gp.shape + "' (known: " + list + ")");
                     }
                 } else if (gkey == "resolution")
-                    gp.resolution = static_cast<int>(r.integer_at_least(gv, gfull, 1));
+                    gp.resolution = static_cast<int>(r.integer_in(gv, gfull, 1, k_max_resolution));
                 else if (gkey == "size") {
                     // A single number is the longest extent (the shape keeps its proportions);
                     // three numbers are the bounding-box extents (the shape is stretched to them).
@@ -302,11 +320,11 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         if (key == "dt")
             s.dt = r.positive(v, key);
         else if (key == "steps")
-            s.steps = static_cast<int>(r.integer_at_least(v, key, 0));
+            s.steps = r.int_at_least(v, key, 0);
         else if (key == "substeps")
-            s.substeps = static_cast<int>(r.integer_at_least(v, key, 1));
+            s.substeps = r.int_at_least(v, key, 1);
         else if (key == "iterations")
-            s.iterations = static_cast<int>(r.integer_at_least(v, key, 1));
+            s.iterations = r.int_at_least(v, key, 1);
         else if (key == "tolerance")
             s.tolerance = r.positive(v, key);
         else if (key == "acceleration")
@@ -399,7 +417,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         r.fail(&dv, full, e.what());
                     }
                 } else if (d == "threads")
-                    s.detect.threads = static_cast<int>(r.integer_at_least(dv, full, 0));
+                    s.detect.threads = r.int_at_least(dv, full, 0);
                 else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
                     if (dv.is_number()) {
                         s.detect.skin_mode = DetectParams::SkinMode::absolute;
@@ -423,7 +441,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             for (auto&& [ok, ov] : t) {
                 const std::string o(ok.str()), full = "output." + o;
                 if (o == "every")
-                    s.output.every = static_cast<int>(r.integer_at_least(ov, full, 0));
+                    s.output.every = r.int_at_least(ov, full, 0);
                 else if (o == "fields") {
                     const toml::array* a = ov.as_array();
                     if (!a)
@@ -456,14 +474,14 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                 for (auto&& [pk, pv] : t) {
                     const std::string pkey(pk.str()), full = pre + pkey;
                     if (pkey == "object")
-                        p.object = static_cast<int>(r.integer_at_least(pv, full, 0));
+                        p.object = r.int_at_least(pv, full, 0);
                     else if (pkey == "vertices") {
                         const toml::array* va = pv.as_array();
                         if (!va)
                             r.fail(&pv, full,
                                    std::string("expected an array of integers, found ") + Reader::type_name(pv));
                         for (const toml::node& id : *va)
-                            p.vertices.push_back(static_cast<Index>(r.integer_at_least(id, full, 0)));
+                            p.vertices.push_back(r.int_at_least(id, full, 0));
                     } else if (pkey == "box_min") {
                         p.box_min = r.vec3(pv, full);
                         has_min = true;
