@@ -1,5 +1,6 @@
 // Detector vs the brute-force oracle over many seeded scenes and every parameter kind; determinism;
 // object rules; API errors.
+#include "../src/core/scan.hpp"
 #include "core_scenes.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -10,6 +11,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -482,4 +484,16 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
                         << "cell " << cell << " table " << table << " hash " << to_string(hash) << " threads "
                         << threads;
                 }
+}
+
+TEST(CoreDetect, ScanKernelFollowsTethashSimd)
+{
+    // .ci/run repeats the detection tests with TETHASH_SIMD=scalar (the path of machines without AVX2):
+    // they must then run the scalar kernel.
+    const char* env = std::getenv("TETHASH_SIMD");
+    const std::string kernel = detail::scan_kernel_name();
+    if (env && std::strcmp(env, "scalar") == 0)
+        EXPECT_EQ(kernel, "scalar");
+    else
+        EXPECT_TRUE(kernel == "avx2" || kernel == "scalar") << kernel;
 }
