@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace tethash::test {
@@ -18,6 +20,22 @@ struct Scene {
     std::vector<Index> vertex_object, tet_object;
     std::vector<ObjectOptions> objects;
 };
+
+/// One object as the text of a Medit .mesh file (1-based indices).
+inline std::string medit_text(const Scene& s)
+{
+    std::ostringstream o;
+    o.precision(17);
+    o << "MeshVersionFormatted 1\nDimension 3\nVertices\n" << s.positions.rows() << "\n";
+    for (Eigen::Index v = 0; v < s.positions.rows(); ++v)
+        o << s.positions(v, 0) << " " << s.positions(v, 1) << " " << s.positions(v, 2) << " 0\n";
+    o << "Tetrahedra\n" << s.tets.rows() << "\n";
+    for (Eigen::Index t = 0; t < s.tets.rows(); ++t)
+        o << s.tets(t, 0) + 1 << " " << s.tets(t, 1) + 1 << " " << s.tets(t, 2) + 1 << " " << s.tets(t, 3) + 1
+          << " 0\n";
+    o << "End\n";
+    return o.str();
+}
 
 /// Cube lattice of nx × ny × nz cubes of edge h at `origin`, 6 tets per cube (all positively oriented).
 inline Scene lattice_object(int nx, int ny, int nz, double h, const Eigen::Vector3d& origin)

@@ -73,7 +73,6 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
         {"generate box -o " + sq(dir / "g.vtu") + " --resolution abc", "--resolution"},
         {"generate box -o " + sq(dir / "g.vtu") + " --size 1 2", "--size"},
         {"tetrahedralize x.obj -o " + sq(dir / "t.vtu") + " -r abc", "--resolution"},
-        {"detect " + sq(kBox) + " --threads abc", "--threads"},
         {"study cell-size --mesh " + sq(kBox) + " --repeat abc", "--repeat"},
         {"info --no-such-option " + sq(kBox), "--no-such-option"},
         {"convert " + sq(kBox), "OUT"},
@@ -84,6 +83,7 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
         expect_one_line_error(r, args, {fragment, "--help"});
         EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
     }
+    expect_one_line_error(run_tethash("detect " + sq(kBox) + " --threads abc"), "--threads abc", {"--threads", "abc"});
     // Options that contradict each other.
     const std::vector<std::pair<std::string, std::string>> conflicts = {
         {"generate box -o " + sq(dir / "g.vtu") + " --size 1 1 1 --scale 2", "--scale"},

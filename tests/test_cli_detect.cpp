@@ -18,21 +18,18 @@ std::string sq(const std::filesystem::path& p)
     return tethash::test::quote(p);
 }
 
-/// Writes one object as a Medit .mesh file (1-based indices).
-void write_medit(const std::filesystem::path& p, const Scene& s)
+/// A contacts CSV without its '#' header comment.
+std::string csv_body(const std::string& text)
 {
-    std::ostringstream o;
-    o.precision(17);
-    o << "MeshVersionFormatted 1\nDimension 3\nVertices\n" << s.positions.rows() << "\n";
-    for (Eigen::Index v = 0; v < s.positions.rows(); ++v)
-        o << s.positions(v, 0) << " " << s.positions(v, 1) << " " << s.positions(v, 2) << " 0\n";
-    o << "Tetrahedra\n" << s.tets.rows() << "\n";
-    for (Eigen::Index t = 0; t < s.tets.rows(); ++t)
-        o << s.tets(t, 0) + 1 << " " << s.tets(t, 1) + 1 << " " << s.tets(t, 2) + 1 << " " << s.tets(t, 3) + 1
-          << " 0\n";
-    o << "End\n";
-    write_text(p, o.str());
+    std::istringstream in(text);
+    std::string out;
+    for (std::string line; std::getline(in, line);)
+        if (line.empty() || line[0] != '#') out += line + "\n";
+    return out;
 }
+
+const char* const kContactsHeader =
+    "vertex,tet,vertex_object,tet_object,vertex_file,vertex_in_file,tet_file,tet_in_file,b0,b1,b2,b3";
 
 struct Files {
     std::filesystem::path a, b;
@@ -46,8 +43,8 @@ Files two_objects(const std::filesystem::path& dir)
     const Scene b = lattice_object(3, 3, 3, 0.25, Eigen::Vector3d(0.125, 0.125, 0.3));
     f.a = dir / "a.mesh";
     f.b = dir / "b.mesh";
-    write_medit(f.a, a);
-    write_medit(f.b, b);
+    write_text(f.a, medit_text(a));
+    write_text(f.b, medit_text(b));
     f.scene = a;
     append_object(f.scene, b);
     return f;
@@ -66,16 +63,19 @@ TEST(CliDetect, ContactsCsvMatchesOracleSortedWithHeader)
     const std::vector<Contact> want =
         brute_force_contacts(f.scene.positions, f.scene.tets, f.scene.vertex_object, f.scene.tet_object);
     ASSERT_FALSE(want.empty());
-    std::istringstream csv(read_text(dir / "c.csv"));
+    std::istringstream csv(csv_body(read_text(dir / "c.csv")));
     std::string line;
     ASSERT_TRUE(std::getline(csv, line));
-    EXPECT_EQ(line, "vertex,tet,b0,b1,b2,b3");
+    EXPECT_EQ(line, kContactsHeader);
     std::size_t i = 0;
     long prev_v = -1, prev_t = -1;
     while (std::getline(csv, line)) {
         long v = -1, t = -1;
         double b[4];
-        ASSERT_EQ(std::sscanf(line.c_str(), "%ld,%ld,%lf,%lf,%lf,%lf", &v, &t, &b[0], &b[1], &b[2], &b[3]), 6) << line;
+        ASSERT_EQ(std::sscanf(line.c_str(), "%ld,%ld,%*d,%*d,%*d,%*d,%*d,%*d,%lf,%lf,%lf,%lf", &v, &t, &b[0], &b[1],
+                              &b[2], &b[3]),
+                  6)
+            << line;
         EXPECT_TRUE(v > prev_v || (v == prev_v && t > prev_t)) << "not sorted at row " << i;
         prev_v = v;
         prev_t = t;
@@ -174,9 +174,9 @@ $EndElements
     auto run = [&](const std::string& options) {
         const auto r = run_tethash("detect " + file + " " + options + " --contacts " + sq(dir / "c.csv"));
         EXPECT_EQ(r.status, 0) << options << "\n" << r.err;
-        return std::make_pair(r.out, read_text(dir / "c.csv"));
+        return std::make_pair(r.out, csv_body(read_text(dir / "c.csv")));
     };
-    const std::string header = "vertex,tet,b0,b1,b2,b3\n";
+    const std::string header = std::string(kContactsHeader) + "\n";
     auto [out, csv] = run("");
     EXPECT_NE(out.find("scene: 1 objects"), std::string::npos) << out;
     EXPECT_EQ(csv.rfind(header + "4,0,", 0), 0u) << csv;
@@ -206,7 +206,7 @@ TEST(CliDetect, SkinReusesCandidatesWithTheSameContacts)
     const std::string js = read_text(dir / "s.json");
     EXPECT_NE(js.find("\"contacts\": " + std::to_string(want.size())), std::string::npos) << js;
     EXPECT_NE(js.find("\"reused\": 1"), std::string::npos) << js;
-    std::istringstream csv(read_text(dir / "c.csv"));
+    std::istringstream csv(csv_body(read_text(dir / "c.csv")));
     std::string line;
     std::size_t rows = 0;
     while (std::getline(csv, line))

@@ -105,7 +105,7 @@ TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir, 2);
     const std::string common = "study table-size --mesh " + mesh +
-                               " --table-size x0.1:x10:3 --cell-size 0.7,1.4 "
+                               " --table-size x0.1:x10:3 --cell-size x0.7,x1.4 "
                                "--repeat 2 --no-plot --quiet";
     ASSERT_EQ(run_tethash(common + " --out " + quote(dir / "all")).status, 0);
     for (int i = 0; i < 3; ++i) {
@@ -140,7 +140,7 @@ TEST(CliStudy, PlotScriptWritesFiguresWhenMatplotlibIsPresent)
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir, 2);
     const auto r = run_tethash("study cell-size --mesh " + mesh +
-                               " --cell-size 0.5:2:3 --table-size 31,x1 --repeat 1 --out " + quote(dir / "s"));
+                               " --cell-size x0.5:x2:3 --table-size 31,x1 --repeat 1 --out " + quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     for (const char* f : {"stages_vs_cell.png", "stages_vs_cell.svg", "candidates_vs_cell.svg", "exactness.svg"})
         EXPECT_TRUE(std::filesystem::exists(dir / "s" / f)) << f << "\n" << r.out << r.err;
@@ -242,10 +242,10 @@ TEST(CliStudy, BadInputExitsTwoBeforeAnyWork)
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"study cell-size --mesh " + quote(dir / "missing.vtu"), "file not found"},
         {"study cell-size --mesh " + mesh + " --cell-size 0", "--cell-size"},
-        {"study cell-size --mesh " + mesh + " --cell-size=-2", "must be > 0"},
+        {"study cell-size --mesh " + mesh + " --cell-size=-2", "--cell-size: expected a length"},
         {"study cell-size --mesh " + mesh + " --from 4 --to 1 --points 3", "empty range"},
-        {"study cell-size --mesh " + mesh + " --cell-size 1:2:0", "empty range"},
-        {"study table-size --mesh " + mesh + " --table-size 0", "table size must be >= 1"},
+        {"study cell-size --mesh " + mesh + " --cell-size x1:x2:0", "empty range"},
+        {"study table-size --mesh " + mesh + " --table-size 0", "--table-size: expected N"},
         {"study cell-size --mesh " + mesh + " --shard 3/3", "--shard"},
         {"study cell-size --mesh " + mesh + " --shard x", "--shard"},
         {"study cell-size --mesh " + mesh + " --repeat 0", "--repeat"},
@@ -274,7 +274,7 @@ TEST(CliStudy, InterruptKeepsTheRowsMeasuredInAValidCsv)
     const auto csv = dir / "s" / "study.csv";
     // A long sweep in the background; SIGINT once a few rows are there.
     const std::string cmd = std::string("'") + TETHASH_EXE + "' study cell-size --mesh " + mesh +
-                            " --cell-size 0.5:2:400 --repeat 20 --no-oracle --no-penetration --no-plot --out " +
+                            " --cell-size x0.5:x2:400 --repeat 20 --no-oracle --no-penetration --no-plot --out " +
                             quote(dir / "s") + " >/dev/null 2>&1 & echo $! > " + quote(dir / "pid");
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     const auto partial = dir / "s" / "study.csv.partial"; // rows are streamed there while the study runs

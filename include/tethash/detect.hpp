@@ -73,6 +73,29 @@ struct DetectParams {
     double skin = 0; ///< a length, or the factor of the cell size for factor_of_cell_size
 };
 
+// ---- the text grammar of the detector's parameters: one parser for every command and scene file ----------
+// Lengths are plain numbers; factors are written with a leading x ("x0.5"). Every function throws Error naming
+// `option` and the text.
+
+/// Most threads any command accepts: 256, or the hardware threads if there are more. Beyond it the OpenMP
+/// runtime fails (or crashes) while starting the team, so it is refused before.
+int max_threads();
+/// "N": 0 = every hardware thread (OpenMP's default, OMP_NUM_THREADS where set), 1..max_threads().
+int parse_threads(const std::string& text, const std::string& option = "--threads");
+/// Checks a thread count given as a number (0 = all, 1..max_threads()); returns it.
+int check_threads(long long threads, const std::string& option = "--threads");
+/// "auto" (the mean edge length) | "L" (a length > 0) | "xF" (F > 0 times the mean edge length):
+/// sets params.cell_size_mode and params.cell_size.
+void parse_cell_size(const std::string& text, DetectParams& params, const std::string& option = "--cell-size");
+/// "auto" (0: the detector chooses) | "N" (N ≥ 1 buckets) | "xF" (F > 0 times `vertices`, rounded up to a power
+/// of two). Returns the table size for DetectParams::table_size. `vertices` 0: checks the syntax only.
+std::int64_t parse_table_size(const std::string& text, std::int64_t vertices,
+                              const std::string& option = "--table-size");
+/// "L" (a length ≥ 0; 0 = no candidate reuse) | "xF" (F ≥ 0 times the cell size): sets skin_mode and skin.
+void parse_skin(const std::string& text, DetectParams& params, const std::string& option = "--skin");
+/// The smallest power of two ≥ n (n ≥ 1).
+std::int64_t next_power_of_two(std::int64_t n);
+
 /// Statistics of one detect() call. Times in milliseconds.
 struct DetectStats {
     double ms_total = 0, ms_vertices = 0, ms_tets = 0, ms_inside = 0, ms_sort = 0;
@@ -116,7 +139,8 @@ class Detector {
 
     /// Sets the topology once. `tets` is m × 4; `vertex_object`/`tet_object` give object ids (empty: all 0);
     /// `objects[k]` gives the options of object k (missing: defaults). The number of vertices is fixed here.
-    /// Throws Error on indices out of range or repeated within a tet, or object ids out of range.
+    /// Throws Error on indices out of range or object ids out of range. A tet with a repeated vertex (collapsed,
+    /// zero volume) is accepted and skipped like every degenerate tet (DetectStats::degenerate_tets).
     void set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object = {},
                       std::span<const Index> tet_object = {}, std::span<const ObjectOptions> objects = {});
     /// Convenience: topology and object ids of a TetMesh.

@@ -127,6 +127,10 @@ struct TetQuality {
 };
 TetQuality tet_quality(const PositionsRef& positions, const std::array<Index, 4>& tet);
 
+/// Connected components of the tets, tets that share a vertex being connected. Returns the number of
+/// components; `component`, when given, gets the component of each tet (0, 1, ... in the order of their first tet).
+Index tet_components(const TetsRef& tets, Index num_vertices, std::vector<Index>* component = nullptr);
+
 /// Bounding box of the positions (min, max); both zero for an empty set.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> bounding_box(const PositionsRef& positions);
 

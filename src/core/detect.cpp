@@ -84,12 +84,11 @@ void check_topology(const TetsRef& tets, Index num_vertices, std::span<const Ind
     for (Eigen::Index t = 0; t < tets.rows(); ++t) {
         for (int k = 0; k < 4; ++k) {
             const Index v = tets(t, k);
+            // A vertex repeated within a tet is allowed: a collapsed tet has zero volume, and the inside test skips
+            // it like every other degenerate tet (counted in DetectStats::degenerate_tets).
             if (v < 0 || v >= num_vertices)
                 throw Error("tet " + std::to_string(t) + ": vertex index " + std::to_string(v) + " out of range [0, " +
                             std::to_string(num_vertices) + ")");
-            for (int j = 0; j < k; ++j)
-                if (tets(t, j) == v)
-                    throw Error("tet " + std::to_string(t) + ": vertex index " + std::to_string(v) + " repeated");
         }
     }
     for (std::size_t i = 0; i < vertex_object.size(); ++i)
@@ -859,7 +858,7 @@ void validate_params(const DetectParams& p)
     if (p.table_size > max_table_size)
         throw Error("table_size " + std::to_string(p.table_size) + " is too large (at most " +
                     std::to_string(max_table_size) + ")");
-    if (p.threads < 0) throw Error("threads must be ≥ 0 (0 = all), got " + std::to_string(p.threads));
+    check_threads(p.threads, "threads");
     if (!(p.skin >= 0) || !std::isfinite(p.skin)) {
         std::ostringstream s;
         s << "skin must be ≥ 0 and finite (0 = no candidate reuse), got " << p.skin;

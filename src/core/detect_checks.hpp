@@ -7,8 +7,9 @@
 
 namespace tethash::detail {
 
-/// Throws Error naming the first offending tet/vertex: index out of range or repeated in a tet,
-/// object id arrays of the wrong length or negative ids.
+/// Throws Error naming the first offending tet/vertex: index out of range, object id arrays of the wrong
+/// length or negative ids. A vertex repeated within a tet is no error: such a tet has zero volume and is
+/// skipped as degenerate, by the detector and the oracle alike.
 void check_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
                     std::span<const Index> tet_object);
 /// Throws Error on a wrong row count or a non-finite coordinate (naming the vertex).

@@ -511,4 +511,34 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> bounding_box(const PositionsRef& pos
     return {positions.colwise().minCoeff().transpose(), positions.colwise().maxCoeff().transpose()};
 }
 
+Index tet_components(const TetsRef& tets, Index num_vertices, std::vector<Index>* component)
+{
+    // Union-find over the vertices (path halving); a tet joins its four vertices.
+    std::vector<Index> parent(static_cast<std::size_t>(std::max<Index>(num_vertices, 0)));
+    for (Index v = 0; v < num_vertices; ++v)
+        parent[static_cast<std::size_t>(v)] = v;
+    const auto find = [&](Index v) {
+        while (parent[static_cast<std::size_t>(v)] != v) {
+            const Index up = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(v)])];
+            parent[static_cast<std::size_t>(v)] = up;
+            v = up;
+        }
+        return v;
+    };
+    for (Eigen::Index t = 0; t < tets.rows(); ++t)
+        for (int k = 1; k < 4; ++k) {
+            const Index a = find(tets(t, 0)), b = find(tets(t, k));
+            if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+        }
+    std::vector<Index> id(parent.size(), -1);
+    Index count = 0;
+    if (component) component->resize(static_cast<std::size_t>(tets.rows()));
+    for (Eigen::Index t = 0; t < tets.rows(); ++t) {
+        Index& c = id[static_cast<std::size_t>(find(tets(t, 0)))];
+        if (c < 0) c = count++;
+        if (component) (*component)[static_cast<std::size_t>(t)] = c;
+    }
+    return count;
+}
+
 } // namespace tethash

@@ -175,7 +175,10 @@ constexpr std::int64_t k_max_count = std::numeric_limits<std::int64_t>::max() / 
 
 class MshReader {
   public:
-    MshReader(const std::string& path, ReadNotes* notes) : m_r(path), m_notes(notes) {}
+    MshReader(const std::string& path, ReadNotes* notes, const ReadOptions& options)
+        : m_r(path), m_notes(notes), m_options(options)
+    {
+    }
 
     TetMesh read()
     {
@@ -444,6 +447,8 @@ class MshReader {
     }
 
     void skip_elements(std::int64_t type, std::int64_t count) { m_skipped[type] += count; }
+    /// 4-node tets, and 10-node tets (type 11) when linearizing.
+    bool is_tet(std::int64_t type) const { return type == 4 || (type == 11 && m_options.linearize); }
 
     void read_elements41()
     {
@@ -467,17 +472,19 @@ class MshReader {
                 m_r.fail_message(msg);
             }
             const int nn = nodes_per_element(type);
-            if (type == 4) {
-                check_room(count, 5 * m_size_t, 5, "tets");
+            if (is_tet(type)) {
+                check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn),
+                           "tets");
                 const std::int64_t label = label_of(dim, entity);
                 for (std::int64_t e = 0; e < count; ++e) {
                     const std::int64_t etag = read_size("an element tag");
-                    for (int k = 0; k < 4; ++k) {
+                    for (int k = 0; k < nn; ++k) { // a 10-node tet lists its corners first
                         const std::size_t at = m_r.offset();
-                        m_tets.push_back(
-                            node_index(read_size("a node tag of element " + std::to_string(etag)), etag, at));
+                        const std::int64_t tag = read_size("a node tag of element " + std::to_string(etag));
+                        if (k < 4) m_tets.push_back(node_index(tag, etag, at));
                     }
                     m_labels.push_back(static_cast<Index>(label));
+                    m_tet_tags.push_back(etag);
                 }
             } else if (nn > 0) {
                 check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn),
@@ -554,12 +561,14 @@ class MshReader {
             if (k == 1) elementary = t;
         }
         const int nn = nodes_per_element(type);
-        if (type == 4) {
-            for (int k = 0; k < 4; ++k) {
+        if (is_tet(type)) {
+            for (int k = 0; k < nn; ++k) { // a 10-node tet lists its corners first
                 const std::size_t at = m_r.offset();
-                m_tets.push_back(node_index(read_int("a node tag of element " + std::to_string(etag)), etag, at));
+                const std::int64_t tag = read_int("a node tag of element " + std::to_string(etag));
+                if (k < 4) m_tets.push_back(node_index(tag, etag, at));
             }
             m_labels.push_back(static_cast<Index>(physical != 0 ? physical : elementary));
+            m_tet_tags.push_back(etag);
         } else {
             for (int k = 0; k < nn; ++k)
                 read_int("a node tag of element " + std::to_string(etag));
@@ -641,11 +650,17 @@ class MshReader {
         mesh.tets.resize(m, 4);
         if (m) std::memcpy(mesh.tets.data(), m_tets.data(), m_tets.size() * sizeof(Index));
         mesh.tet_label = std::move(m_labels);
+        if (m_notes) { // the file's own numbering: node and element tags
+            m_notes->vertex_ids = m_node_tags;
+            m_notes->tet_ids = std::move(m_tet_tags);
+        }
         if (m_notes) {
             for (const auto& [type, count] : m_skipped) {
                 m_notes->skipped_cells += count;
                 m_notes->messages.push_back("skipped " + std::to_string(count) + " elements of type " +
                                             std::to_string(type) + " (" + element_type_name(type) + ")");
+                m_notes->skipped.push_back(
+                    {count, "type " + std::to_string(type) + " (" + element_type_name(type) + ")", type == 11});
             }
         }
         return mesh;
@@ -653,11 +668,13 @@ class MshReader {
 
     TextReader m_r;
     ReadNotes* m_notes;
+    ReadOptions m_options;
     int m_version = 41;
     bool m_binary = false;
     std::size_t m_size_t = 8;
     bool m_have_nodes = false, m_have_elements = false;
     std::vector<std::int64_t> m_node_tags;
+    std::vector<std::int64_t> m_tet_tags; ///< element tag of each tet
     std::vector<double> m_xyz;
     NodeMap m_map;
     std::vector<Index> m_tets;
@@ -714,9 +731,9 @@ struct MshOut {
 
 } // namespace
 
-TetMesh read_msh(const std::string& path, ReadNotes* notes)
+TetMesh read_msh(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
-    MshReader reader(path, notes);
+    MshReader reader(path, notes, options);
     return reader.read();
 }
 

@@ -172,8 +172,10 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
     if (notes)
         for (const auto& [name, count] : skipped) {
             if (name == "Triangles" || name == "Quadrilaterals" || name == "Hexahedra" || name == "Prisms" ||
-                name == "Pyramids" || name == "Edges")
+                name == "Pyramids" || name == "Edges") {
                 notes->skipped_cells += count;
+                if (count) notes->skipped.push_back({count, name, false});
+            }
             if (count) notes->messages.push_back("skipped " + std::to_string(count) + " entries of " + name);
         }
     return mesh;

@@ -56,6 +56,30 @@ SurfaceMesh boundary_surface(const TetMesh& mesh)
     return s;
 }
 
+namespace {
+
+/// Wavefront OBJ written here rather than by assimp, whose exporter adds per-corner normal indices that
+/// meshio cannot read: only "v x y z" and "f a b c" (1-based, shared vertices), one surface for every reader.
+void write_obj(const std::string& path, const SurfaceMesh& surface)
+{
+    std::string text = "# boundary surface written by tethash: " + std::to_string(surface.vertices.rows()) +
+                       " vertices, " + std::to_string(surface.triangles.rows()) + " triangles\n";
+    char buf[96];
+    for (Eigen::Index v = 0; v < surface.vertices.rows(); ++v) {
+        std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", surface.vertices(v, 0), surface.vertices(v, 1),
+                      surface.vertices(v, 2));
+        text += buf;
+    }
+    for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t) {
+        std::snprintf(buf, sizeof buf, "f %d %d %d\n", surface.triangles(t, 0) + 1, surface.triangles(t, 1) + 1,
+                      surface.triangles(t, 2) + 1);
+        text += buf;
+    }
+    write_text_file(path, text);
+}
+
+} // namespace
+
 #ifdef TETHASH_HAVE_ASSIMP
 
 bool have_assimp()
@@ -251,6 +275,7 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
             if (surface.triangles(t, k) < 0 || static_cast<unsigned>(surface.triangles(t, k)) >= nv)
                 throw Error(path + ": surface triangle " + std::to_string(t) + " has vertex index " +
                             std::to_string(surface.triangles(t, k)) + " out of range");
+    if (e == ".obj") return write_obj(path, surface);
 
     // The scene owns (and its destructor frees) everything allocated below.
     aiScene scene;
@@ -325,9 +350,10 @@ SurfaceMesh read_surface(const std::string& path)
 {
     throw Error(path + ": cannot read surfaces: tethash was built without assimp");
 }
-void write_surface(const std::string& path, const SurfaceMesh&)
+void write_surface(const std::string& path, const SurfaceMesh& surface)
 {
-    throw Error(path + ": cannot write surfaces: tethash was built without assimp");
+    if (extension_of(path) == ".obj") return write_obj(path, surface);
+    throw Error(path + ": cannot write surfaces other than .obj: tethash was built without assimp");
 }
 
 #endif

@@ -101,6 +101,7 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
         }
         if (!r.at_end()) r.fail("end of file after " + std::to_string(n) + " nodes", TextReader::describe(r.next("")));
         if (nattr && notes) notes->messages.push_back("ignored " + std::to_string(nattr) + " node attribute(s)");
+        if (notes) notes->first_id = static_cast<int>(base);
     }
     // ---- .ele
     {

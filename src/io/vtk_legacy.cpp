@@ -45,7 +45,10 @@ struct ArrayPlace {
 
 class LegacyReader {
   public:
-    LegacyReader(std::string path, ReadNotes* notes) : m_path(std::move(path)), m_notes(notes) {}
+    LegacyReader(std::string path, ReadNotes* notes, const ReadOptions& options)
+        : m_path(std::move(path)), m_notes(notes), m_options(options)
+    {
+    }
     TetMesh read();
 
   private:
@@ -81,6 +84,7 @@ class LegacyReader {
 
     std::string m_path;
     ReadNotes* m_notes;
+    ReadOptions m_options;
     std::string m_data;
     std::size_t m_pos = 0;
     std::int64_t m_line = 1;
@@ -553,15 +557,17 @@ TetMesh LegacyReader::read()
     std::map<std::int64_t, std::int64_t> skipped;
     for (std::int64_t c = 0; c < num_cells; ++c) {
         const std::size_t cs = static_cast<std::size_t>(c);
-        if (types[cs] != 10) {
+        const bool quadratic = types[cs] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+        if (types[cs] != 10 && !quadratic) {
             ++skipped[types[cs]];
             continue;
         }
         const std::size_t first = static_cast<std::size_t>(offsets[cs]) + (old_layout ? 1 : 0);
         const std::size_t size = static_cast<std::size_t>(offsets[cs + 1]) - first;
-        if (size != 4)
-            fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type 10 (tetra) but " +
-                                                std::to_string(size) + " points, expected 4");
+        if (size != (quadratic ? 10u : 4u))
+            fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
+                                                " but " + std::to_string(size) + " points, expected " +
+                                                (quadratic ? "10" : "4"));
         for (std::size_t k = 0; k < 4; ++k) {
             const std::int64_t v = conn[first + k];
             if (v < 0 || v >= num_points)
@@ -584,6 +590,8 @@ TetMesh LegacyReader::read()
             m_notes->skipped_cells += count;
             m_notes->messages.push_back(m_path + ": skipped " + std::to_string(count) + " cells of type " +
                                         std::to_string(type) + " (" + cell_type_name(type) + ")");
+            m_notes->skipped.push_back(
+                {count, "type " + std::to_string(type) + " (" + cell_type_name(type) + ")", type == 24});
         }
     }
     apply_label_arrays(mesh, point_arrays, cell_arrays, tet_cells, static_cast<std::size_t>(num_cells), m_notes);
@@ -625,9 +633,9 @@ void write_arrays(std::string& out, bool binary, const char* section, std::size_
 
 } // namespace
 
-TetMesh read_vtk(const std::string& path, ReadNotes* notes)
+TetMesh read_vtk(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
-    return LegacyReader(path, notes).read();
+    return LegacyReader(path, notes, options).read();
 }
 
 void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& fields, bool binary)

@@ -307,7 +307,10 @@ XmlDocument XmlParser::parse()
 
 class VtuReader {
   public:
-    VtuReader(std::string path, ReadNotes* notes) : m_path(std::move(path)), m_notes(notes) {}
+    VtuReader(std::string path, ReadNotes* notes, const ReadOptions& options)
+        : m_path(std::move(path)), m_notes(notes), m_options(options)
+    {
+    }
     TetMesh read();
 
   private:
@@ -342,6 +345,7 @@ class VtuReader {
 
     std::string m_path;
     ReadNotes* m_notes;
+    ReadOptions m_options;
     std::string m_data;
     XmlDocument m_doc;
     bool m_big_endian = false;
@@ -740,14 +744,16 @@ TetMesh VtuReader::read()
                                                        "DataArray 'connectivity' (" + std::to_string(conn_size) +
                                                            " values, the last offset)");
             for (std::size_t c = 0; c < ncz; ++c) {
-                if (types[c] != 10) {
+                const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+                if (types[c] != 10 && !quadratic) {
                     ++skipped[types[c]];
                     continue;
                 }
                 const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
-                if (offsets[c] - first != 4)
-                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type 10 (tetra) but " +
-                                               std::to_string(offsets[c] - first) + " points, expected 4");
+                if (offsets[c] - first != (quadratic ? 10 : 4))
+                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
+                                               " but " + std::to_string(offsets[c] - first) + " points, expected " +
+                                               (quadratic ? "10" : "4"));
                 for (int k = 0; k < 4; ++k) {
                     const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
                     if (v < 0 || v >= np)
@@ -794,6 +800,7 @@ TetMesh VtuReader::read()
             m_notes->skipped_cells += count;
             m_notes->messages.push_back(m_path + ": skipped " + std::to_string(count) + " cells of type " +
                                         std::to_string(t) + " (" + cell_type_name(t) + ")");
+            m_notes->skipped.push_back({count, "type " + std::to_string(t) + " (" + cell_type_name(t) + ")", t == 24});
         }
     }
     std::vector<NamedArray> pa, ca;
@@ -818,9 +825,9 @@ void write_whole(const std::string& path, const std::string& text)
 
 } // namespace
 
-TetMesh read_vtu(const std::string& path, ReadNotes* notes)
+TetMesh read_vtu(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
-    return VtuReader(path, notes).read();
+    return VtuReader(path, notes, options).read();
 }
 
 void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)

@@ -195,14 +195,6 @@ std::int64_t next_prime(std::int64_t n)
     return n;
 }
 
-std::int64_t next_pow2(std::int64_t n)
-{
-    std::int64_t p = 1;
-    while (p < n)
-        p <<= 1;
-    return p;
-}
-
 } // namespace
 
 std::vector<double> parse_real_list(const std::vector<std::string>& specs, const std::string& option,
@@ -341,7 +333,7 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
         s.source = entry;
         std::string name;
         for (const auto& file : split(entry, '+')) {
-            TetMesh m = io::read_mesh(file);
+            TetMesh m = io::read_tet_mesh(file);
             if (s.mesh.num_vertices() == 0 && s.mesh.num_tets() == 0) {
                 s.mesh = std::move(m);
                 s.mesh.ensure_object_ids();
@@ -379,6 +371,41 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
     return scenes;
 }
 
+/// A cell size of the study: a factor of each scene's mean edge length, or a length.
+struct CellChoice {
+    double value = 1;
+    bool factor = true;
+};
+
+/// The cell-size grammar of every command (detect.hpp: L a length, xF a factor of the mean edge, auto), plus
+/// log ranges "xFROM:xTO:POINTS" (factors) and "FROM:TO:POINTS" (lengths).
+std::vector<CellChoice> cell_choices(const std::vector<std::string>& specs)
+{
+    const std::string opt = "--cell-size";
+    std::vector<CellChoice> out;
+    for (const auto& it : items_of(specs, opt)) {
+        if (it.find(':') != std::string::npos) {
+            const auto parts = split(it, ':');
+            const auto is_x = [](const std::string& p) { return !p.empty() && (p[0] == 'x' || p[0] == 'X'); };
+            const bool factor = parts.size() == 3 && is_x(trim(parts[0])) && is_x(trim(parts[1]));
+            if (parts.size() == 3 && !factor && (is_x(trim(parts[0])) || is_x(trim(parts[1]))))
+                throw Error(opt + ": range '" + it +
+                            "' mixes a factor and a length (write xFROM:xTO:POINTS for "
+                            "factors of the mean edge, FROM:TO:POINTS for lengths)");
+            std::string plain = it;
+            plain.erase(std::remove_if(plain.begin(), plain.end(), [](char c) { return c == 'x' || c == 'X'; }),
+                        plain.end());
+            for (double v : log_range(plain, opt, -1))
+                out.push_back({v, factor});
+        } else {
+            DetectParams p;
+            parse_cell_size(it, p, opt);
+            out.push_back({p.cell_size, p.cell_size_mode != DetectParams::CellSizeMode::absolute});
+        }
+    }
+    return out;
+}
+
 struct TableChoice {
     std::int64_t size = 0;
     std::string kind, request;
@@ -395,17 +422,12 @@ std::vector<TableChoice> table_choices(const std::vector<std::string>& specs, st
         } else if (it.find(':') != std::string::npos) {
             for (double v : log_range(it, opt, scale)) {
                 const auto target = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::ceil(v)));
-                out.push_back({next_pow2(target), "pow2", it});
+                out.push_back({next_power_of_two(target), "pow2", it});
                 out.push_back({next_prime(target), "prime", it});
             }
-        } else if (it[0] == 'x') {
-            const double v = parse_scaled(it, opt, scale);
-            if (!(v > 0)) throw Error(opt + ": value " + it + " must be > 0");
-            out.push_back({next_pow2(static_cast<std::int64_t>(std::ceil(v))), "pow2", it});
-        } else {
-            const long long n = parse_integer(it, opt);
-            if (n <= 0) throw Error(opt + ": table size must be >= 1, found " + it);
-            out.push_back({n, "given", it});
+        } else { // the grammar of every command (detect.hpp)
+            const bool factor = it[0] == 'x' || it[0] == 'X';
+            out.push_back({parse_table_size(it, vertices, opt), factor ? "pow2" : "given", it});
         }
     }
     // Ranges can give one size twice (a power of two that is also the next prime: 2): keep the first.
@@ -417,6 +439,27 @@ std::vector<TableChoice> table_choices(const std::vector<std::string>& specs, st
         if (!dup) unique.push_back(c);
     }
     return unique;
+}
+
+/// Thread counts: the grammar of every command (detect.hpp: 0 = every hardware thread) and ranges FROM:TO.
+std::vector<int> thread_choices(const std::vector<std::string>& specs)
+{
+    const std::string opt = "--threads";
+    std::vector<int> out;
+    for (const auto& it : items_of(specs, opt)) {
+        const auto parts = split(it, ':');
+        if (parts.size() == 1) {
+            out.push_back(parse_threads(it, opt));
+        } else if (parts.size() == 2) {
+            const int a = parse_threads(trim(parts[0]), opt), b = parse_threads(trim(parts[1]), opt);
+            if (a < 1 || b < a) throw Error(opt + ": empty range '" + it + "' (need 1 <= FROM <= TO)");
+            for (int v = a; v <= b; ++v)
+                out.push_back(v);
+        } else {
+            throw Error(opt + ": expected N or FROM:TO, found '" + it + "'");
+        }
+    }
+    return out;
 }
 
 std::vector<HashFunction> hash_choices(const std::vector<std::string>& specs)
@@ -452,8 +495,8 @@ void plan_detection(StudyPlan& plan)
     }
     const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
     const auto cell_specs = !o.cell_size.empty() ? o.cell_size
-                            : swept("cell-size") ? std::vector<std::string>{is_grid ? "0.25:4:9" : "0.125:8:13"}
-                                                 : std::vector<std::string>{"1"};
+                            : swept("cell-size") ? std::vector<std::string>{is_grid ? "x0.25:x4:9" : "x0.125:x8:13"}
+                                                 : std::vector<std::string>{"auto"};
     const auto table_specs = !o.table_size.empty() ? o.table_size
                              : swept("table-size") ? std::vector<std::string>{is_grid ? "x0.03:x30:4" : "x0.01:x100:9"}
                                                    : std::vector<std::string>{"auto"};
@@ -465,10 +508,10 @@ void plan_detection(StudyPlan& plan)
                                                  : std::vector<std::string>{"1"};
 
     // Validate every list before loading anything.
-    const auto cells = parse_real_list(cell_specs, "--cell-size", -1, true);
+    const auto cells = cell_choices(cell_specs);
     const auto hashes = hash_choices(hash_specs);
-    const auto threads = parse_int_list(thread_specs, "--threads");
-    (void)table_choices(table_specs, 1000); // syntax and value checks
+    const auto threads = thread_choices(thread_specs);
+    (void)table_choices(table_specs, 0); // syntax and value checks
 
     plan.scenes = load_scenes(o);
     if (plan.scenes.empty())
@@ -480,7 +523,9 @@ void plan_detection(StudyPlan& plan)
         for (const auto& t : tables)
             for (HashFunction h : hashes)
                 for (int th : threads)
-                    for (double c : cells) {
+                    for (const CellChoice& cc : cells) {
+                        const double mean_edge = plan.scenes[s].mean_edge;
+                        const double c = cc.factor ? cc.value : cc.value / (mean_edge > 0 ? mean_edge : 1.0);
                         DetectPoint p{s, c, t.size, t.kind, t.request, h, th};
                         PointInfo info;
                         info.index = static_cast<std::int64_t>(plan.points.size());

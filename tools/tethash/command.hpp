@@ -26,6 +26,8 @@ struct Registrar {
 
 /// Adds `--objects-from-labels[=separate|join]` (info, detect): each tet label of a file is an object.
 void add_objects_from_labels_option(CLI::App& sub, std::string& value);
+/// Adds `--linearize` (info, detect, convert): quadratic (10-node) tets are read as the tets of their corners.
+void add_linearize_option(CLI::App& sub, bool& value);
 /// Throws Error unless `value` is "", "separate" or "join".
 void check_objects_from_labels_value(const std::string& value);
 /// Splits `mesh` (read from `path`) into objects by its tet labels (split_objects_by_label); `value`

@@ -15,15 +15,23 @@ namespace {
 
 struct ConvertOptions {
     std::string in;
-    std::string out;
+    std::string out;            ///< -o/--out
+    std::string out_positional; ///< the older form: convert IN OUT
     bool reorient = false;
+    bool linearize = false;
 };
 
-void run_convert(const ConvertOptions& o)
+void run_convert(ConvertOptions o)
 {
-    io::check_mesh_output_file(o.out, "OUT"); // before reading: a bad output name costs no work
+    if (!o.out.empty() && !o.out_positional.empty())
+        throw Error("convert: two outputs ('" + o.out_positional + "' and -o '" + o.out + "'): give one");
+    if (o.out.empty()) o.out = o.out_positional;
+    if (o.out.empty()) throw Error("convert: missing output file -o OUT (see 'tethash convert --help')");
+    io::check_mesh_output_file(o.out, "--out"); // before reading: a bad output name costs no work
     io::ReadNotes notes;
-    TetMesh mesh = io::read_mesh(o.in, &notes);
+    io::ReadOptions read_options;
+    read_options.linearize = o.linearize;
+    TetMesh mesh = io::read_tet_mesh(o.in, &notes, read_options);
     fmt::print("read {}: {} vertices, {} tets", o.in, mesh.num_vertices(), mesh.num_tets());
     if (notes.skipped_cells) fmt::print(" ({} non-tet cells skipped)", notes.skipped_cells);
     fmt::print("\n");
@@ -47,10 +55,11 @@ const Registrar reg{
     {"convert", "Convert a tet mesh between formats (chosen by file extension)", [](CLI::App& sub) {
          auto o = std::make_shared<ConvertOptions>();
          sub.add_option("IN", o->in, "Input tet mesh (.vtk .vtu .msh .node/.ele .mesh .veg)")->required();
-         sub.add_option("OUT", o->out,
-                        "Output (.vtu .vtk .msh .mesh .node/.ele, or a boundary surface .obj .ply .stl .gltf .glb)")
-             ->required();
+         sub.add_option("-o,--out", o->out,
+                        "Output (.vtu .vtk .msh .mesh .node/.ele, or a boundary surface .obj .ply .stl .gltf .glb)");
+         sub.add_option("OUT", o->out_positional, "The output as a second argument (the same as -o OUT)");
          sub.add_flag("--reorient", o->reorient, "Flip inverted (negative-volume) tets before writing");
+         add_linearize_option(sub, o->linearize);
          sub.callback([o] { run_convert(*o); });
      }}};
 

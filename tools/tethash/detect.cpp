@@ -5,11 +5,13 @@
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/penetration.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -24,107 +26,144 @@ struct DetectOptions {
     std::string table_size = "auto";
     std::string skin = "0";
     std::string hash = "column";
-    int threads = 0;
+    std::string threads = "0";
     int repeat = 1;
     std::string contacts_path, stats_path;
     bool no_self = false;
     std::vector<int> static_objects;
     std::string objects_from_labels; ///< "", "separate" or "join"
+    bool linearize = false;
 };
 
-/// "auto" | "xF" (factor of the mean edge length) | L (absolute, > 0).
-void parse_cell_size(const std::string& s, DetectParams& p)
+/// One input file of the scene: where its vertices and tets start in the scene, and its own numbering.
+struct InputFile {
+    std::string path;
+    Index first_vertex = 0, first_tet = 0;
+    io::ReadNotes notes; ///< vertex_ids, tet_ids, first_id: the file's numbering
+};
+
+/// The file holding scene id `id`, given the first ids of each file (`first` increasing).
+std::size_t file_of(const std::vector<InputFile>& files, Index id, Index InputFile::*first)
 {
-    auto bad = [&] {
-        return Error(
-            "--cell-size: expected a positive length, 'auto' or 'xF' (F > 0, a factor of the mean edge length), got '" +
-            s + "'");
-    };
-    if (s == "auto") {
-        p.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
-        return;
-    }
-    const bool factor = !s.empty() && (s[0] == 'x' || s[0] == 'X');
-    const std::string num = factor ? s.substr(1) : s;
-    double v = 0;
-    std::size_t used = 0;
-    try {
-        v = std::stod(num, &used);
-    } catch (const std::exception&) {
-        throw bad();
-    }
-    if (used != num.size() || !(v > 0) || !std::isfinite(v)) throw bad();
-    p.cell_size_mode = factor ? DetectParams::CellSizeMode::factor_of_mean_edge : DetectParams::CellSizeMode::absolute;
-    p.cell_size = v;
+    std::size_t k = files.size() - 1;
+    while (k > 0 && files[k].*first > id)
+        --k;
+    return k;
 }
 
-/// L (a length ≥ 0; 0 = no candidate reuse) | "xF" (F ≥ 0, a factor of the cell size).
-void parse_skin(const std::string& s, DetectParams& p)
+/// Id `local` (0-based in its file) in the file's own numbering.
+std::int64_t file_id(const io::ReadNotes& notes, const std::vector<std::int64_t>& ids, Index local)
 {
-    const bool factor = !s.empty() && (s[0] == 'x' || s[0] == 'X');
-    const std::string num = factor ? s.substr(1) : s;
-    double v = 0;
-    std::size_t used = 0;
-    try {
-        v = std::stod(num, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used == 0 || used != num.size() || !(v >= 0) || !std::isfinite(v))
-        throw Error("--skin: expected a length ≥ 0 or 'xF' (F ≥ 0, a factor of the cell size), got '" + s + "'");
-    p.skin_mode = factor ? DetectParams::SkinMode::factor_of_cell_size : DetectParams::SkinMode::absolute;
-    p.skin = v;
+    return ids.empty() ? std::int64_t{notes.first_id} + local : ids[static_cast<std::size_t>(local)];
 }
 
-void parse_table_size(const std::string& s, DetectParams& p)
+/// Contacts as CSV: a header comment saying which id is which, then one row per contact sorted by (vertex, tet).
+std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector<InputFile>& files)
 {
-    if (s == "auto") {
-        p.table_size = 0;
-        return;
+    std::string csv = "# tethash detect: each row is a vertex lying inside a tet it does not belong to.\n"
+                      "# vertex, tet: 0-based ids in the scene (the input files joined in argument order).\n"
+                      "# vertex_object, tet_object: objects (each file one, in order from 0; its 'object' cell data or "
+                      "labels with --objects-from-labels).\n"
+                      "# vertex_file, tet_file: the input file (0-based argument position, listed below); "
+                      "vertex_in_file, tet_in_file: the id in that file's own numbering (Gmsh node and element tags; "
+                      "1-based in Medit and Vega; TetGen from its first index; 0-based in VTK).\n"
+                      "# b0..b3: barycentric coordinates of the vertex in the tet (corners in the tet's order).\n";
+    for (std::size_t k = 0; k < files.size(); ++k)
+        csv += fmt::format("# file {}: {}\n", k, files[k].path);
+    csv += "vertex,tet,vertex_object,tet_object,vertex_file,vertex_in_file,tet_file,tet_in_file,b0,b1,b2,b3\n";
+    for (const Contact& c : contacts) {
+        const std::size_t fv = file_of(files, c.vertex, &InputFile::first_vertex);
+        const std::size_t ft = file_of(files, c.tet, &InputFile::first_tet);
+        const io::ReadNotes& nv = files[fv].notes;
+        const io::ReadNotes& nt = files[ft].notes;
+        csv += fmt::format(
+            "{},{},{},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex, c.tet, c.vertex_object, c.tet_object,
+            fv, file_id(nv, nv.vertex_ids, c.vertex - files[fv].first_vertex), ft,
+            file_id(nt, nt.tet_ids, c.tet - files[ft].first_tet), c.bary[0], c.bary[1], c.bary[2], c.bary[3]);
     }
-    long long v = 0;
-    std::size_t used = 0;
-    try {
-        v = std::stoll(s, &used);
-    } catch (const std::exception&) {
-        used = 0;
+    return csv;
+}
+
+/// Contacts as a VTU of the scene: point data contact (number of tets the vertex lies in), penetration_depth
+/// (the largest over its contacts, 0 where none) and contact_tet (the scene id of the first such tet, -1 where
+/// none); cell data object (written from the mesh) and contacts (vertices inside the tet).
+void write_contacts_vtu(const std::string& path, const TetMesh& scene, std::vector<Contact>& contacts)
+{
+    Penetration pen;
+    pen.set_topology(scene);
+    pen.compute(scene.positions, contacts);
+    const auto n = static_cast<std::size_t>(scene.num_vertices()), m = static_cast<std::size_t>(scene.num_tets());
+    io::Fields f;
+    f.point.push_back({"contact", 1, std::vector<double>(n, 0.0)});
+    f.point.push_back({"penetration_depth", 1, std::vector<double>(n, 0.0)});
+    f.point.push_back({"contact_tet", 1, std::vector<double>(n, -1.0)});
+    f.cell.push_back({"contacts", 1, std::vector<double>(m, 0.0)});
+    for (const Contact& c : contacts) {
+        const auto v = static_cast<std::size_t>(c.vertex);
+        f.point[0].values[v] += 1;
+        if (std::isfinite(c.depth)) f.point[1].values[v] = std::max(f.point[1].values[v], c.depth);
+        if (f.point[2].values[v] < 0) f.point[2].values[v] = c.tet;
+        f.cell[0].values[static_cast<std::size_t>(c.tet)] += 1;
     }
-    if (used == 0 || used != s.size() || v < 1)
-        throw Error("--table-size: expected a positive integer or 'auto', got '" + s + "'");
-    p.table_size = v;
+    io::write_mesh(path, scene, f);
 }
 
 void run(const DetectOptions& o)
 {
     DetectParams params;
     parse_cell_size(o.cell_size, params);
-    parse_table_size(o.table_size, params);
+    parse_table_size(o.table_size, 0); // the syntax now; the value once the vertices are counted
     parse_skin(o.skin, params);
     params.hash = parse_hash_function(o.hash);
-    if (o.threads < 0) throw Error("--threads: expected ≥ 0 (0 = all), got " + std::to_string(o.threads));
     if (o.repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(o.repeat));
-    params.threads = set_threads(o.threads);
+    params.threads = set_threads(parse_threads(o.threads));
     check_objects_from_labels_value(o.objects_from_labels);
     // Output files are checked before the work, so that a typo does not cost a long run.
-    if (!o.contacts_path.empty()) io::check_output_file(o.contacts_path, "--contacts");
+    if (!o.contacts_path.empty()) {
+        io::check_output_file(o.contacts_path, "--contacts");
+        const std::string e = io::extension_of(o.contacts_path);
+        if (e != ".csv" && e != ".vtu")
+            throw Error("--contacts " + o.contacts_path + ": unknown format '" + e +
+                        "' (expected .csv for a table or .vtu for the meshes with contact fields)");
+    }
     if (!o.stats_path.empty()) io::check_output_file(o.stats_path, "--stats");
 
-    // The scene: each file one object; ids global in argument order.
+    // The scene: each file one object (or the objects of its 'object' cell data, or of its labels); ids global in
+    // argument order.
     TetMesh scene;
     std::vector<Index> vobj, tobj;
-    std::vector<Positions> parts;
     Index nv = 0, nt = 0;
     std::vector<TetMesh> meshes;
+    std::vector<InputFile> files;
     Index num_objects = 0;
+    io::ReadOptions read_options;
+    read_options.linearize = o.linearize;
     for (const std::string& path : o.meshes) {
-        meshes.push_back(io::read_mesh(path));
+        InputFile file{path, nv, nt, {}};
+        meshes.push_back(io::read_tet_mesh(path, &file.notes, read_options));
+        TetMesh& mesh = meshes.back();
+        for (const std::string& m : file.notes.messages)
+            if (m.rfind("--linearize", 0) == 0) fmt::print("{}: note: {}\n", path, m);
         if (!o.objects_from_labels.empty()) {
-            fmt::print("{}: {}\n", path, objects_from_labels(meshes.back(), path, o.objects_from_labels));
-        } else { // each file one object, whatever object ids it carries
-            meshes.back().vertex_object.clear();
-            meshes.back().tet_object.clear();
+            fmt::print("{}: {}\n", path, objects_from_labels(mesh, path, o.objects_from_labels));
+        } else if (!mesh.tet_object.empty() && mesh.num_objects() > 1) {
+            // A simulation frame (or any file with 'object' cell data) keeps its objects.
+            fmt::print("{}: {} objects from its 'object' cell data\n", path, mesh.num_objects());
+        } else { // one object
+            mesh.vertex_object.clear();
+            mesh.tet_object.clear();
         }
-        meshes.back().ensure_object_ids();
+        mesh.ensure_object_ids();
+        std::int64_t collapsed = 0;
+        for (Index t = 0; t < mesh.num_tets(); ++t) {
+            const auto r = mesh.tets.row(t);
+            collapsed += r(0) == r(1) || r(0) == r(2) || r(0) == r(3) || r(1) == r(2) || r(1) == r(3) || r(2) == r(3);
+        }
+        if (collapsed)
+            fmt::print("{}: note: {} tets with a repeated vertex (collapsed, zero volume) are skipped like the other "
+                       "degenerate tets ('tethash info' lists them)\n",
+                       path, collapsed);
+        files.push_back(std::move(file));
         num_objects += std::max<Index>(1, meshes.back().num_objects()); // an empty file is still an object
         nv += meshes.back().num_vertices();
         nt += meshes.back().num_tets();
@@ -154,6 +193,7 @@ void run(const DetectOptions& o)
         objects[static_cast<std::size_t>(s)].is_static = true;
     }
 
+    params.table_size = parse_table_size(o.table_size, nv);
     Detector det(params);
     det.set_topology(scene.tets, nv, vobj, tobj, objects);
     DetectStats stats;
@@ -182,11 +222,13 @@ void run(const DetectOptions& o)
     fmt::print("contacts: {}\n", contacts.size());
 
     if (!o.contacts_path.empty()) {
-        std::string csv = "vertex,tet,b0,b1,b2,b3\n";
-        for (const Contact& c : contacts)
-            csv += fmt::format("{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex, c.tet, c.bary[0], c.bary[1],
-                               c.bary[2], c.bary[3]);
-        io::write_text_file(o.contacts_path, csv);
+        if (io::extension_of(o.contacts_path) == ".vtu") {
+            scene.vertex_object = vobj;
+            scene.tet_object = tobj;
+            write_contacts_vtu(o.contacts_path, scene, det.contacts());
+        } else {
+            io::write_text_file(o.contacts_path, contacts_csv(contacts, files));
+        }
     }
     if (!o.stats_path.empty()) {
         std::string msl;
@@ -221,22 +263,30 @@ Registrar reg{
          auto o = std::make_shared<DetectOptions>();
          sub.add_option("meshes", o->meshes, "Tet meshes; together one scene, each file an object")->required();
          sub.add_option("--cell-size", o->cell_size,
-                        "Cell edge length: L, auto (the mean edge length) or xF (F × mean edge)")
+                        "Cell edge length: L (a length), xF (F × the mean edge length) or auto (= x1)")
              ->capture_default_str();
-         sub.add_option("--table-size", o->table_size, "Hash table size: N ≥ 1 or auto (chosen from the vertex count)")
+         sub.add_option("--table-size", o->table_size,
+                        "Hash table size: N buckets, xF (F × the vertices, rounded up to a power of two) or auto")
              ->capture_default_str();
          sub.add_option("--skin", o->skin,
                         "Candidate reuse between calls (--repeat): L (a length, 0 = off) or xF (F × cell size)")
              ->capture_default_str();
          sub.add_option("--hash", o->hash, "Hash function: column or teschner")->capture_default_str();
-         sub.add_option("--threads", o->threads, "Threads (0 = all)")->capture_default_str();
+         sub.add_option("--threads", o->threads, "Threads: 0 = every hardware thread, or 1..256")
+             ->capture_default_str();
          sub.add_option("--repeat", o->repeat, "Run K times after a warm-up; report the median")->capture_default_str();
-         sub.add_option("--contacts", o->contacts_path, "Write contacts CSV (vertex,tet,b0,b1,b2,b3)");
+         sub.add_option("--contacts", o->contacts_path,
+                        "Write the contacts: FILE.csv (scene ids, objects, each side's file and id in that file's "
+                        "numbering, barycentric coordinates) or FILE.vtu (the meshes with point data contact, "
+                        "penetration_depth, contact_tet; cell data object)");
          sub.add_option("--stats", o->stats_path, "Write statistics JSON");
          sub.add_flag("--no-self", o->no_self, "No self-collisions (only between objects)");
          sub.add_option("--static", o->static_objects,
-                        "Object index (file order, from 0) that never moves; repeatable");
+                        "Object index (file order, from 0) that never moves; repeat the option or give a list 0,2")
+             ->allow_extra_args(false)
+             ->delimiter(',');
          add_objects_from_labels_option(sub, o->objects_from_labels);
+         add_linearize_option(sub, o->linearize);
          sub.callback([o] { run(*o); });
      }}};
 

@@ -57,7 +57,7 @@ void run_generate(const GenerateOptions& o)
     if (o.out.empty()) throw Error("generate: missing output file (-o OUT)");
     if (o.resolution < 1 || o.resolution > 1000)
         throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1 and at most 1000");
-    io::check_mesh_output_file(o.out, "--output");
+    io::check_mesh_output_file(o.out, "--out");
     io::GenerateParams p;
     p.shape = o.shape;
     p.resolution = o.resolution;
@@ -82,7 +82,7 @@ const Registrar reg{
     {"generate", "Make a tet mesh of a built-in shape (BCC lattice; see --list)", [](CLI::App& sub) {
          auto o = std::make_shared<GenerateOptions>();
          sub.add_option("shape", o->shape, "Shape name (see --list)");
-         sub.add_option("-o,--output", o->out,
+         sub.add_option("-o,--out,--output", o->out,
                         "Output mesh (.vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
          sub.add_option("-r,--resolution", o->resolution, "Lattice cells along the longest extent (1..1000)")
              ->capture_default_str();

@@ -20,6 +20,7 @@ struct InfoOptions {
     bool json = false;
     bool per_file = false;
     std::string objects_from_labels; ///< "" (each file one object), "separate" or "join"
+    bool linearize = false;
 };
 
 /// Bins of the minimum dihedral angle, in degrees (a regular tet has 70.5°).
@@ -34,6 +35,7 @@ struct Summary {
     double min_dihedral = 0, max_dihedral = 0, max_aspect = 0;
     std::array<std::int64_t, kDihedralEdges.size()> histogram{};
     std::int64_t boundary_faces = 0;
+    Index components = 0; ///< connected components (tets sharing a vertex are connected)
     ValidationReport report;
     std::vector<std::string> notes;
 };
@@ -53,6 +55,7 @@ Summary summarize(const std::string& name, const TetMesh& mesh, const io::ReadNo
     s.edges = edge_stats(mesh.positions, mesh.tets);
     s.volume = volume_stats(mesh.positions, mesh.tets);
     s.boundary_faces = boundary_faces(mesh.tets).rows();
+    s.components = tet_components(mesh.tets, mesh.num_vertices());
     s.min_dihedral = mesh.num_tets() ? 180.0 : 0.0;
     for (Index t = 0; t < mesh.num_tets(); ++t) {
         const TetQuality q =
@@ -106,6 +109,7 @@ std::string to_json(const Summary& s, const std::string& indent)
     kv("volume", fmt::format("{{\"total\": {}, \"min\": {}, \"mean\": {}, \"max\": {}}}", json_number(s.volume.total),
                              json_number(s.volume.min), json_number(s.volume.mean), json_number(s.volume.max)));
     kv("boundary_faces", std::to_string(s.boundary_faces));
+    kv("components", std::to_string(s.components));
     kv("min_dihedral_deg", json_number(s.min_dihedral));
     kv("max_dihedral_deg", json_number(s.max_dihedral));
     kv("max_aspect_ratio", json_number(s.max_aspect));
@@ -136,8 +140,8 @@ void print_text(const Summary& s)
 {
     const auto& r = s.report;
     fmt::print("{}\n", s.name);
-    fmt::print("  vertices {}   tets {}   objects {}   boundary faces {}\n", s.vertices, s.tets, s.objects,
-               s.boundary_faces);
+    fmt::print("  vertices {}   tets {}   objects {}   connected components {}   boundary faces {}\n", s.vertices,
+               s.tets, s.objects, s.components, s.boundary_faces);
     fmt::print("  bounding box [{:.6g}, {:.6g}, {:.6g}] - [{:.6g}, {:.6g}, {:.6g}]\n", s.box_min.x(), s.box_min.y(),
                s.box_min.z(), s.box_max.x(), s.box_max.y(), s.box_max.z());
     fmt::print("  edges {}: length min {:.6g}  mean {:.6g}  max {:.6g}\n", s.edges.count, s.edges.min, s.edges.mean,
@@ -184,7 +188,9 @@ void run(const InfoOptions& opt)
     io::ReadNotes all_notes;
     for (const auto& path : opt.meshes) {
         io::ReadNotes notes;
-        TetMesh mesh = io::read_mesh(path, &notes);
+        io::ReadOptions read_options;
+        read_options.linearize = opt.linearize;
+        TetMesh mesh = io::read_tet_mesh(path, &notes, read_options);
         if (!opt.objects_from_labels.empty())
             notes.messages.push_back(objects_from_labels(mesh, path, opt.objects_from_labels));
         summaries.push_back(summarize(path, mesh, notes));
@@ -221,6 +227,7 @@ Registrar reg{
          sub.add_flag("--json", opt->json, "Print JSON for scripts");
          sub.add_flag("--per-file", opt->per_file, "With several files, also print each file");
          add_objects_from_labels_option(sub, opt->objects_from_labels);
+         add_linearize_option(sub, opt->linearize);
          sub.callback([opt] { run(*opt); });
      }}};
 

@@ -44,7 +44,15 @@ void add_objects_from_labels_option(CLI::App& sub, std::string& value)
     sub.add_flag("--objects-from-labels{separate}", value,
                  "[=separate|join] Each tet label of a file (Gmsh physical tag, else entity tag; Medit ref; "
                  "TetGen region attribute) is an object, numbered in label order; a vertex in tets of two labels "
-                 "is an error, or with =join makes those labels one object. Without it each file is one object");
+                 "is an error, or with =join makes those labels one object. Without it each file is one object, "
+                 "or the objects of its 'object' cell data (simulation frames); labels take precedence");
+}
+
+void add_linearize_option(CLI::App& sub, bool& value)
+{
+    sub.add_flag("--linearize", value,
+                 "Read quadratic (10-node) tets of .vtu, .vtk and .msh files as 4-node tets of their corner nodes; "
+                 "the mid-edge nodes are dropped");
 }
 
 void check_objects_from_labels_value(const std::string& value)
@@ -115,6 +123,12 @@ int main(int argc, char** argv)
     for (auto& c : commands) {
         CLI::App* sub = app.add_subcommand(c.name, c.description);
         c.setup(*sub);
+        // The separator rule of every command: an option takes one value per occurrence (repeat it, or give a
+        // comma list where the option says so), so options and positional arguments mix in any order:
+        // `detect --static 0 a.vtu b.vtu` is --static 0 and two meshes.
+        for (CLI::Option* opt : sub->get_options())
+            if (!opt->get_positional() && opt->get_expected_min() <= 1 && opt->get_allow_extra_args())
+                opt->allow_extra_args(false);
     }
     try {
         if (argc > 1 && argv[1][0] != '-' &&

@@ -1,6 +1,7 @@
 // tethash simulate: runs a scene (TOML, or the built-in default) and writes VTU frames + a .pvd series.
 #include "command.hpp"
 
+#include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/vtk.hpp"
 #include "tethash/sim/simulation.hpp"
@@ -24,7 +25,7 @@ struct SimulateOptions {
     double dt = std::numeric_limits<double>::quiet_NaN();
     int substeps = unset;
     std::string integrator;
-    int threads = unset;
+    std::string threads; ///< "" = the scene's
     std::string out = "out";
 };
 
@@ -50,10 +51,10 @@ void run_simulate(const SimulateOptions& o)
             throw Error(std::string("--integrator: ") + e.what());
         }
     }
-    if (o.threads != SimulateOptions::unset) {
-        if (o.threads < 0) throw Error(fmt::format("--threads must be ≥ 0, found {}", o.threads));
-        scene.detect.threads = o.threads;
-    }
+    if (!o.threads.empty())
+        scene.detect.threads = parse_threads(o.threads);
+    else
+        check_threads(scene.detect.threads, scene.source + ": [detector] threads");
     // Detector threads: the scene's (1 unless [detector] threads says otherwise), --threads overrides; 0 = all.
     const int all = set_threads(scene.detect.threads);
     const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
@@ -159,8 +160,9 @@ Registrar reg{
          sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
          sub.add_option("--integrator", o->integrator, "vbd (default), implicit_euler or symplectic_euler");
          sub.add_option("--threads", o->threads,
-                        "Detector threads (default: the scene's [detector] threads, 1 if absent; 0: all cores)");
-         sub.add_option("--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
+                        "Detector threads: 0 = every hardware thread, or 1..256 (default: the scene's [detector] "
+                        "threads, 1 if absent)");
+         sub.add_option("-o,--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
          sub.callback([o] { run_simulate(*o); });
      }}};
 

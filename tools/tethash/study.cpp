@@ -154,8 +154,8 @@ void run(Args& a)
             throw Error("--from/--to/--points: empty range (need FROM <= TO)");
         char buf[128];
         switch (o.sweep) {
-        case study::Sweep::cell_size:
-            std::snprintf(buf, sizeof buf, "%.10g:%.10g:%d", a.from, a.to, a.points);
+        case study::Sweep::cell_size: // factors of the mean edge
+            std::snprintf(buf, sizeof buf, "x%.10g:x%.10g:%d", a.from, a.to, a.points);
             o.cell_size = {buf};
             break;
         case study::Sweep::table_size: // factors of the vertex count
@@ -222,15 +222,17 @@ Registrar reg{
                         "with or instead of --teschner-scenarios: which (1..5), e.g. 1,5")
              ->delimiter(',');
          sub.add_option("--cell-size", a->o.cell_size,
-                        "cell sizes as factors of the mean edge: list '0.5,1,2' or log range FROM:TO:POINTS "
-                        "(default: 0.125:8:13 when swept, 0.25:4:9 in a grid, else 1)");
+                        "cell sizes: xF (F x the mean edge), L (a length) or auto; a list 'x0.5,x1,x2' or a log range "
+                        "xFROM:xTO:POINTS (or FROM:TO:POINTS of lengths) (default: x0.125:x8:13 when swept, "
+                        "x0.25:x4:9 in a grid, else auto)");
          sub.add_option("--table-size", a->o.table_size,
                         "table sizes: N, auto, xF (F x vertices), or range xFROM:xTO:POINTS (primes and powers of two; "
                         "default: x0.01:x100:9 when swept, x0.03:x30:4 in a grid, else auto)");
          sub.add_option("--hash", a->o.hash,
                         "hash functions: teschner, column, all (default: all when swept, else column)");
          sub.add_option("--threads", a->o.threads,
-                        "thread counts: list or FROM:TO (default 1; threads sweep: 1..cores)");
+                        "thread counts: list or FROM:TO (0 = every hardware thread; default 1; threads sweep: "
+                        "1..cores)");
          sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
              ->delimiter(',');
          sub.add_option("--from", a->from,
@@ -257,7 +259,7 @@ Registrar reg{
          sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
          sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
          sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
-         sub.add_option("--out", a->out, "output folder, made if missing (default: study)");
+         sub.add_option("-o,--out", a->out, "output folder, made if missing (default: study)");
          sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
          sub.add_flag("--quiet", a->quiet, "no progress output");
          sub.callback([a]() { run(*a); });

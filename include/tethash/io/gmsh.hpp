@@ -13,7 +13,7 @@
 
 namespace tethash::io {
 
-TetMesh read_msh(const std::string& path, ReadNotes* notes = nullptr);
+TetMesh read_msh(const std::string& path, ReadNotes* notes = nullptr, const ReadOptions& options = {});
 /// Writes MSH 4.1 (ASCII unless `binary`; binary is little-endian with 8-byte size_t) through
 /// write_atomically. One volume entity per (object id, label) pair, numbered 1, 2, ... in order of first
 /// appearance, with the label as its physical tag when the mesh has labels; node and element tags are

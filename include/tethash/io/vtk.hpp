@@ -20,7 +20,7 @@ namespace tethash::io {
 
 /// Legacy .vtk UNSTRUCTURED_GRID, versions 1.0 to 5.1 (both the classic CELLS layout and the
 /// OFFSETS/CONNECTIVITY layout of 5.x), ASCII or BINARY (big-endian), float or double points.
-TetMesh read_vtk(const std::string& path, ReadNotes* notes = nullptr);
+TetMesh read_vtk(const std::string& path, ReadNotes* notes = nullptr, const ReadOptions& options = {});
 /// Legacy .vtk version 4.2 (classic CELLS layout, read by every VTK/ParaView version);
 /// BINARY (big-endian) unless `binary` is false. Point/cell fields go into FIELD blocks.
 void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& fields = {}, bool binary = true);
@@ -28,7 +28,7 @@ void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& field
 /// VTK XML UnstructuredGrid (.vtu): format ascii, binary (base64) or appended (raw or base64),
 /// either byte order, UInt32 or UInt64 headers, vtkZLibDataCompressor (when built with zlib),
 /// several Pieces (concatenated).
-TetMesh read_vtu(const std::string& path, ReadNotes* notes = nullptr);
+TetMesh read_vtu(const std::string& path, ReadNotes* notes = nullptr, const ReadOptions& options = {});
 /// Binary appended raw data (no base64), little-endian, UInt32 header (UInt64 if an array
 /// exceeds 4 GiB).
 void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields = {});

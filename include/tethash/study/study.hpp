@@ -5,13 +5,15 @@
 /// a warm-up, written as one CSV row per point and repeat (DIR/study.csv) and a summary (DIR/study.json).
 ///
 /// Value lists ("specs") are comma-separated items:
-///  - cell size: factors of the scene's mean edge length, e.g. "0.5,1,2", or a log-spaced range
-///    "FROM:TO:POINTS" (e.g. "0.125:8:13"); every factor must be > 0.
+///  Single values follow the grammar of every command (detect.hpp: parse_cell_size, parse_table_size,
+///  parse_threads): a plain number is a length or a count, "xF" a factor.
+///  - cell size: factors of the scene's mean edge length "x0.5,x1,x2", lengths "0.01", "auto" (= x1), or a
+///    log-spaced range of factors "xFROM:xTO:POINTS" (e.g. "x0.125:x8:13") or of lengths "FROM:TO:POINTS".
 ///  - table size: bucket counts ("1009"), "auto" (the detector's default), "xF" (F × the vertex count,
 ///    rounded up to the next power of two) or a range "xFROM:xTO:POINTS" / "FROM:TO:POINTS" that gives,
 ///    for each log-spaced value v, both the next power of two ≥ v and the next prime ≥ v. 0 is invalid.
 ///  - hash: names of detect.hpp's hash functions ("teschner,column") or "all".
-///  - threads: counts ≥ 1 ("1,2") or "FROM:TO" (every count in between).
+///  - threads: counts ("1,2"; 0 = every hardware thread) or "FROM:TO" (every count in between).
 ///  - integrator: names of the simulator's integrators or "all"; dt: seconds, list or log range
 ///    "FROM:TO:POINTS"; substeps: counts ≥ 1.
 

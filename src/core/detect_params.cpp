@@ -1,0 +1,129 @@
+// The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
+// --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/hash_grid.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <thread>
+
+namespace tethash {
+namespace {
+
+/// A whole-string decimal number, or false.
+bool to_double(const std::string& text, double& out)
+{
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return false;
+    char* end = nullptr;
+    out = std::strtod(text.c_str(), &end);
+    return end == text.c_str() + text.size() && std::isfinite(out);
+}
+
+/// A whole-string decimal integer, or false.
+bool to_integer(const std::string& text, long long& out)
+{
+    if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return false;
+    char* end = nullptr;
+    errno = 0;
+    out = std::strtoll(text.c_str(), &end, 10);
+    return end == text.c_str() + text.size() && errno == 0;
+}
+
+/// Splits "xF" into (true, "F"); anything else into (false, text).
+std::pair<bool, std::string> factor_form(const std::string& text)
+{
+    if (!text.empty() && (text[0] == 'x' || text[0] == 'X')) return {true, text.substr(1)};
+    return {false, text};
+}
+
+} // namespace
+
+int max_threads()
+{
+    const unsigned hw = std::thread::hardware_concurrency();
+    return std::max(256, static_cast<int>(std::min(hw, 1u << 20)));
+}
+
+int check_threads(long long threads, const std::string& option)
+{
+    if (threads < 0 || threads > max_threads())
+        throw Error(option + " " + std::to_string(threads) + ": expected 0 (every hardware thread) or 1.." +
+                    std::to_string(max_threads()) + " (this machine has " +
+                    std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " hardware threads)");
+    return static_cast<int>(threads);
+}
+
+int parse_threads(const std::string& text, const std::string& option)
+{
+    long long v = 0;
+    if (!to_integer(text, v))
+        throw Error(option + ": expected a thread count (0 = every hardware thread, 1.." +
+                    std::to_string(max_threads()) + "), found '" + text + "'");
+    return check_threads(v, option);
+}
+
+void parse_cell_size(const std::string& text, DetectParams& params, const std::string& option)
+{
+    if (text == "auto") {
+        params.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
+        params.cell_size = 1.0;
+        return;
+    }
+    const auto [factor, number] = factor_form(text);
+    double v = 0;
+    if (!to_double(number, v) || !(v > 0))
+        throw Error(option + ": expected a length L > 0, 'xF' (F > 0 times the mean edge length) or 'auto', found '" +
+                    text + "'");
+    params.cell_size_mode =
+        factor ? DetectParams::CellSizeMode::factor_of_mean_edge : DetectParams::CellSizeMode::absolute;
+    params.cell_size = v;
+}
+
+std::int64_t next_power_of_two(std::int64_t n)
+{
+    std::int64_t p = 1;
+    while (p < n && p < (std::int64_t{1} << 62))
+        p <<= 1;
+    return p;
+}
+
+std::int64_t parse_table_size(const std::string& text, std::int64_t vertices, const std::string& option)
+{
+    if (text == "auto") return 0;
+    const auto [factor, number] = factor_form(text);
+    const std::string expected = option + ": expected N (1.." + std::to_string(max_table_size) +
+                                 " buckets), 'xF' (F > 0 times the vertex count, rounded up to a power of two) or "
+                                 "'auto', found '" +
+                                 text + "'";
+    std::int64_t size = 0;
+    if (factor) {
+        double f = 0;
+        if (!to_double(number, f) || !(f > 0)) throw Error(expected);
+        const double want = std::ceil(f * static_cast<double>(std::max<std::int64_t>(vertices, 1)));
+        if (vertices > 0 && !(want <= static_cast<double>(max_table_size)))
+            throw Error(option + " " + text + ": " + std::to_string(vertices) + " vertices × " + number +
+                        " is more than the largest table (" + std::to_string(max_table_size) + " buckets)");
+        size = next_power_of_two(std::max<std::int64_t>(1, static_cast<std::int64_t>(std::min(want, 1e18))));
+    } else {
+        long long n = 0;
+        if (!to_integer(number, n) || n < 1 || n > max_table_size) throw Error(expected);
+        size = n;
+    }
+    return std::min(size, max_table_size);
+}
+
+void parse_skin(const std::string& text, DetectParams& params, const std::string& option)
+{
+    const auto [factor, number] = factor_form(text);
+    double v = 0;
+    if (!to_double(number, v) || !(v >= 0))
+        throw Error(option + ": expected a length ≥ 0 or 'xF' (F ≥ 0 times the cell size), found '" + text + "'");
+    params.skin_mode = factor ? DetectParams::SkinMode::factor_of_cell_size : DetectParams::SkinMode::absolute;
+    params.skin = v;
+}
+
+} // namespace tethash
