@@ -67,7 +67,9 @@ struct DetectParams {
     /// s > 0 a full detection collects each tet's candidates with its box inflated by s and keeps them; a later
     /// call whose moving vertices all moved less than s/2 per axis since that detection only re-runs the exact
     /// inside tests on the kept candidates (same contacts, bit for bit). 0 = off (the default). Must be ≥ 0 and
-    /// finite. Costs 24 bytes per vertex plus 4 bytes per kept candidate (see docs/detection.md).
+    /// finite. Costs 24 bytes per vertex plus 4 bytes per kept candidate (see docs/detection.md). When a kept list
+    /// was not reused even once (the scene moves faster than s/2 per call), full detections run without the skin
+    /// until a call moved less than s/4 since the previous one (DetectStats::skin then reads 0).
     enum class SkinMode { absolute, factor_of_cell_size };
     SkinMode skin_mode = SkinMode::absolute;
     double skin = 0; ///< a length, or the factor of the cell size for factor_of_cell_size
@@ -114,7 +116,7 @@ struct DetectStats {
     std::int64_t contacts = 0;
     double table_load = 0;              ///< vertices / table size
     std::int64_t memory_bytes = 0;      ///< detector working memory
-    double skin = 0;                    ///< skin actually used (length; 0 = no candidate reuse)
+    double skin = 0;                    ///< skin actually used (length; 0 = no candidate reuse, or paused)
     int reused = 0;                     ///< 1: stages 1-2 skipped, the kept candidates were tested (skin > 0)
     std::int64_t cached_candidates = 0; ///< candidates kept for reuse (skin > 0; 0 otherwise)
 };

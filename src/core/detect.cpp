@@ -230,8 +230,14 @@ class DetectorImpl {
     double origin[3] = {0, 0, 0};
     std::int64_t table_sizes[2] = {1, 1};
     VertexTable tables[2];  // 0: moving vertices (rebuilt each call), 1: static vertices (built once)
-    double skin = 0;        // candidate reuse: tet boxes inflated by skin (length; 0 = off)
-    double reuse_limit = 0; // largest per-axis displacement that still allows reuse (just below skin / 2)
+    double skin = 0;        // candidate reuse: tet boxes inflated by skin (length; 0 = off or paused)
+    double set_skin = 0;    // the skin asked for (length); skin is 0 while reuse is paused
+    double reuse_limit = 0; // largest per-axis displacement that still allows reuse (just below set_skin / 2)
+    // Paused reuse: a full detection with the skin whose candidates were not reused once means the scene moves too
+    // fast for the skin to pay (its inflated boxes cost more candidates); full detections then run without it, and
+    // resume it when a call's displacement since the previous call is below reuse_limit / 2 (reuse would last).
+    bool paused = false;
+    int reuses_since_full = 0;
     // candidate cache (skin > 0): the kept candidates are the threads' candidate runs of the last full detection
     bool cache_valid = false;
     int cache_threads = 0;
@@ -249,7 +255,8 @@ class DetectorImpl {
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs, const Index* candidates,
                       const double* P);
-    bool moved_less_than_limit(const double* P, int T) const;
+    bool moved_less_than(const double* P, int T, double limit) const;
+    void remember_positions(const double* P);
     void keep_for_reuse(const double* P, Index m);
     std::int64_t memory_bytes() const;
 };
@@ -282,8 +289,11 @@ void DetectorImpl::prepare(const PositionsRef& positions)
     // measured (relative error ≤ 2^-53): the limit sits a relative 1e-12 below. Skins below 1e-290 are treated as
     // off (the limit would lose its margin in subnormal arithmetic).
     if (!(skin >= 1e-290)) skin = 0;
+    set_skin = skin;
     reuse_limit = 0.5 * skin * (1.0 - 1e-12);
     cache_valid = false;
+    paused = false;
+    reuses_since_full = 0;
     if (num_vertices > 0) {
         const Eigen::RowVector3d lo = positions.colwise().minCoeff(), hi = positions.colwise().maxCoeff();
         for (int a = 0; a < 3; ++a)
@@ -558,12 +568,13 @@ void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::
     }
 }
 
-// Skin: true when every moving vertex moved less than reuse_limit (< skin / 2) per axis since the last full detection.
-// A non-finite coordinate counts as moved too far (the full detection then reports it). Blocks of 1,024 values with an
-// early exit; parallel over the team for big scenes only (a region costs more than checking 20,000 vertices).
-bool DetectorImpl::moved_less_than_limit(const double* P, int T) const
+// Skin: true when every moving vertex moved less than `limit` per axis since the remembered positions (the last full
+// detection; reuse_limit < skin / 2 allows reuse). A non-finite coordinate counts as moved too far (the full detection
+// then reports it). Blocks of 1,024 values with an early exit; parallel over the team for big scenes only (a region
+// costs more than checking 20,000 vertices).
+bool DetectorImpl::moved_less_than(const double* P, int T, double limit) const
 {
-    const double h = reuse_limit;
+    const double h = limit;
     const double* R = reference.data();
     const std::int64_t n = static_cast<std::int64_t>(dynamic_ids.size());
     const Index* ids = dynamic_ids.data();
@@ -593,7 +604,7 @@ bool DetectorImpl::moved_less_than_limit(const double* P, int T) const
 // Skin: after a full detection, remembers the moving vertices' positions and where each chunk's candidate runs are
 // (each thread's chunks are in increasing order, monotonic schedule: a chunk's runs end where the thread's next
 // chunk begins, or at the thread's last run).
-void DetectorImpl::keep_for_reuse(const double* P, Index m)
+void DetectorImpl::remember_positions(const double* P)
 {
     const std::size_t n = dynamic_ids.size();
     reference.resize(3 * n);
@@ -604,6 +615,12 @@ void DetectorImpl::keep_for_reuse(const double* P, Index m)
             for (int a = 0; a < 3; ++a)
                 reference[3 * i + static_cast<std::size_t>(a)] =
                     P[3 * static_cast<std::size_t>(dynamic_ids[i]) + static_cast<std::size_t>(a)];
+}
+
+void DetectorImpl::keep_for_reuse(const double* P, Index m)
+{
+    remember_positions(P);
+    reuses_since_full = 0;
     const std::size_t num_chunks = static_cast<std::size_t>((m + chunk_tets - 1) / chunk_tets);
     last_chunk.assign(threads.size(), -1);
     for (std::size_t k = 0; k < num_chunks; ++k) {
@@ -670,8 +687,17 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     // Candidate reuse (skin > 0): when every moving vertex moved less than skin / 2 since the last full detection,
     // the kept candidates contain every contact (docs/detection.md) and only stage 3 runs.
     bool reuse = false;
-    if (skin > 0 && cache_valid && cache_threads == T) {
-        reuse = moved_less_than_limit(P, T);
+    if (set_skin > 0) {
+        if (cache_valid && cache_threads == T) {
+            reuse = moved_less_than(P, T, reuse_limit);
+            if (reuse)
+                ++reuses_since_full;
+            else if (reuses_since_full == 0)
+                paused = true; // the last inflated detection bought nothing
+        } else if (paused && !reference.empty() && moved_less_than(P, T, 0.5 * reuse_limit)) {
+            paused = false; // slow enough since the previous call for a kept candidate list to last
+        }
+        skin = paused ? 0.0 : set_skin;
         ms_vertices = ms_since(t_start);
     }
     for (ThreadState& ts : threads) {
@@ -764,7 +790,10 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
                             (skin > 0 ? " with its box inflated by the skin " + std::to_string(skin) +
                                             "; use a larger cell size or a smaller skin"
                                       : "; use a larger cell size"));
-        if (skin > 0) keep_for_reuse(P, m);
+        if (skin > 0)
+            keep_for_reuse(P, m);
+        else if (paused)
+            remember_positions(P); // the next call measures its displacement from here
     }
 
     // Merge the threads' sorted runs: sorted by (vertex, tet), the same for any thread count.

@@ -16,6 +16,7 @@
 // the start of each iteration (Jacobi across the contact's five nodes), so no two threads ever read a position
 // another one writes.
 #include "integrator.hpp"
+#include "vertex_stencils.hpp"
 
 #include <Eigen/Geometry>
 
@@ -32,22 +33,10 @@ namespace tethash::sim {
 
 namespace {
 
-/// A spring seen from one of its ends (32 bytes). Stored in the order the sweep visits the vertices, so a
-/// sweep streams through these arrays.
-struct VertexSpring {
-    std::int32_t other; ///< the other end
-    double k, rest;
-    double length_t; ///< length at the start of the substep (relative damping)
-};
-
-/// A volume term seen from one of its corners i (40 bytes), in terms of W = 6V = (x_a − x_i) · N,
-/// N = (x_b − x_a) × (x_c − x_a): energy ½ k36 (W − W0)², ∇_i W = −N (W is linear in x_i).
-struct VertexTet {
-    std::int32_t a, b, c;
-    double k36; ///< k / (36 V0): the volume term's ½ (k/V0) (V − V0)² in W
-    double w0;  ///< 6 V0
-    double wt;  ///< 6 V at the start of the substep (relative damping)
-};
+using detail::LaneGroup;
+using detail::LaneTerms;
+using detail::SpringLanes;
+using detail::TetLanes;
 
 /// One incidence of a vertex in a contact's stencil.
 struct VertexContact {
@@ -73,28 +62,6 @@ struct Sym3 {
         yy += s;
         zz += s;
     }
-    /// Solves H d = f by Cholesky; false when H is not positive definite.
-    bool solve(const double f[3], double d[3]) const
-    {
-        const double l11 = xx;
-        if (!(l11 > 0)) return false;
-        const double r11 = std::sqrt(l11);
-        const double l21 = xy / r11, l31 = xz / r11;
-        const double l22sq = yy - l21 * l21;
-        if (!(l22sq > 0)) return false;
-        const double r22 = std::sqrt(l22sq);
-        const double l32 = (yz - l31 * l21) / r22;
-        const double l33sq = zz - l31 * l31 - l32 * l32;
-        if (!(l33sq > 0)) return false;
-        const double r33 = std::sqrt(l33sq);
-        const double z1 = f[0] / r11;
-        const double z2 = (f[1] - l21 * z1) / r22;
-        const double z3 = (f[2] - l31 * z1 - l32 * z2) / r33;
-        d[2] = z3 / r33;
-        d[1] = (z2 - l32 * d[2]) / r22;
-        d[0] = (z1 - l21 * d[1] - l31 * d[2]) / r11;
-        return true;
-    }
 };
 
 class BlockDescent final : public StepIntegrator {
@@ -105,37 +72,36 @@ class BlockDescent final : public StepIntegrator {
 
   private:
     void setup();
-    void start_substep(const Positions& x);
+    void start_substep(const double* x4);
     void gather_contacts();
-    /// One Newton step on the vertex at position k of the sweep order.
-    /// Returns the step's length over the vertex's clamp length (0 … 1).
-    double solve_vertex(std::int32_t k, double* x, double h) const;
-    /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices.
+    /// One Newton step on each real lane of group g (its elastic terms gathered four lanes at a time, then
+    /// inertia, ground and contacts lane by lane). Returns the largest step over its lane's clamp length (0 … 1).
+    double solve_group(std::int32_t g, double* x4, double h) const;
+    /// Adds lane l's inertia, ground and contact terms to its elastic ones.
+    void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
+    /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
     void accelerate(int n, double rho, double& omega, double* x);
-    /// Newton steps on the vertices at positions [begin, end) of the sweep order, in order. (An x86-64-v3 clone
-    /// with fused multiply-adds measured 7 % slower on the hand drop than this baseline build, interleaved runs.)
-    double sweep(std::int32_t begin, std::int32_t end, double* x, double h) const
-    {
-        double largest = 0;
-        for (std::int32_t k = begin; k < end; ++k)
-            largest = std::max(largest, solve_vertex(k, x, h));
-        return largest;
-    }
 
     StepContext m_ctx;
-    // Fixed set-up, built once. Everything per vertex is indexed by the vertex's position k in the sweep order
-    // (free vertices grouped by colour), so that a sweep reads these arrays front to back.
-    std::vector<std::int32_t> m_colour_start;              ///< positions k of each colour
-    std::vector<std::int32_t> m_order;                     ///< k → vertex id
-    std::vector<std::int32_t> m_spring_start, m_tet_start; ///< k → entries
-    std::vector<VertexSpring> m_springs;
-    std::vector<VertexTet> m_tets;
-    std::vector<double> m_damping;  ///< k → its object's damping time (s)
-    std::vector<double> m_max_step; ///< k → largest local step (a fifth of its object's mean edge)
-    std::vector<double> m_ground_k, m_ground_c; ///< vertex id → ground penalty and damping
+    // Fixed set-up, built once: the free vertices of each colour in groups of four lanes (vertex_stencils.hpp),
+    // the groups' entries stored in sweep order, so that a sweep reads them front to back.
+    std::vector<std::int32_t> m_colour_start; ///< groups of each colour
+    std::vector<LaneGroup> m_groups;
+    std::vector<SpringLanes> m_springs;
+    std::vector<TetLanes> m_tets;
+    std::vector<std::int32_t> m_order;            ///< the free vertices
+    std::vector<double> m_max_step;               ///< vertex id → largest local step (a fifth of its object's mean edge)
+    std::vector<double> m_ground_k, m_ground_c;   ///< vertex id → ground penalty and damping
+    detail::GatherFn m_gather = nullptr;
+    detail::StartFn m_start = nullptr;
+    detail::SolveFn m_solve = nullptr;
     int m_threads = 1;
     // Per-substep state, buffers reused.
     Positions m_xt;          ///< positions at the start of the substep
+    struct alignas(32) Point4 {
+        double c[4];
+    };
+    std::vector<Point4> m_x4; ///< the positions the sweeps work on (stride 4: aligned row loads)
     std::vector<double> m_y; ///< inertial target, flat 3n
     std::vector<double> m_prev1, m_prev2; ///< the iterates of the two previous sweeps (Chebyshev acceleration)
     // Contacts of the substep: per contact depth, direction, weighted stiffness and damping, relative
@@ -201,56 +167,100 @@ void BlockDescent::setup()
         colour[static_cast<size_t>(i)] = c;
         colours = std::max(colours, c + 1);
     }
-    m_colour_start.assign(static_cast<size_t>(colours) + 1, 0);
+    std::vector<std::int32_t> colour_start(static_cast<size_t>(colours) + 1, 0); // positions in m_order
     for (Index i = 0; i < n; ++i)
-        if (colour[static_cast<size_t>(i)] >= 0) ++m_colour_start[static_cast<size_t>(colour[static_cast<size_t>(i)]) + 1];
+        if (colour[static_cast<size_t>(i)] >= 0)
+            ++colour_start[static_cast<size_t>(colour[static_cast<size_t>(i)]) + 1];
     for (int c = 0; c < colours; ++c)
-        m_colour_start[static_cast<size_t>(c) + 1] += m_colour_start[static_cast<size_t>(c)];
-    m_order.resize(static_cast<size_t>(m_colour_start.back()));
-    fill.assign(m_colour_start.begin(), m_colour_start.end() - 1);
+        colour_start[static_cast<size_t>(c) + 1] += colour_start[static_cast<size_t>(c)];
+    m_order.resize(static_cast<size_t>(colour_start.back()));
+    fill.assign(colour_start.begin(), colour_start.end() - 1);
     for (Index i = 0; i < n; ++i)
         if (colour[static_cast<size_t>(i)] >= 0)
             m_order[static_cast<size_t>(fill[static_cast<size_t>(colour[static_cast<size_t>(i)])]++)] =
                 static_cast<std::int32_t>(i);
 
-    // Entries in sweep order. Volume terms: the other three corners in an order that keeps the orientation (even
-    // permutations of (0, 1, 2, 3) starting with the corner).
+    // Groups of four lanes: within a colour the order does not change the result (its vertices are independent),
+    // so each colour's vertices are sorted by their number of tets and springs and grouped by four, which keeps
+    // the padding of the lane-interleaved entries small. Volume terms: the other three corners in an order that
+    // keeps the orientation (even permutations of (0, 1, 2, 3) starting with the corner).
     static constexpr int others[4][3] = {{1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}};
-    const size_t nk = m_order.size();
-    m_spring_start.assign(nk + 1, 0);
-    m_tet_start.assign(nk + 1, 0);
+    auto count_of = [](const std::vector<std::int32_t>& start, std::int32_t i) {
+        return start[static_cast<size_t>(i) + 1] - start[static_cast<size_t>(i)];
+    };
+    m_colour_start.assign(1, 0);
+    m_groups.clear();
     m_springs.clear();
     m_tets.clear();
-    m_damping.assign(nk, 0.0);
-    m_max_step.assign(nk, 0.0);
-    for (size_t k = 0; k < nk; ++k) {
-        const Index i = m_order[k];
-        for (std::int32_t s = adj_start[static_cast<size_t>(i)]; s < adj_start[static_cast<size_t>(i) + 1]; ++s) {
-            const Index e = adj_spring[static_cast<size_t>(s)];
-            const Index j = model.springs.edges(e, 0) == i ? model.springs.edges(e, 1) : model.springs.edges(e, 0);
-            m_springs.push_back(VertexSpring{static_cast<std::int32_t>(j), model.springs.k[static_cast<size_t>(e)],
-                                             model.springs.rest[static_cast<size_t>(e)], 0.0});
+    m_max_step.assign(un, std::numeric_limits<double>::infinity());
+    for (int c = 0; c < colours; ++c) {
+        std::vector<std::int32_t> members(m_order.begin() + colour_start[static_cast<size_t>(c)],
+                                          m_order.begin() + colour_start[static_cast<size_t>(c) + 1]);
+        std::stable_sort(members.begin(), members.end(), [&](std::int32_t p, std::int32_t q) {
+            const std::int32_t tp = count_of(tet_adj_start, p), tq = count_of(tet_adj_start, q);
+            if (tp != tq) return tp > tq;
+            return count_of(adj_start, p) > count_of(adj_start, q);
+        });
+        for (size_t first = 0; first < members.size(); first += 4) {
+            LaneGroup g{};
+            g.lanes = static_cast<std::int32_t>(std::min<size_t>(4, members.size() - first));
+            std::int32_t springs = 0, tets = 0;
+            for (int l = 0; l < 4; ++l) {
+                const std::int32_t i = members[first + static_cast<size_t>(std::min(l, g.lanes - 1))];
+                g.vertex[l] = l < g.lanes ? i : members[first];
+                springs = std::max(springs, count_of(adj_start, i));
+                tets = std::max(tets, count_of(tet_adj_start, i));
+            }
+            g.spring_begin = static_cast<std::int32_t>(m_springs.size());
+            g.spring_end = g.spring_begin + springs;
+            g.tet_begin = static_cast<std::int32_t>(m_tets.size());
+            g.tet_end = g.tet_begin + tets;
+            m_springs.resize(static_cast<size_t>(g.spring_end));
+            m_tets.resize(static_cast<size_t>(g.tet_end));
+            for (int l = 0; l < 4; ++l) {
+                const std::int32_t i = g.vertex[l];
+                const bool real = l < g.lanes;
+                const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
+                g.damping[l] = o < m_ctx.scene.objects.size() ? m_ctx.scene.objects[o].material.damping : 0.0;
+                const double edge = o < model.object_mean_edge.size() ? model.object_mean_edge[o] : 0.0;
+                if (edge > 0) m_max_step[static_cast<size_t>(i)] = 0.2 * edge;
+                // Padding (a padding lane, or a lane's entries beyond its own): zero stiffness on the lane's own
+                // vertex, which contributes nothing.
+                for (std::int32_t e = 0; e < springs; ++e) {
+                    SpringLanes& sl = m_springs[static_cast<size_t>(g.spring_begin + e)];
+                    sl.other[l] = i;
+                    sl.k[l] = sl.rest[l] = sl.length_t[l] = 0;
+                    if (!real || e >= count_of(adj_start, i)) continue;
+                    const Index edge_id = adj_spring[static_cast<size_t>(adj_start[static_cast<size_t>(i)] + e)];
+                    const Index j = model.springs.edges(edge_id, 0) == i ? model.springs.edges(edge_id, 1)
+                                                                         : model.springs.edges(edge_id, 0);
+                    sl.other[l] = static_cast<std::int32_t>(j);
+                    sl.k[l] = model.springs.k[static_cast<size_t>(edge_id)];
+                    sl.rest[l] = model.springs.rest[static_cast<size_t>(edge_id)];
+                }
+                for (std::int32_t e = 0; e < tets; ++e) {
+                    TetLanes& tl = m_tets[static_cast<size_t>(g.tet_begin + e)];
+                    tl.a[l] = tl.b[l] = tl.c[l] = i;
+                    tl.k36[l] = tl.w0[l] = tl.wt[l] = 0;
+                    if (!real || e >= count_of(tet_adj_start, i)) continue;
+                    const std::int32_t entry = tet_adj[static_cast<size_t>(tet_adj_start[static_cast<size_t>(i)] + e)];
+                    const Index t = entry / 4;
+                    const int a = entry % 4;
+                    const double v0 = model.volumes.rest[static_cast<size_t>(t)];
+                    tl.a[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][0]));
+                    tl.b[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][1]));
+                    tl.c[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][2]));
+                    tl.k36[l] = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
+                    tl.w0[l] = tl.wt[l] = 6.0 * v0;
+                }
+            }
+            m_groups.push_back(g);
         }
-        for (std::int32_t s = tet_adj_start[static_cast<size_t>(i)]; s < tet_adj_start[static_cast<size_t>(i) + 1]; ++s) {
-            const Index t = tet_adj[static_cast<size_t>(s)] / 4;
-            const int a = tet_adj[static_cast<size_t>(s)] % 4;
-            const double v0 = model.volumes.rest[static_cast<size_t>(t)];
-            VertexTet vt;
-            vt.a = model.volumes.tets(t, others[a][0]);
-            vt.b = model.volumes.tets(t, others[a][1]);
-            vt.c = model.volumes.tets(t, others[a][2]);
-            vt.k36 = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
-            vt.w0 = 6.0 * v0;
-            vt.wt = vt.w0;
-            m_tets.push_back(vt);
-        }
-        m_spring_start[k + 1] = static_cast<std::int32_t>(m_springs.size());
-        m_tet_start[k + 1] = static_cast<std::int32_t>(m_tets.size());
-        const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
-        m_damping[k] = o < m_ctx.scene.objects.size() ? m_ctx.scene.objects[o].material.damping : 0.0;
-        const double edge = o < model.object_mean_edge.size() ? model.object_mean_edge[o] : 0.0;
-        m_max_step[k] = edge > 0 ? 0.2 * edge : std::numeric_limits<double>::infinity();
+        m_colour_start.push_back(static_cast<std::int32_t>(m_groups.size()));
     }
+    m_gather = detail::choose_gather();
+    m_start = detail::choose_start(m_gather);
+    m_solve = detail::choose_solve(m_gather);
     if (model.ground.enabled) {
         m_ground_k.resize(un);
         m_ground_c.resize(un);
@@ -267,30 +277,11 @@ void BlockDescent::setup()
 #endif
 }
 
-void BlockDescent::start_substep(const Positions& x)
+void BlockDescent::start_substep(const double* x4)
 {
     // Lengths and volumes at the start of the substep, for the relative damping.
-    const double* xp = x.data();
-    const size_t nk = m_order.size();
-    for (size_t k = 0; k < nk; ++k) {
-        const double* xi = xp + 3 * static_cast<size_t>(m_order[k]);
-        for (std::int32_t s = m_spring_start[k]; s < m_spring_start[k + 1]; ++s) {
-            VertexSpring& sp = m_springs[static_cast<size_t>(s)];
-            const double* xj = xp + 3 * static_cast<size_t>(sp.other);
-            const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-            sp.length_t = std::sqrt(dx * dx + dy * dy + dz * dz);
-        }
-        for (std::int32_t s = m_tet_start[k]; s < m_tet_start[k + 1]; ++s) {
-            VertexTet& t = m_tets[static_cast<size_t>(s)];
-            const double* a = xp + 3 * static_cast<size_t>(t.a);
-            const double* b = xp + 3 * static_cast<size_t>(t.b);
-            const double* c = xp + 3 * static_cast<size_t>(t.c);
-            const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-            const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-            const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-            t.wt = (a[0] - xi[0]) * nx + (a[1] - xi[1]) * ny + (a[2] - xi[2]) * nz;
-        }
-    }
+    for (const LaneGroup& g : m_groups)
+        m_start(g, m_springs.data(), m_tets.data(), x4);
 }
 
 void BlockDescent::gather_contacts()
@@ -333,54 +324,49 @@ void BlockDescent::gather_contacts()
         }
 }
 
-inline __attribute__((always_inline)) double BlockDescent::solve_vertex(std::int32_t k, double* x, double h) const
+double BlockDescent::solve_group(std::int32_t gi, double* x, double h) const
+{
+    const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
+    LaneTerms terms;
+    const double inv_h = 1.0 / h;
+    m_gather(grp, m_springs.data(), m_tets.data(), x, inv_h, terms);
+    for (int l = 0; l < grp.lanes; ++l)
+        add_lane_terms(grp, l, terms, x, h);
+    double d[3][4];
+    const int solved = m_solve(terms, d);
+    double largest = 0;
+    for (int l = 0; l < grp.lanes; ++l) {
+        if (!(solved >> l & 1)) continue; // not positive definite: the vertex stays
+        const size_t u = static_cast<size_t>(grp.vertex[l]);
+        const double step = std::sqrt(d[0][l] * d[0][l] + d[1][l] * d[1][l] + d[2][l] * d[2][l]);
+        double scale = 1.0, relative = step / m_max_step[u];
+        if (relative > 1) {
+            scale = 1.0 / relative;
+            relative = 1;
+        }
+        for (size_t r = 0; r < 3; ++r)
+            x[4 * u + r] += scale * d[r][l];
+        largest = std::max(largest, relative);
+    }
+    return largest;
+}
+
+void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms, const double* x, double h) const
 {
     const Model& model = m_ctx.model;
-    const size_t kk = static_cast<size_t>(k);
-    const size_t u = static_cast<size_t>(m_order[kk]);
+    const size_t u = static_cast<size_t>(grp.vertex[l]);
     const double inv_h = 1.0 / h;
     const double m_h2 = model.mass[u] * inv_h * inv_h;
-    const double xi = x[3 * u], yi = x[3 * u + 1], zi = x[3 * u + 2];
-    double f[3] = {m_h2 * (m_y[3 * u] - xi), m_h2 * (m_y[3 * u + 1] - yi), m_h2 * (m_y[3 * u + 2] - zi)};
+    const double xi = x[4 * u], yi = x[4 * u + 1], zi = x[4 * u + 2];
+    double f[3] = {m_h2 * (m_y[3 * u] - xi) + terms.f[0][l], m_h2 * (m_y[3 * u + 1] - yi) + terms.f[1][l],
+                   m_h2 * (m_y[3 * u + 2] - zi) + terms.f[2][l]};
     Sym3 H;
-    H.add_identity(m_h2);
-    const double damp_h = m_damping[kk] * inv_h; // dashpot c = damping · k, taken over the substep
-
-    for (std::int32_t s = m_spring_start[kk]; s < m_spring_start[kk + 1]; ++s) {
-        const VertexSpring& sp = m_springs[static_cast<size_t>(s)];
-        const double* xj = x + 3 * static_cast<size_t>(sp.other);
-        const double dx = xi - xj[0], dy = yi - xj[1], dz = zi - xj[2];
-        const double len2 = dx * dx + dy * dy + dz * dz;
-        if (!(len2 > 0)) continue;
-        const double len = std::sqrt(len2), inv = 1.0 / len;
-        const double ux = dx * inv, uy = dy * inv, uz = dz * inv;
-        const double fs = sp.k * ((len - sp.rest) + damp_h * (len - sp.length_t));
-        f[0] -= fs * ux;
-        f[1] -= fs * uy;
-        f[2] -= fs * uz;
-        // k (uuᵀ + (1 − L0/l)(I − uuᵀ)) with the transverse part clamped at 0 when compressed, plus damping uuᵀ.
-        const double tr = std::max(0.0, 1.0 - sp.rest * inv);
-        H.add_identity(sp.k * tr);
-        H.add_outer(sp.k * (1.0 - tr) + damp_h * sp.k, ux, uy, uz);
-    }
-
-    const double tet_scale = 1.0 + damp_h;
-    for (std::int32_t s = m_tet_start[kk]; s < m_tet_start[kk + 1]; ++s) {
-        const VertexTet& t = m_tets[static_cast<size_t>(s)];
-        const double* a = x + 3 * static_cast<size_t>(t.a);
-        const double* b = x + 3 * static_cast<size_t>(t.b);
-        const double* c = x + 3 * static_cast<size_t>(t.c);
-        const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-        const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-        const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-        const double w = (a[0] - xi) * nx + (a[1] - yi) * ny + (a[2] - zi) * nz;
-        // f = −∂E/∂x_i = k36 ((W − W0) + damping/h (W − W_t)) N, H = k36 (1 + damping/h) N Nᵀ.
-        const double fs = t.k36 * ((w - t.w0) + damp_h * (w - t.wt));
-        f[0] += fs * nx;
-        f[1] += fs * ny;
-        f[2] += fs * nz;
-        H.add_outer(t.k36 * tet_scale, nx, ny, nz);
-    }
+    H.xx = terms.H[0][l] + m_h2;
+    H.yy = terms.H[1][l] + m_h2;
+    H.zz = terms.H[2][l] + m_h2;
+    H.xy = terms.H[3][l];
+    H.xz = terms.H[4][l];
+    H.yz = terms.H[5][l];
 
     const double* xt = m_xt.data() + 3 * u;
     if (!m_ground_k.empty()) {
@@ -440,19 +426,14 @@ inline __attribute__((always_inline)) double BlockDescent::solve_vertex(std::int
         }
     }
 
-    double d[3];
-    if (!H.solve(f, d)) return 0;
-    const double step2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    const double cap = m_max_step[kk];
-    double scale = 1.0, relative = std::sqrt(step2) / cap;
-    if (relative > 1) {
-        scale = 1.0 / relative;
-        relative = 1;
-    }
-    x[3 * u] = xi + scale * d[0];
-    x[3 * u + 1] = yi + scale * d[1];
-    x[3 * u + 2] = zi + scale * d[2];
-    return relative;
+    for (int r = 0; r < 3; ++r)
+        terms.f[r][l] = f[r];
+    terms.H[0][l] = H.xx;
+    terms.H[1][l] = H.yy;
+    terms.H[2][l] = H.zz;
+    terms.H[3][l] = H.xy;
+    terms.H[4][l] = H.xz;
+    terms.H[5][l] = H.yz;
 }
 
 void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
@@ -465,7 +446,7 @@ void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
     const bool ground = !m_ground_k.empty();
     if (n >= 2)
         for (size_t k = 0; k < nk; ++k) {
-            const size_t i = static_cast<size_t>(m_order[k]), u = 3 * i;
+            const size_t i = static_cast<size_t>(m_order[k]), u = 4 * i;
             if (m_vc_start[i + 1] > m_vc_start[i]) continue;
             if (ground && g.normal.x() * x[u] + g.normal.y() * x[u + 1] + g.normal.z() * x[u + 2] < g.height) continue;
             for (size_t r = u; r < u + 3; ++r)
@@ -473,7 +454,7 @@ void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
         }
     m_prev2.swap(m_prev1);
     for (size_t k = 0; k < nk; ++k) {
-        const size_t u = 3 * static_cast<size_t>(m_order[k]);
+        const size_t u = 4 * static_cast<size_t>(m_order[k]);
         for (size_t r = u; r < u + 3; ++r)
             m_prev1[r] = x[r];
     }
@@ -485,7 +466,12 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     const Index n = x.rows();
     const size_t un = static_cast<size_t>(n);
     m_xt = x;
-    start_substep(x);
+    // The sweeps work on a copy with a stride of 4 doubles (vertex_stencils.hpp), written back at the end.
+    m_x4.resize(un);
+    for (size_t i = 0; i < un; ++i)
+        m_x4[i] = {x(static_cast<Index>(i), 0), x(static_cast<Index>(i), 1), x(static_cast<Index>(i), 2), 0.0};
+    double* xp = m_x4.data()->c;
+    start_substep(xp);
     // Inertial target y = x + h v + h² g; the iterations start from it.
     m_y.resize(3 * un);
     const Eigen::Vector3d& g = model.gravity;
@@ -498,12 +484,11 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         for (int r = 0; r < 3; ++r) {
             const double yr = x(static_cast<Index>(i), r) + h * v(static_cast<Index>(i), r) + h * h * g[r];
             m_y[3 * i + static_cast<size_t>(r)] = yr;
-            x(static_cast<Index>(i), r) = yr;
+            xp[4 * i + static_cast<size_t>(r)] = yr;
         }
     }
     gather_contacts();
 
-    double* xp = x.data();
     const double* xtp = m_xt.data();
     const int colours = static_cast<int>(m_colour_start.size()) - 1;
     const int max_sweeps = std::max(1, m_ctx.scene.iterations);
@@ -513,7 +498,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     const double rho = m_ctx.scene.acceleration;
     double omega = 1;
     if (rho > 0) {
-        m_prev2.assign(xp, xp + 3 * un);
+        m_prev2.assign(xp, xp + 4 * un);
         m_prev1 = m_prev2;
     }
     while (sweeps < max_sweeps) {
@@ -522,23 +507,24 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
             for (int s = 0; s < 5; ++s) {
                 const size_t j = static_cast<size_t>(c.node[s]);
                 for (int r = 0; r < 3; ++r)
-                    c.rel[r] += c.coef[s] * (xp[3 * j + static_cast<size_t>(r)] - xtp[3 * j + static_cast<size_t>(r)]);
+                    c.rel[r] += c.coef[s] * (xp[4 * j + static_cast<size_t>(r)] - xtp[3 * j + static_cast<size_t>(r)]);
             }
         }
         double largest = 0;
         for (int c = 0; c < colours; ++c) {
             const std::int32_t begin = m_colour_start[static_cast<size_t>(c)], end = m_colour_start[static_cast<size_t>(c) + 1];
 #ifdef TETHASH_HAVE_OPENMP
-            if (m_threads > 1 && end - begin > 256) {
+            if (m_threads > 1 && end - begin > 64) {
                 double colour_largest = 0;
 #pragma omp parallel for num_threads(m_threads) schedule(static) reduction(max : colour_largest)
-                for (std::int32_t k = begin; k < end; ++k)
-                    colour_largest = std::max(colour_largest, solve_vertex(k, xp, h));
+                for (std::int32_t g = begin; g < end; ++g)
+                    colour_largest = std::max(colour_largest, solve_group(g, xp, h));
                 largest = std::max(largest, colour_largest);
                 continue;
             }
 #endif
-            largest = std::max(largest, sweep(begin, end, xp, h));
+            for (std::int32_t g = begin; g < end; ++g)
+                largest = std::max(largest, solve_group(g, xp, h));
         }
         ++sweeps;
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
@@ -547,8 +533,10 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
-        for (int r = 0; r < 3; ++r)
+        for (int r = 0; r < 3; ++r) {
+            x(static_cast<Index>(i), r) = xp[4 * i + static_cast<size_t>(r)];
             v(static_cast<Index>(i), r) = (x(static_cast<Index>(i), r) - m_xt(static_cast<Index>(i), r)) * inv_h;
+        }
     }
     return sweeps;
 }

@@ -1,0 +1,73 @@
+#pragma once
+// The block-descent sweep's elastic stencils, four vertices at a time (private to tethash::sim).
+//
+// A sweep solves one 3 × 3 Newton step per vertex; most of its time is gathering the vertex's springs and
+// volume terms into a force and a Hessian. Vertices of one colour share no spring and no tet, so any four of
+// them can be gathered together: the free vertices of each colour are sorted by their number of tets and
+// springs and grouped by four (lanes), and each group's entries are stored lane-interleaved (entry e of the
+// group holds that entry for the four lanes; a lane with fewer entries is padded with zero-stiffness ones).
+// The gather then runs as four-wide arithmetic (AVX2 with fused multiply-adds where the processor has them,
+// chosen at run time; TETHASH_SIMD=scalar forces the one-lane version, which computes the same terms).
+
+#include <cstdint>
+
+namespace tethash::sim::detail {
+
+/// A spring seen from its end in each of four lanes (k = 0 pads).
+struct alignas(32) SpringLanes {
+    double k[4], rest[4];
+    double length_t[4]; ///< length at the start of the substep (relative damping)
+    std::int32_t other[4]; ///< the other end's vertex id
+    std::int32_t unused[4];
+};
+
+/// A volume term seen from one corner i in each of four lanes, in terms of W = 6V = (x_a − x_i) · N,
+/// N = (x_b − x_a) × (x_c − x_a): energy ½ k36 (W − W0)², ∇_i W = −N (W is linear in x_i). k36 = 0 pads.
+struct alignas(32) TetLanes {
+    double k36[4]; ///< k / (36 V0): the volume term's ½ (k/V0) (V − V0)² in W
+    double w0[4];  ///< 6 V0
+    double wt[4];  ///< 6 V at the start of the substep (relative damping)
+    std::int32_t a[4], b[4], c[4];
+    std::int32_t unused[4];
+};
+
+/// Four vertices of one colour and their entries.
+struct alignas(32) LaneGroup {
+    double damping[4];     ///< each lane's object damping time (s)
+    std::int32_t vertex[4]; ///< vertex ids; a padding lane repeats lane 0 and is not written
+    std::int32_t lanes;     ///< real lanes (1 … 4)
+    std::int32_t spring_begin, spring_end, tet_begin, tet_end;
+};
+
+/// The elastic part of four vertices' local problems: force f = −∇E and Hessian H (xx, yy, zz, xy, xz, yz),
+/// lane by lane, with relative damping over the substep (inv_h = 1 / h).
+struct LaneTerms {
+    alignas(32) double f[3][4];
+    alignas(32) double H[6][4];
+};
+
+/// Positions are given with a stride of 4 doubles (x, y, z, unused), 32-byte aligned.
+using GatherFn = void (*)(const LaneGroup& g, const SpringLanes* springs, const TetLanes* tets, const double* x,
+                          double inv_h, LaneTerms& out);
+
+/// Sets length_t and wt of a group's entries (every lane, padding included) from positions x: the lengths and
+/// volumes at the start of the substep, for the relative damping.
+using StartFn = void (*)(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, const double* x);
+
+/// The start-of-substep pass matching choose_gather().
+StartFn choose_start(GatherFn gather);
+
+/// Solves the four lanes' H d = f by Cholesky (H as in LaneTerms). Returns a bit mask of the lanes whose H is
+/// positive definite (their d is set; the others' is not).
+using SolveFn = int (*)(const LaneTerms& t, double d[3][4]);
+
+/// The solve matching choose_gather().
+SolveFn choose_solve(GatherFn gather);
+
+/// The gather for this processor (AVX2 + FMA or one lane at a time; TETHASH_SIMD=scalar forces the latter).
+GatherFn choose_gather();
+
+/// "avx2" or "scalar": what choose_gather() returns.
+const char* gather_kernel_name(GatherFn fn);
+
+} // namespace tethash::sim::detail
