@@ -3,6 +3,7 @@
 
 #include "tethash/error.hpp"
 #include "tethash/sim/scene.hpp"
+#include "tethash/sim/simulation.hpp"
 
 #include <filesystem>
 
@@ -133,12 +134,43 @@ TEST(SimScene, WrongTypesAndValuesNameKeyAndLine)
         {"[[object]]\nname = \"x\"\n", "object[0]", "s.toml:"},
         {"dt = = 1\n", "TOML", "s.toml:1"},
         {"\nacceleration = 1\n" + kObject, "'acceleration'", "s.toml:2"},
+        {"[detector]\nthreads = 100000\n" + kObject, "detector.threads", "s.toml:2"},
+        {"[detector]\ntable_size = \"x0\"\n" + kObject, "detector.table_size", "s.toml:2"},
+        {"[detector]\nskin = \"x-1\"\n" + kObject, "detector.skin", "s.toml:2"},
     };
     for (const Case& c : cases) {
         const std::string e = error_of(c.text);
         EXPECT_NE(e.find(c.key), std::string::npos) << c.text << " -> " << e;
         EXPECT_NE(e.find(c.line), std::string::npos) << c.text << " -> " << e;
     }
+}
+
+TEST(SimScene, DetectorKeysUseTheCommandLineGrammar)
+{
+    // Strings mean what they mean on the command line (detect.hpp): "xF" factors, "auto", plain lengths.
+    Scene s = parse_scene("[detector]\ncell_size = \"0.25\"\nskin = \"x0.5\"\ntable_size = \"x2\"\n" + kObject,
+                          "s.toml", ".");
+    EXPECT_EQ(s.detect.cell_size_mode, DetectParams::CellSizeMode::absolute);
+    EXPECT_DOUBLE_EQ(s.detect.cell_size, 0.25);
+    EXPECT_EQ(s.detect.skin_mode, DetectParams::SkinMode::factor_of_cell_size);
+    EXPECT_DOUBLE_EQ(s.detect.skin, 0.5);
+    EXPECT_EQ(s.table_size_of_vertices, "x2");
+    // "xF" is resolved against the scene's vertex count when the simulation is built, as `detect --table-size xF`
+    // does: a factor too large for this scene is refused there, naming the key.
+    s.output.every = 0;
+    EXPECT_NO_THROW(Simulation{s});
+    s = parse_scene("[detector]\ntable_size = \"x1e17\"\n" + kObject, "s.toml", ".");
+    try {
+        Simulation sim(s);
+        ADD_FAILURE() << "a table of 1e17 × the vertices was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("detector.table_size"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("largest table"), std::string::npos) << e.what();
+    }
+    s = parse_scene("[detector]\ntable_size = \"auto\"\nthreads = 0\n" + kObject, "s.toml", ".");
+    EXPECT_EQ(s.detect.table_size, 0);
+    EXPECT_TRUE(s.table_size_of_vertices.empty());
+    EXPECT_EQ(s.detect.threads, 0);
 }
 
 TEST(SimScene, ShippedScenesAndDefaultParse)

@@ -44,7 +44,11 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
     }
     m_enabled = dynamic_objects > 0 && (self || scene.objects.size() >= 2);
     if (m_enabled) {
-        m_detector.set_params(scene.detect);
+        DetectParams params = scene.detect;
+        if (!scene.table_size_of_vertices.empty())
+            params.table_size = parse_table_size(scene.table_size_of_vertices, mesh.num_vertices(),
+                                                 scene.source + ": detector.table_size");
+        m_detector.set_params(params);
         m_detector.set_topology(mesh, options);
         m_penetration.set_topology(mesh);
     }

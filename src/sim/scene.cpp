@@ -385,54 +385,50 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             r.check_keys(t, "detector.", {"cell_size", "table_size", "hash", "threads", "skin"});
             for (auto&& [dk, dv] : t) {
                 const std::string d(dk.str()), full = "detector." + d;
+                // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
+                // a value means here what it means on the command line.
+                const auto grammar = [&](auto&& parse) {
+                    try {
+                        parse(r.string(dv, full));
+                    } catch (const Error& e) {
+                        r.fail(&dv, full, e.what());
+                    }
+                };
                 if (d == "cell_size") {
                     if (dv.is_number()) {
                         s.detect.cell_size_mode = DetectParams::CellSizeMode::absolute;
                         s.detect.cell_size = r.positive(dv, full);
-                    } else {
-                        const std::string str = r.string(dv, full);
-                        if (str == "auto")
-                            s.detect.cell_size_mode = DetectParams::CellSizeMode::auto_mean_edge;
-                        else if (str.size() > 1 && str[0] == 'x') {
-                            char* end = nullptr;
-                            const double f = std::strtod(str.c_str() + 1, &end);
-                            if (*end != '\0' || !(f > 0) || !std::isfinite(f))
-                                r.fail(&dv, full,
-                                       "expected a number, \"auto\" or \"xF\" (F > 0), found \"" + str + "\"");
-                            s.detect.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
-                            s.detect.cell_size = f;
-                        } else
-                            r.fail(&dv, full, "expected a number, \"auto\" or \"xF\", found \"" + str + "\"");
-                    }
-                } else if (d == "table_size") {
-                    if (dv.is_string()) {
-                        if (r.string(dv, full) != "auto") r.fail(&dv, full, "expected an integer ≥ 1 or \"auto\"");
-                        s.detect.table_size = 0;
                     } else
+                        grammar([&](const std::string& text) { parse_cell_size(text, s.detect, full); });
+                } else if (d == "table_size") {
+                    if (dv.is_number()) {
                         s.detect.table_size = r.integer_at_least(dv, full, 1);
+                        s.table_size_of_vertices.clear();
+                    } else
+                        grammar([&](const std::string& text) {
+                            // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
+                            s.detect.table_size = parse_table_size(text, 0, full);
+                            s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
+                        });
                 } else if (d == "hash") {
                     try {
                         s.detect.hash = parse_hash_function(r.string(dv, full));
                     } catch (const Error& e) {
                         r.fail(&dv, full, e.what());
                     }
-                } else if (d == "threads")
-                    s.detect.threads = r.int_at_least(dv, full, 0);
-                else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
+                } else if (d == "threads") {
+                    const long long threads = r.int_at_least(dv, full, 0);
+                    try {
+                        s.detect.threads = check_threads(threads, full);
+                    } catch (const Error& e) {
+                        r.fail(&dv, full, e.what());
+                    }
+                } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
                     if (dv.is_number()) {
                         s.detect.skin_mode = DetectParams::SkinMode::absolute;
                         s.detect.skin = r.non_negative(dv, full);
-                    } else {
-                        const std::string str = r.string(dv, full);
-                        char* end = nullptr;
-                        const double f = str.size() > 1 && str[0] == 'x' ? std::strtod(str.c_str() + 1, &end) : -1.0;
-                        if (!end || *end != '\0' || !(f >= 0) || !std::isfinite(f))
-                            r.fail(&dv, full,
-                                   "expected a number ≥ 0 or \"xF\" (F ≥ 0, a factor of the cell size), found \"" +
-                                       str + "\"");
-                        s.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
-                        s.detect.skin = f;
-                    }
+                    } else
+                        grammar([&](const std::string& text) { parse_skin(text, s.detect, full); });
                 }
             }
         } else if (key == "output") {

@@ -101,6 +101,9 @@ struct Scene {
         p.skin = 0.3;
         return p;
     }();
+    /// `[detector] table_size = "xF"`: F × the scene's vertex count (rounded up to a power of two, parse_table_size),
+    /// resolved when the simulation is built; empty: detect.table_size as given.
+    std::string table_size_of_vertices;
     Output output;
     std::string source = "<code>"; ///< file it was read from (messages)
 };
