@@ -132,6 +132,26 @@ TEST(SimBlockDescent, BitIdenticalAtOneAndTwoThreads)
     EXPECT_GT(contacts, 0);
 }
 
+TEST(SimBlockDescent, SweepsGrowWithTheSubstepUnlessTheSceneSetsThem)
+{
+    // Automatic: 6 sweeps up to a substep of 1/240 s, 6 √(240 h) above (12 at 1/60); a scene's `iterations` wins.
+    struct Case {
+        double dt;
+        int substeps, iterations, want;
+    } cases[] = {{1e-3, 1, 0, 6}, {1.0 / 240, 1, 0, 6}, {1.0 / 120, 1, 0, 9}, {1.0 / 60, 1, 0, 12},
+                 {1.0 / 60, 4, 0, 4 * 6}, {1.0 / 60, 1, 7, 7}};
+    for (const Case& c : cases) {
+        Scene s = cantilever(4, 0.2, 1e5);
+        s.dt = c.dt;
+        s.substeps = c.substeps;
+        s.iterations = c.iterations;
+        Simulation sim(s);
+        sim.step();
+        EXPECT_EQ(sim.last_stats().solver_iterations, c.want)
+            << "dt " << c.dt << " substeps " << c.substeps << " iterations " << c.iterations;
+    }
+}
+
 TEST(SimBlockDescent, SameBodyMeshedCoarseAndFineSagsTheSame)
 {
     // A cantilever (one end pinned) under gravity, meshed at two resolutions: the tip deflection at equilibrium

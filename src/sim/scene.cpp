@@ -324,7 +324,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         else if (key == "substeps")
             s.substeps = r.int_at_least(v, key, 1);
         else if (key == "iterations")
-            s.iterations = r.int_at_least(v, key, 1);
+            s.iterations = r.int_at_least(v, key, 0);
         else if (key == "tolerance")
             s.tolerance = r.positive(v, key);
         else if (key == "acceleration")

@@ -80,7 +80,8 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     if (!(scene.dt > 0) || !std::isfinite(scene.dt))
         throw Error("dt must be positive, found " + short_number(scene.dt));
     if (scene.substeps < 1) throw Error("substeps must be ≥ 1, found " + std::to_string(scene.substeps));
-    if (scene.iterations < 1) throw Error("iterations must be ≥ 1, found " + std::to_string(scene.iterations));
+    if (scene.iterations < 0)
+        throw Error("iterations must be ≥ 1 (or 0: automatic), found " + std::to_string(scene.iterations));
     objects = load_objects(scene);
     const Index n = mesh().num_vertices();
     model = Model::build(mesh(), objects.materials, objects.is_static);
