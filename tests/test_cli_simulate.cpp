@@ -181,3 +181,62 @@ TEST(CliSimulate, BlowUpWithinSubstepsIsARunFailureNamingTheStep)
     const std::string check = check_frames(py, dir / "out");
     EXPECT_EQ(check.substr(0, 3), "OK ") << check;
 }
+
+TEST(CliSimulate, TimeStepIsCheckedAndAcceptsFractions)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", kSmall);
+    for (const char* bad : {"nan", "inf", "0", "-1/240", "1/0", "fast", "1/"}) {
+        const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --dt " + quote(bad) + " --out " +
+                                   quote(dir / "out"));
+        EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find("--dt"), std::string::npos) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find(bad), std::string::npos) << bad << ": " << r.err;
+    }
+    const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --dt 1/500 --steps 1 --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("dt 0.002 s"), std::string::npos) << r.out;
+}
+
+TEST(CliSimulate, APreviousRunsFramesAreRemovedWithANote)
+{
+    // Ten frames from a first run, then a run of two steps into the same folder: ParaView's file group must see
+    // only the second run. Files the command does not write stay.
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", kSmall);
+    auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --steps 20 --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(std::filesystem::exists(dir / "out" / "frame_00020.vtu"));
+    write_text(dir / "out" / "notes.txt", "mine");
+    write_text(dir / "out" / "frame_1.vtu", "not of the pattern");
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --steps 2 --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("removed 12 files of a previous run"), std::string::npos) << r.err;
+    int frames = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir / "out"))
+        frames += e.path().filename().string().rfind("frame_0", 0) == 0;
+    EXPECT_EQ(frames, 2); // frame_00000 and frame_00002
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "frame_00020.vtu"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "notes.txt"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_1.vtu"));
+    EXPECT_EQ(read_text(dir / "out" / "scene.pvd").find("frame_00020"), std::string::npos);
+}
+
+TEST(CliSimulate, CtrlCStopsAfterTheStepAndSaysTheFramesAreValid)
+{
+    // Job control on, so that the background run does not start with SIGINT ignored.
+    const auto dir = temp_dir();
+    const std::string cmd = "set -m; " + quote(TETHASH_EXE) + " simulate --steps 100000000 --out " +
+                            quote(dir / "out") + " >/dev/null 2>" + quote(dir / "err") +
+                            " & p=$!; for i in $(seq 100); do [ -e " + quote(dir / "out" / "frame_00010.vtu") +
+                            " ] && break; sleep 0.1; done; kill -INT $p; wait $p; echo $?";
+    write_text(dir / "run.sh", cmd + "\n");
+    const auto r = run_shell("bash " + quote(dir / "run.sh"));
+    EXPECT_EQ(r.out, "130\n") << r.err;
+    const std::string err = read_text(dir / "err");
+    EXPECT_NE(err.find("interrupted after step"), std::string::npos) << err;
+    EXPECT_NE(err.find("form a valid series"), std::string::npos) << err;
+    const std::string pvd = read_text(dir / "out" / "scene.pvd");
+    EXPECT_NE(pvd.find("</VTKFile>"), std::string::npos) << pvd;
+    EXPECT_NE(pvd.find("frame_00010.vtu"), std::string::npos);
+}

@@ -176,7 +176,8 @@ std::string FailureCheck::likely_cause(const Scene& scene, double h, double dt_l
         return "contact response (max penetration " + short_number(depth) + ", contact stiffness up to " +
                short_number(kmax) + "): lower contact.stiffness or dt, or raise substeps";
     return "stiffness too high for the time step " + short_number(h) + " s (explicit limit ≈ " + short_number(dt_limit) +
-           " s): lower dt, raise substeps or use vbd";
+           " s): lower dt or raise substeps" +
+           (scene.integrator == Integrator::vbd ? std::string(" or iterations") : std::string(", or use vbd"));
 }
 
 } // namespace tethash::sim

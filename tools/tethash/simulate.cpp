@@ -9,8 +9,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <csignal>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -18,11 +21,54 @@
 namespace tethash::cli {
 namespace {
 
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int)
+{
+    g_interrupted = 1;
+}
+
+/// "1/240", "0.004", "4e-3": seconds; false when the text is not a number or a fraction of two numbers.
+bool parse_seconds(const std::string& text, double& out)
+{
+    const auto number = [](const std::string& t, double& v) {
+        if (t.empty() || std::isspace(static_cast<unsigned char>(t[0]))) return false;
+        char* end = nullptr;
+        v = std::strtod(t.c_str(), &end);
+        return end == t.c_str() + t.size();
+    };
+    const std::size_t slash = text.find('/');
+    if (slash == std::string::npos) return number(text, out);
+    double a = 0, b = 0;
+    if (!number(text.substr(0, slash), a) || !number(text.substr(slash + 1), b) || !(b != 0)) return false;
+    out = a / b;
+    return true;
+}
+
+/// Removes frame_NNNNN.vtu and scene.pvd from `dir`; returns how many files it removed.
+int remove_previous_frames(const std::string& dir)
+{
+    int removed = 0;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        const bool frame = name.size() == 15 && name.compare(0, 6, "frame_") == 0 &&
+                           name.compare(11, 4, ".vtu") == 0 &&
+                           std::all_of(name.begin() + 6, name.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
+        if ((frame || name == "scene.pvd") && entry.is_regular_file()) {
+            std::error_code rm;
+            if (std::filesystem::remove(entry.path(), rm)) ++removed;
+            else if (rm)
+                throw Error("--out: cannot remove '" + entry.path().string() + "' of a previous run: " + rm.message());
+        }
+    }
+    return removed;
+}
+
 struct SimulateOptions {
     std::string scene;
     static constexpr int unset = std::numeric_limits<int>::min();
     int steps = unset;
-    double dt = std::numeric_limits<double>::quiet_NaN();
+    std::string dt; ///< "" = the scene's
     int substeps = unset;
     std::string integrator;
     std::string threads; ///< "" = the scene's
@@ -36,9 +82,12 @@ void run_simulate(const SimulateOptions& o)
         if (o.steps < 0) throw Error(fmt::format("--steps must be ≥ 0, found {}", o.steps));
         scene.steps = o.steps;
     }
-    if (!std::isnan(o.dt)) {
-        if (!(o.dt > 0)) throw Error(fmt::format("--dt must be positive, found {}", o.dt));
-        scene.dt = o.dt;
+    if (!o.dt.empty()) {
+        // One grammar with the scene file and the studies: seconds, or a fraction such as 1/240.
+        double dt = 0;
+        if (!parse_seconds(o.dt, dt) || !(dt > 0) || !std::isfinite(dt))
+            throw Error("--dt must be a positive, finite time in seconds (e.g. 0.004 or 1/240), found '" + o.dt + "'");
+        scene.dt = dt;
     }
     if (o.substeps != SimulateOptions::unset) {
         if (o.substeps < 1) throw Error(fmt::format("--substeps must be ≥ 1, found {}", o.substeps));
@@ -66,6 +115,12 @@ void run_simulate(const SimulateOptions& o)
     std::error_code ec;
     std::filesystem::create_directories(o.out, ec);
     if (ec) throw Error("--out: cannot create folder '" + o.out + "': " + ec.message());
+    // A previous run's frames would join this run's in ParaView's file group: they go first (only the files this
+    // command writes: frame_NNNNN.vtu and scene.pvd), and the run says so.
+    const int removed = remove_previous_frames(o.out);
+    if (removed > 0)
+        std::fprintf(stderr, "tethash: note: removed %d file%s of a previous run from %s\n", removed,
+                     removed == 1 ? "" : "s", o.out.c_str());
     std::vector<std::pair<double, std::string>> series;
     const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
     auto write_frame = [&]() {
@@ -94,9 +149,21 @@ void run_simulate(const SimulateOptions& o)
     const auto start = std::chrono::steady_clock::now();
     auto last_print = start;
     const int plain_every = std::max(1, scene.steps / 10);
+    // Ctrl-C ends the run after the current step with a note of where it stopped; the frames written so far and
+    // scene.pvd stay a valid series.
+    g_interrupted = 0;
+    const auto old_handler = std::signal(SIGINT, on_interrupt);
+    if (old_handler == SIG_IGN) std::signal(SIGINT, SIG_IGN); // ignored stays ignored (nohup, &)
+    struct Restore {
+        decltype(old_handler) h;
+        ~Restore() { std::signal(SIGINT, h); }
+    } restore{old_handler};
+    int done = 0;
     try {
         for (int s = 0; s < scene.steps; ++s) {
+            if (g_interrupted) break;
             sim.step();
+            done = s + 1;
             const sim::StepStats& st = sim.last_stats();
             ms_detect += st.ms_detect;
             ms_depth += st.ms_depth;
@@ -130,6 +197,15 @@ void run_simulate(const SimulateOptions& o)
         throw;
     }
     if (tty) std::fprintf(stderr, "\n");
+    if (g_interrupted) {
+        std::fprintf(stderr,
+                     "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
+                     "series: %s\n",
+                     done, scene.steps, sim.time(), series.size(), series.size() == 1 ? "" : "s", pvd.c_str());
+        std::fflush(stderr);
+        std::signal(SIGINT, SIG_DFL);
+        std::raise(SIGINT); // the conventional status of a run ended by Ctrl-C (130 from a shell)
+    }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int n = std::max(1, scene.steps);
     const sim::Energy e1 = sim.energy();
@@ -156,13 +232,15 @@ Registrar reg{
          auto o = std::make_shared<SimulateOptions>();
          sub.add_option("scene", o->scene, "Scene file (TOML); without it the built-in default scene runs");
          sub.add_option("--steps", o->steps, "Number of steps (overrides the scene)");
-         sub.add_option("--dt", o->dt, "Time step in s (overrides the scene)");
+         sub.add_option("--dt", o->dt, "Time step in s, or a fraction such as 1/240 (overrides the scene)");
          sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
          sub.add_option("--integrator", o->integrator, "vbd (default), implicit_euler or symplectic_euler");
          sub.add_option("--threads", o->threads,
                         "Detector threads: 0 = every hardware thread, or 1..256 (default: the scene's [detector] "
                         "threads, 1 if absent)");
-         sub.add_option("-o,--out", o->out, "Output folder for frame_NNNNN.vtu and scene.pvd")->capture_default_str();
+         sub.add_option("-o,--out", o->out,
+                        "Output folder for frame_NNNNN.vtu and scene.pvd (those of a previous run there are removed)")
+             ->capture_default_str();
          sub.callback([o] { run_simulate(*o); });
      }}};
 
