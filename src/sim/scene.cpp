@@ -387,11 +387,12 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                 const std::string d(dk.str()), full = "detector." + d;
                 // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
                 // a value means here what it means on the command line.
-                const auto grammar = [&](auto&& parse) {
+                const toml::node& node = dv; // (a structured binding cannot be captured before C++20's P1091)
+                const auto grammar = [&r, &node, &full](auto&& parse) {
                     try {
-                        parse(r.string(dv, full));
+                        parse(r.string(node, full));
                     } catch (const Error& e) {
-                        r.fail(&dv, full, e.what());
+                        r.fail(&node, full, e.what());
                     }
                 };
                 if (d == "cell_size") {
