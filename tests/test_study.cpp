@@ -1,4 +1,5 @@
 // The study library: value lists, CSV, a small detection sweep against the oracle, the Teschner scenarios.
+#include "study_support.hpp"
 #include "support.hpp"
 
 #include "tethash/error.hpp"
@@ -19,19 +20,10 @@ using study::StudyOptions;
 using study::Sweep;
 using study::Table;
 
-/// Two overlapping generated boxes written as two files; returns "a+b" for --mesh.
+/// Two overlapping boxes (study_support.hpp).
 std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 {
-    io::GenerateParams p;
-    p.shape = "box";
-    p.resolution = resolution;
-    TetMesh a = io::generate(p);
-    TetMesh b = a;
-    for (Eigen::Index v = 0; v < b.positions.rows(); ++v)
-        b.positions.row(v) += Eigen::RowVector3d(0.37, 0.21, 0.13);
-    io::write_mesh((dir / "a.vtu").string(), a);
-    io::write_mesh((dir / "b.vtu").string(), b);
-    return (dir / "a.vtu").string() + "+" + (dir / "b.vtu").string();
+    return test::two_boxes(dir, resolution, Eigen::RowVector3d(0.37, 0.21, 0.13));
 }
 
 std::string error_of(const StudyOptions& o)
@@ -168,19 +160,6 @@ TEST(StudyRun, SmallSweepMatchesTheOracleInEveryRow)
         EXPECT_NE(json.find(key), std::string::npos) << key;
 }
 
-/// The rows of a study.csv without its timing columns.
-std::vector<study::Row> deterministic_rows(const Table& t)
-{
-    std::vector<study::Row> rows;
-    for (const auto& r : t.rows) {
-        study::Row x;
-        for (std::size_t c = 0; c < t.columns.size(); ++c)
-            if (!study::is_timing_column(t.columns[c])) x.push_back(r[c]);
-        rows.push_back(std::move(x));
-    }
-    return rows;
-}
-
 TEST(StudyMerge, MergedShardsEqualTheUnshardedStudy)
 {
     const auto dir = test::temp_dir();
@@ -209,7 +188,7 @@ TEST(StudyMerge, MergedShardsEqualTheUnshardedStudy)
         EXPECT_TRUE(study::merge_studies(shards, out, "merge").empty()) << n << " shards";
         const Table a = Table::read_csv(all.csv_path), m = Table::read_csv(out + "/study.csv");
         EXPECT_EQ(a.columns, m.columns);
-        EXPECT_EQ(deterministic_rows(a), deterministic_rows(m)) << n << " shards";
+        EXPECT_EQ(test::deterministic(a).rows, test::deterministic(m).rows) << n << " shards";
         const std::string json = test::read_text(out + "/study.json");
         EXPECT_NE(json.find("\"sweep\": \"grid\""), std::string::npos) << json;
         EXPECT_NE(json.find("\"points_total\": 6,"), std::string::npos) << json;
