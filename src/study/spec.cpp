@@ -3,6 +3,7 @@
 
 #include "value_list.hpp"
 
+#include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 
 namespace tethash::study {

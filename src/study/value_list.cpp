@@ -1,10 +1,10 @@
 // The study's value lists (value_list.hpp): items, numbers, fractions, factors and log ranges.
 #include "value_list.hpp"
 
+#include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 
 #include <cmath>
-#include <exception>
 
 namespace tethash::study {
 
@@ -46,33 +46,7 @@ std::vector<std::string> items_of(const std::vector<std::string>& specs, const s
     return items;
 }
 
-long long parse_integer(const std::string& text, const std::string& option)
-{
-    std::size_t used = 0;
-    long long v = 0;
-    try {
-        v = std::stoll(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size()) throw Error(option + ": expected an integer, found '" + text + "'");
-    return v;
-}
-
 namespace {
-
-double parse_number(const std::string& text, const std::string& option)
-{
-    std::size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || !std::isfinite(v)) throw Error(option + ": expected a number, found '" + text + "'");
-    return v;
-}
 
 /// "xF" → F · scale (scale > 0), otherwise the number itself.
 double parse_scaled(const std::string& text, const std::string& option, double scale)
@@ -83,9 +57,9 @@ double parse_scaled(const std::string& text, const std::string& option, double s
     }
     // A fraction such as 1/240 (time steps are usually given so).
     if (const auto slash = text.find('/'); slash != std::string::npos) {
-        const double den = parse_number(text.substr(slash + 1), option);
+        const double den = parse_number(trim(text.substr(slash + 1)), option);
         if (!(den != 0)) throw Error(option + ": division by zero in '" + text + "'");
-        return parse_number(text.substr(0, slash), option) / den;
+        return parse_number(trim(text.substr(0, slash)), option) / den;
     }
     return parse_number(text, option);
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The grammar of the study's value lists (spec.hpp): comma-separated items, each a single value in the grammar
-// of every command (detect.hpp for the detector's parameters) or a range. Shared by every sweep.
+// of every command (detect.hpp for the detector's parameters; numbers: detect.hpp's parse_number and
+// parse_integer) or a range. Shared by every sweep.
 #include <string>
 #include <vector>
 
@@ -13,8 +14,6 @@ std::string trim(const std::string& s);
 /// All comma-separated items of all specs, trimmed. Throws Error naming `option` on an empty item or list.
 std::vector<std::string> items_of(const std::vector<std::string>& specs, const std::string& option);
 
-/// A whole-string integer. Throws Error naming `option` otherwise.
-long long parse_integer(const std::string& text, const std::string& option);
 /// Log-spaced values FROM..TO ("FROM:TO:POINTS", POINTS ≥ 1; one point: FROM, which must equal TO), each end
 /// a number, "xF" (F · scale, scale > 0) or a fraction "A/B".
 std::vector<double> log_range(const std::string& item, const std::string& option, double scale);
