@@ -1,4 +1,5 @@
 // tethash study: the command end to end (CSV columns and rows, shards and merge, figures, bad input, Ctrl-C).
+#include "study_support.hpp"
 #include "support.hpp"
 
 #include "tethash/io/generate.hpp"
@@ -16,38 +17,13 @@ using study::Table;
 using test::quote;
 using test::run_tethash;
 
+/// Two overlapping boxes (study_support.hpp), quoted for the command line.
 std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 {
-    io::GenerateParams p;
-    p.shape = "box";
-    p.resolution = resolution;
-    TetMesh a = io::generate(p);
-    TetMesh b = a;
-    for (Eigen::Index v = 0; v < b.positions.rows(); ++v)
-        b.positions.row(v) += Eigen::RowVector3d(0.31, 0.17, 0.23);
-    io::write_mesh((dir / "a.vtu").string(), a);
-    io::write_mesh((dir / "b.vtu").string(), b);
-    return quote((dir / "a.vtu").string() + "+" + (dir / "b.vtu").string());
+    return quote(test::two_boxes(dir, resolution, Eigen::RowVector3d(0.31, 0.17, 0.23)));
 }
 
-/// The table without its timing columns.
-Table deterministic(const Table& t)
-{
-    Table d;
-    std::vector<std::size_t> keep;
-    for (std::size_t c = 0; c < t.columns.size(); ++c)
-        if (!study::is_timing_column(t.columns[c])) {
-            keep.push_back(c);
-            d.columns.push_back(t.columns[c]);
-        }
-    for (const auto& r : t.rows) {
-        study::Row x;
-        for (auto c : keep)
-            x.push_back(r[c]);
-        d.rows.push_back(std::move(x));
-    }
-    return d;
-}
+using test::deterministic;
 
 TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
 {

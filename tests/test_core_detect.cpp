@@ -518,3 +518,19 @@ TEST(CoreDetect, ScanKernelFollowsTethashSimd)
     else
         EXPECT_TRUE(kernel == "avx2" || kernel == "scalar") << kernel;
 }
+
+TEST(CoreDetectParams, NumbersAreWholeStringsAndFinite)
+{
+    EXPECT_EQ(tethash::parse_number("0.25", "--dt"), 0.25);
+    EXPECT_EQ(tethash::parse_number("-1e3", "--dt"), -1000.0);
+    EXPECT_EQ(tethash::parse_integer("-7", "--substeps"), -7);
+    for (const char* bad : {"", " 1", "1 ", "1x", "nan", "inf", "1e999", "x2"})
+        try {
+            tethash::parse_number(bad, "--dt");
+            ADD_FAILURE() << "accepted '" << bad << "'";
+        } catch (const tethash::Error& e) {
+            EXPECT_EQ(std::string(e.what()), std::string("--dt: expected a number, found '") + bad + "'");
+        }
+    for (const char* bad : {"", "1.5", "2 ", "99999999999999999999"})
+        EXPECT_THROW(tethash::parse_integer(bad, "--substeps"), tethash::Error) << bad;
+}

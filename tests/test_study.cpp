@@ -1,4 +1,5 @@
 // The study library: value lists, CSV, a small detection sweep against the oracle, the Teschner scenarios.
+#include "study_support.hpp"
 #include "support.hpp"
 
 #include "tethash/error.hpp"
@@ -19,19 +20,10 @@ using study::StudyOptions;
 using study::Sweep;
 using study::Table;
 
-/// Two overlapping generated boxes written as two files; returns "a+b" for --mesh.
+/// Two overlapping boxes (study_support.hpp).
 std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 {
-    io::GenerateParams p;
-    p.shape = "box";
-    p.resolution = resolution;
-    TetMesh a = io::generate(p);
-    TetMesh b = a;
-    for (Eigen::Index v = 0; v < b.positions.rows(); ++v)
-        b.positions.row(v) += Eigen::RowVector3d(0.37, 0.21, 0.13);
-    io::write_mesh((dir / "a.vtu").string(), a);
-    io::write_mesh((dir / "b.vtu").string(), b);
-    return (dir / "a.vtu").string() + "+" + (dir / "b.vtu").string();
+    return test::two_boxes(dir, resolution, Eigen::RowVector3d(0.37, 0.21, 0.13));
 }
 
 std::string error_of(const StudyOptions& o)
@@ -166,6 +158,52 @@ TEST(StudyRun, SmallSweepMatchesTheOracleInEveryRow)
     for (const char* key :
          {"\"machine\"", "\"cores\"", "\"cpu\"", "\"compiler\"", "\"summary\"", "\"median\"", "\"points_total\": 24"})
         EXPECT_NE(json.find(key), std::string::npos) << key;
+}
+
+TEST(StudyMerge, MergedShardsEqualTheUnshardedStudy)
+{
+    const auto dir = test::temp_dir();
+    StudyOptions o;
+    o.sweep = Sweep::grid;
+    o.grid = {"cell-size", "hash"};
+    o.meshes = {two_boxes(dir, 2)};
+    o.cell_size = {"x0.5:x2:3"};
+    o.repeat = 2;
+    o.penetration = false;
+    o.command_line = "study \"quoted\"\tcommand";
+    o.out_dir = (dir / "all").string();
+    const auto all = study::run_study(*study::plan_study(o));
+    std::vector<std::string> shards;
+    for (int n : {1, 2, 5}) { // one shard, two shards and more shards than points in one pass each
+        shards.clear();
+        for (int i = 0; i < n; ++i) {
+            StudyOptions so = o;
+            so.shard_index = i;
+            so.shard_count = n;
+            so.out_dir = (dir / (std::to_string(n) + "-shards") / std::to_string(i)).string();
+            study::run_study(*study::plan_study(so));
+            shards.insert(shards.begin(), so.out_dir); // reversed: the merge orders rows itself
+        }
+        const std::string out = (dir / ("merged" + std::to_string(n))).string();
+        EXPECT_TRUE(study::merge_studies(shards, out, "merge").empty()) << n << " shards";
+        const Table a = Table::read_csv(all.csv_path), m = Table::read_csv(out + "/study.csv");
+        EXPECT_EQ(a.columns, m.columns);
+        EXPECT_EQ(test::deterministic(a).rows, test::deterministic(m).rows) << n << " shards";
+        const std::string json = test::read_text(out + "/study.json");
+        EXPECT_NE(json.find("\"sweep\": \"grid\""), std::string::npos) << json;
+        EXPECT_NE(json.find("\"points_total\": 6,"), std::string::npos) << json;
+        EXPECT_NE(json.find("\"missing_points\": []"), std::string::npos) << json;
+    }
+    // Without the last shard the merge names its points; a shard's study.json that is not JSON is an error.
+    shards.erase(shards.begin());
+    EXPECT_EQ(study::merge_studies(shards, (dir / "part").string(), "merge"), (std::vector<std::int64_t>{4}));
+    test::write_text(shards.front() + "/study.json", "{\"points_total\": 6,");
+    try {
+        study::merge_studies(shards, (dir / "bad").string(), "merge");
+        ADD_FAILURE() << "accepted a broken study.json";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("study.json: invalid JSON at line 1"), std::string::npos) << e.what();
+    }
 }
 
 TEST(StudyRun, StopFlagKeepsAValidPrefix)

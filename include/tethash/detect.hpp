@@ -95,6 +95,10 @@ std::int64_t parse_table_size(const std::string& text, std::int64_t vertices,
                               const std::string& option = "--table-size");
 /// "L" (a length ≥ 0; 0 = no candidate reuse) | "xF" (F ≥ 0 times the cell size): sets skin_mode and skin.
 void parse_skin(const std::string& text, DetectParams& params, const std::string& option = "--skin");
+/// The numbers of these grammars, also read by the study's value lists: a whole-string finite decimal number, a
+/// whole-string integer. Throw Error "OPTION: expected a number (an integer), found 'TEXT'".
+double parse_number(const std::string& text, const std::string& option);
+long long parse_integer(const std::string& text, const std::string& option);
 /// The smallest power of two ≥ n (n ≥ 1).
 std::int64_t next_power_of_two(std::int64_t n);
 

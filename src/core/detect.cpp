@@ -252,6 +252,15 @@ class DetectorImpl {
     void prepare(const PositionsRef& positions);
     void diagnose_build_failure(const PositionsRef& positions, const Index* ids, Index count) const;
     const std::vector<Contact>& detect(const PositionsRef& positions, DetectStats* stats);
+    // the stages of detect()
+    bool decide_reuse(const double* P, int T);
+    void reset_threads(bool reuse);
+    void detect_kept(const double* P, int T, Index m, Index num_chunks, bool with_stats);
+    void detect_full(const PositionsRef& positions, int T, Index m, Index num_chunks, bool with_stats,
+                     Clock::time_point t_start, double& ms_vertices);
+    void merge_contacts();
+    void fill_stats(DetectStats& s, int T, Index m, bool reuse, double ms_vertices, double ms_sort,
+                    Clock::time_point t_start) const;
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs, const Index* candidates,
                       const double* P);
@@ -663,6 +672,214 @@ static void sort_own_contacts(ThreadState& ts, Index num_vertices)
     if (src != ts.contacts.data()) std::copy(src, src + n, ts.contacts.data());
 }
 
+/// Candidate reuse (skin > 0): when every moving vertex moved less than skin / 2 since the last full detection,
+/// the kept candidates contain every contact (docs/detection.md) and only stage 3 runs. Also pauses and resumes
+/// the skin (`skin` is the one this call uses).
+bool DetectorImpl::decide_reuse(const double* P, int T)
+{
+    bool reuse = false;
+    if (set_skin > 0) {
+        if (cache_valid && cache_threads == T) {
+            reuse = moved_less_than(P, T, reuse_limit);
+            if (reuse)
+                ++reuses_since_full;
+            else if (reuses_since_full == 0)
+                paused = true; // the last inflated detection bought nothing
+        } else if (paused && !reference.empty() && moved_less_than(P, T, 0.5 * reuse_limit)) {
+            paused = false; // slow enough since the previous call for a kept candidate list to last
+        }
+        skin = paused ? 0.0 : set_skin;
+    }
+    return reuse;
+}
+
+/// Clears the threads' per-call state; a full detection also drops their candidates.
+void DetectorImpl::reset_threads(bool reuse)
+{
+    for (ThreadState& ts : threads) {
+        if (!reuse) {
+            ts.used = 0;
+            ts.num_runs = 0;
+        }
+        ts.contacts.clear();
+        ts.counters = Counters{};
+        ts.too_many_cells = false;
+    }
+}
+
+/// Stage 3 over the kept candidates (candidate reuse).
+void DetectorImpl::detect_kept(const double* P, int T, Index m, Index num_chunks, bool with_stats)
+{
+    // Stage 3 only, over the kept runs chunk by chunk (monotonic dynamic: each thread's contacts come out in
+    // increasing tet order, whichever thread kept the chunk's runs), then each thread sorts its own contacts.
+#pragma omp parallel num_threads(T) if (T > 1)
+    {
+        ThreadState& ts = threads[static_cast<std::size_t>(detail::team_rank())];
+        const auto t1 = Clock::now();
+#pragma omp for schedule(monotonic : dynamic, 1) nowait
+        for (Index k = 0; k < num_chunks; ++k) {
+            const ChunkRuns& c = chunks[static_cast<std::size_t>(k)];
+            const ThreadState& owner = threads[static_cast<std::size_t>(c.thread)];
+            stage_inside(ts, owner.runs.data() + c.begin, static_cast<std::size_t>(c.end - c.begin),
+                         owner.candidates.data(), P);
+            if (with_stats)
+                for (Index t = k * chunk_tets; t < std::min(m, (k + 1) * chunk_tets); ++t) {
+                    const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
+                    ts.counters.degenerate += predicates::orient3d(P + 3 * static_cast<std::size_t>(tv[0]),
+                                                                   P + 3 * static_cast<std::size_t>(tv[1]),
+                                                                   P + 3 * static_cast<std::size_t>(tv[2]),
+                                                                   P + 3 * static_cast<std::size_t>(tv[3]))
+                                                  .sign == 0;
+                }
+        }
+        ts.ms_tets = 0;
+        ts.ms_inside = ms_since(t1);
+        const auto t2 = Clock::now();
+        sort_own_contacts(ts, num_vertices);
+        ts.ms_sort = ms_since(t2);
+    }
+}
+
+/// Stages 1-3 in one parallel region (stage 1 over the team for big scenes only), then the candidates kept for
+/// reuse. Sets `ms_vertices` (stage 1's time since `t_start`).
+void DetectorImpl::detect_full(const PositionsRef& positions, int T, Index m, Index num_chunks, bool with_stats,
+                               Clock::time_point t_start, double& ms_vertices)
+{
+    const double* P = positions.data();
+    const Index* ids = any_static ? dynamic_ids.data() : nullptr;
+    const Index count = static_cast<Index>(dynamic_ids.size());
+    cache_valid = false;
+    if (skin > 0) chunks.resize(static_cast<std::size_t>(num_chunks));
+    tables[0].reserve(count, table_sizes[0], T);
+    // Stage 1: moving vertices. Split over the team only for big scenes (VertexTable::team_parts); else built here,
+    // before the region: each barrier can cost the team a scheduler time slice on a busy machine.
+    const bool team_build = VertexTable::team_parts(count, T) > 1;
+    bool built = true;
+    if (!team_build) {
+        built = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+        ms_vertices = ms_since(t_start);
+    }
+#pragma omp parallel num_threads(T) if (T > 1 && built)
+    {
+        const int rank = detail::team_rank();
+        ThreadState& ts = threads[static_cast<std::size_t>(rank)];
+        bool ok = built;
+        if (team_build) { // every thread gets the same answer
+            ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
+            if (rank == 0) {
+                built = ok;
+                ms_vertices = ms_since(t_start);
+            }
+        }
+        if (ok) {
+            const auto t0 = Clock::now();
+            const bool keep = skin > 0;
+#pragma omp for schedule(monotonic : dynamic, chunk_tets) nowait
+            for (Index t = 0; t < m; ++t) {
+                if (keep && t % chunk_tets == 0) // a chunk starts: remember where its runs go
+                    chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank, static_cast<std::int32_t>(ts.num_runs),
+                                                                        0};
+                stage_tets(ts, t, P, with_stats);
+            }
+            ts.ms_tets = ms_since(t0);
+            const auto t1 = Clock::now();
+            stage_inside(ts, ts.runs.data(), ts.num_runs, ts.candidates.data(), P);
+            ts.ms_inside = ms_since(t1);
+            const auto t2 = Clock::now();
+            sort_own_contacts(ts, num_vertices);
+            ts.ms_sort = ms_since(t2);
+        }
+    }
+    if (!built) diagnose_build_failure(positions, ids, count);
+    for (const ThreadState& ts : threads)
+        if (ts.too_many_cells)
+            throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
+                        std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells" +
+                        (skin > 0 ? " with its box inflated by the skin " + std::to_string(skin) +
+                                        "; use a larger cell size or a smaller skin"
+                                  : "; use a larger cell size"));
+    if (skin > 0)
+        keep_for_reuse(P, m);
+    else if (paused)
+        remember_positions(P); // the next call measures its displacement from here
+}
+
+/// Merges the threads' sorted runs into `contacts`: sorted by (vertex, tet), the same for any thread count.
+void DetectorImpl::merge_contacts()
+{
+    std::size_t total = 0;
+    for (const ThreadState& ts : threads)
+        total += ts.contacts.size();
+    contacts.resize(total);
+    merge_pos.assign(threads.size(), 0);
+    std::size_t* pos = merge_pos.data();
+    const int runs = static_cast<int>(threads.size());
+    for (std::size_t out = 0; out < total; ++out) {
+        int best = -1;
+        Index bv = 0, bt = 0;
+        for (int r = 0; r < runs; ++r) {
+            const ThreadState& ts = threads[static_cast<std::size_t>(r)];
+            if (pos[r] == ts.contacts.size()) continue;
+            const RawContact& rc = ts.contacts[pos[r]];
+            if (best < 0 || rc.vertex < bv || (rc.vertex == bv && rc.tet < bt)) {
+                best = r;
+                bv = rc.vertex;
+                bt = rc.tet;
+            }
+        }
+        const RawContact& rc = threads[static_cast<std::size_t>(best)].contacts[pos[best]++];
+        Contact& c = contacts[out];
+        c.vertex = rc.vertex;
+        c.tet = rc.tet;
+        c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
+        c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
+        for (int k = 0; k < 4; ++k)
+            c.bary[k] = rc.bary[k];
+        c.depth = std::numeric_limits<double>::quiet_NaN();
+        c.direction[0] = c.direction[1] = c.direction[2] = 0;
+    }
+}
+
+/// The statistics of the call that started at `t_start`.
+void DetectorImpl::fill_stats(DetectStats& s, int T, Index m, bool reuse, double ms_vertices, double ms_sort,
+                              Clock::time_point t_start) const
+{
+    const Index count = static_cast<Index>(dynamic_ids.size());
+    Counters sum;
+    double ms_sort_own = 0;
+    s = DetectStats{};
+    s.ms_vertices = ms_vertices;
+    for (const ThreadState& ts : threads) {
+        sum.add(ts.counters);
+        s.ms_tets = std::max(s.ms_tets, ts.ms_tets);
+        s.ms_inside = std::max(s.ms_inside, ts.ms_inside);
+        ms_sort_own = std::max(ms_sort_own, ts.ms_sort);
+    }
+    s.ms_sort = ms_sort_own + ms_sort;
+    s.cell_size = cell_size;
+    s.table_size = table_sizes[0];
+    s.threads = T;
+    s.vertices = num_vertices;
+    s.tets = m;
+    s.cells_visited = sum.cells;
+    s.entries_scanned = sum.scanned;
+    s.hash_collisions = sum.collisions;
+    s.box_rejections = sum.box_rejections;
+    s.own_vertex_skips = sum.own;
+    s.inside_tests = sum.inside_tests;
+    s.exact_fallbacks = sum.exact;
+    s.degenerate_tets = sum.degenerate;
+    s.contacts = static_cast<std::int64_t>(contacts.size());
+    s.table_load = static_cast<double>(count) / static_cast<double>(table_sizes[0]);
+    s.memory_bytes = memory_bytes();
+    s.skin = skin;
+    s.reused = reuse ? 1 : 0;
+    if (skin > 0)
+        for (const ThreadState& ts : threads)
+            s.cached_candidates += static_cast<std::int64_t>(ts.used);
+    s.ms_total = ms_since(t_start);
+}
+
 const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, DetectStats* stats)
 {
     const auto t_start = Clock::now();
@@ -679,196 +896,22 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     // One parallel region: stage 1 (big scenes: split over the team), stages 2 and 3 (dynamic chunks of tets; each
     // thread then tests its own candidates and sorts its own contacts), no barrier in between; then the merge of the
     // threads' sorted runs.
-    const Index* ids = any_static ? dynamic_ids.data() : nullptr;
-    const Index count = static_cast<Index>(dynamic_ids.size());
     const Index m = static_cast<Index>(tets.size() / 4);
     const bool with_stats = stats != nullptr;
-    double ms_vertices = 0, ms_sort_own = 0;
-    // Candidate reuse (skin > 0): when every moving vertex moved less than skin / 2 since the last full detection,
-    // the kept candidates contain every contact (docs/detection.md) and only stage 3 runs.
-    bool reuse = false;
-    if (set_skin > 0) {
-        if (cache_valid && cache_threads == T) {
-            reuse = moved_less_than(P, T, reuse_limit);
-            if (reuse)
-                ++reuses_since_full;
-            else if (reuses_since_full == 0)
-                paused = true; // the last inflated detection bought nothing
-        } else if (paused && !reference.empty() && moved_less_than(P, T, 0.5 * reuse_limit)) {
-            paused = false; // slow enough since the previous call for a kept candidate list to last
-        }
-        skin = paused ? 0.0 : set_skin;
-        ms_vertices = ms_since(t_start);
-    }
-    for (ThreadState& ts : threads) {
-        if (!reuse) {
-            ts.used = 0;
-            ts.num_runs = 0;
-        }
-        ts.contacts.clear();
-        ts.counters = Counters{};
-        ts.too_many_cells = false;
-    }
+    double ms_vertices = 0;
+    const bool reuse = decide_reuse(P, T);
+    if (set_skin > 0) ms_vertices = ms_since(t_start);
+    reset_threads(reuse);
     const Index num_chunks = (m + chunk_tets - 1) / chunk_tets;
-    if (reuse) {
-        // Stage 3 only, over the kept runs chunk by chunk (monotonic dynamic: each thread's contacts come out in
-        // increasing tet order, whichever thread kept the chunk's runs), then each thread sorts its own contacts.
-#pragma omp parallel num_threads(T) if (T > 1)
-        {
-            ThreadState& ts = threads[static_cast<std::size_t>(detail::team_rank())];
-            const auto t1 = Clock::now();
-#pragma omp for schedule(monotonic : dynamic, 1) nowait
-            for (Index k = 0; k < num_chunks; ++k) {
-                const ChunkRuns& c = chunks[static_cast<std::size_t>(k)];
-                const ThreadState& owner = threads[static_cast<std::size_t>(c.thread)];
-                stage_inside(ts, owner.runs.data() + c.begin, static_cast<std::size_t>(c.end - c.begin),
-                             owner.candidates.data(), P);
-                if (with_stats)
-                    for (Index t = k * chunk_tets; t < std::min(m, (k + 1) * chunk_tets); ++t) {
-                        const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
-                        ts.counters.degenerate += predicates::orient3d(P + 3 * static_cast<std::size_t>(tv[0]),
-                                                                       P + 3 * static_cast<std::size_t>(tv[1]),
-                                                                       P + 3 * static_cast<std::size_t>(tv[2]),
-                                                                       P + 3 * static_cast<std::size_t>(tv[3]))
-                                                      .sign == 0;
-                    }
-            }
-            ts.ms_tets = 0;
-            ts.ms_inside = ms_since(t1);
-            const auto t2 = Clock::now();
-            sort_own_contacts(ts, num_vertices);
-            ts.ms_sort = ms_since(t2);
-        }
-    } else {
-        cache_valid = false;
-        if (skin > 0) chunks.resize(static_cast<std::size_t>(num_chunks));
-        tables[0].reserve(count, table_sizes[0], T);
-        // Stage 1: moving vertices. Split over the team only for big scenes (VertexTable::team_parts); else built here,
-        // before the region: each barrier can cost the team a scheduler time slice on a busy machine.
-        const bool team_build = VertexTable::team_parts(count, T) > 1;
-        bool built = true;
-        if (!team_build) {
-            built = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
-            ms_vertices = ms_since(t_start);
-        }
-#pragma omp parallel num_threads(T) if (T > 1 && built)
-        {
-            const int rank = detail::team_rank();
-            ThreadState& ts = threads[static_cast<std::size_t>(rank)];
-            bool ok = built;
-            if (team_build) { // every thread gets the same answer
-                ok = tables[0].build_team(P, ids, count, cell_size, origin, table_sizes[0], params.hash);
-                if (rank == 0) {
-                    built = ok;
-                    ms_vertices = ms_since(t_start);
-                }
-            }
-            if (ok) {
-                const auto t0 = Clock::now();
-                const bool keep = skin > 0;
-#pragma omp for schedule(monotonic : dynamic, chunk_tets) nowait
-                for (Index t = 0; t < m; ++t) {
-                    if (keep && t % chunk_tets == 0) // a chunk starts: remember where its runs go
-                        chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank,
-                                                                            static_cast<std::int32_t>(ts.num_runs), 0};
-                    stage_tets(ts, t, P, with_stats);
-                }
-                ts.ms_tets = ms_since(t0);
-                const auto t1 = Clock::now();
-                stage_inside(ts, ts.runs.data(), ts.num_runs, ts.candidates.data(), P);
-                ts.ms_inside = ms_since(t1);
-                const auto t2 = Clock::now();
-                sort_own_contacts(ts, num_vertices);
-                ts.ms_sort = ms_since(t2);
-            }
-        }
-        if (!built) diagnose_build_failure(positions, ids, count);
-        for (const ThreadState& ts : threads)
-            if (ts.too_many_cells)
-                throw Error("cell size " + std::to_string(cell_size) + " is too small: tet " +
-                            std::to_string(ts.too_many_cells_tet) + " would visit more than 2^24 cells" +
-                            (skin > 0 ? " with its box inflated by the skin " + std::to_string(skin) +
-                                            "; use a larger cell size or a smaller skin"
-                                      : "; use a larger cell size"));
-        if (skin > 0)
-            keep_for_reuse(P, m);
-        else if (paused)
-            remember_positions(P); // the next call measures its displacement from here
-    }
+    if (reuse)
+        detect_kept(P, T, m, num_chunks, with_stats);
+    else
+        detect_full(positions, T, m, num_chunks, with_stats, t_start, ms_vertices);
 
-    // Merge the threads' sorted runs: sorted by (vertex, tet), the same for any thread count.
     const auto t_merge = Clock::now();
-    {
-        std::size_t total = 0;
-        for (const ThreadState& ts : threads)
-            total += ts.contacts.size();
-        contacts.resize(total);
-        merge_pos.assign(threads.size(), 0);
-        std::size_t* pos = merge_pos.data();
-        const int runs = static_cast<int>(threads.size());
-        for (std::size_t out = 0; out < total; ++out) {
-            int best = -1;
-            Index bv = 0, bt = 0;
-            for (int r = 0; r < runs; ++r) {
-                const ThreadState& ts = threads[static_cast<std::size_t>(r)];
-                if (pos[r] == ts.contacts.size()) continue;
-                const RawContact& rc = ts.contacts[pos[r]];
-                if (best < 0 || rc.vertex < bv || (rc.vertex == bv && rc.tet < bt)) {
-                    best = r;
-                    bv = rc.vertex;
-                    bt = rc.tet;
-                }
-            }
-            const RawContact& rc = threads[static_cast<std::size_t>(best)].contacts[pos[best]++];
-            Contact& c = contacts[out];
-            c.vertex = rc.vertex;
-            c.tet = rc.tet;
-            c.vertex_object = vertex_object[static_cast<std::size_t>(rc.vertex)];
-            c.tet_object = tet_object[static_cast<std::size_t>(rc.tet)];
-            for (int k = 0; k < 4; ++k)
-                c.bary[k] = rc.bary[k];
-            c.depth = std::numeric_limits<double>::quiet_NaN();
-            c.direction[0] = c.direction[1] = c.direction[2] = 0;
-        }
-    }
-    double ms_sort = ms_since(t_merge);
-    for (const ThreadState& ts : threads)
-        ms_sort_own = std::max(ms_sort_own, ts.ms_sort);
-
-    if (stats) {
-        Counters sum;
-        DetectStats& s = *stats;
-        s = DetectStats{};
-        s.ms_vertices = ms_vertices;
-        for (const ThreadState& ts : threads) {
-            sum.add(ts.counters);
-            s.ms_tets = std::max(s.ms_tets, ts.ms_tets);
-            s.ms_inside = std::max(s.ms_inside, ts.ms_inside);
-        }
-        s.ms_sort = ms_sort_own + ms_sort;
-        s.cell_size = cell_size;
-        s.table_size = table_sizes[0];
-        s.threads = T;
-        s.vertices = num_vertices;
-        s.tets = m;
-        s.cells_visited = sum.cells;
-        s.entries_scanned = sum.scanned;
-        s.hash_collisions = sum.collisions;
-        s.box_rejections = sum.box_rejections;
-        s.own_vertex_skips = sum.own;
-        s.inside_tests = sum.inside_tests;
-        s.exact_fallbacks = sum.exact;
-        s.degenerate_tets = sum.degenerate;
-        s.contacts = static_cast<std::int64_t>(contacts.size());
-        s.table_load = static_cast<double>(count) / static_cast<double>(table_sizes[0]);
-        s.memory_bytes = memory_bytes();
-        s.skin = skin;
-        s.reused = reuse ? 1 : 0;
-        if (skin > 0)
-            for (const ThreadState& ts : threads)
-                s.cached_candidates += static_cast<std::int64_t>(ts.used);
-        s.ms_total = ms_since(t_start);
-    }
+    merge_contacts();
+    const double ms_sort = ms_since(t_merge);
+    if (stats) fill_stats(*stats, T, m, reuse, ms_vertices, ms_sort, t_start);
     return contacts;
 }
 

@@ -42,6 +42,20 @@ std::pair<bool, std::string> factor_form(const std::string& text)
 
 } // namespace
 
+double parse_number(const std::string& text, const std::string& option)
+{
+    double v = 0;
+    if (!to_double(text, v)) throw Error(option + ": expected a number, found '" + text + "'");
+    return v;
+}
+
+long long parse_integer(const std::string& text, const std::string& option)
+{
+    long long v = 0;
+    if (!to_integer(text, v)) throw Error(option + ": expected an integer, found '" + text + "'");
+    return v;
+}
+
 int max_threads()
 {
     const unsigned hw = std::thread::hardware_concurrency();

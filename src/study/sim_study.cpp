@@ -1,6 +1,8 @@
 // Work-precision study of the simulator: integrator × dt × substeps against a reference run of the same
 // scene with a much smaller time step.
-#include "internal.hpp"
+#include "measure.hpp"
+#include "plan.hpp"
+#include "value_list.hpp"
 
 #include "tethash/error.hpp"
 #include "tethash/sim/scene.hpp"

@@ -2,7 +2,9 @@
 // integrator × young × dt × mass ratio. Each cell either completes with a finite, uncrumpled body (inverted tets
 // ≤ 1 % at the end) or stops with the simulator's message (step and likely cause); a cell that completes
 // crumpled is the failure this sweep exists to find ("crumpled" in the verdict column).
-#include "internal.hpp"
+#include "measure.hpp"
+#include "plan.hpp"
+#include "value_list.hpp"
 
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"

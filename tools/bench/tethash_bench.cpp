@@ -1,19 +1,21 @@
 // tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all threads for the
 // five scenarios of Teschner et al. 2003 rebuilt with io::generate (objects overlapping heavily), plus the
-// meshes of ../shared/meshes; and, in the same run, a plain implementation of the 2003 algorithm (per-bucket
-// vertex lists with timestamps, xor-prime hash mod a prime, plain barycentric test) as the baseline.
+// meshes of ../shared/meshes; and, in the same run, a plain implementation of the 2003 algorithm
+// (baseline_2003.hpp) as the baseline. Scenes of its own: bench_scenes.hpp. `tethash_bench --help` lists options.
 //
 //   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--no-baseline] [--cell-factor F]
 //                 [--hash column|teschner] [--table-factor F]
 //   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "tethash/hash_grid.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/study/scenarios.hpp"
+#include "tethash/study/stats_table.hpp"
 
-#include <Eigen/Geometry>
+#include "baseline_2003.hpp"
+#include "bench_scenes.hpp"
+
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -22,7 +24,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -58,124 +59,6 @@ double median(std::vector<double> v)
     std::sort(v.begin(), v.end());
     return v.empty() ? 0 : v[v.size() / 2];
 }
-
-// ---- scenes ------------------------------------------------------------------------------------
-
-/// The flatness sweep's scenes: `objects` copies of the scenario-5 object (io::generate "blob", resolution 6, as
-/// study/scenarios.hpp chooses it) on a k × k × k lattice with centre spacing 0.6 × the object size, randomly
-/// rotated: every object overlaps its lattice neighbours as in scenario 5, whatever the count.
-TetMesh lattice_scene(int objects, std::uint32_t seed)
-{
-    io::GenerateParams g;
-    g.shape = "blob";
-    g.resolution = 6;
-    TetMesh obj = io::generate(g);
-    obj.vertex_object.clear();
-    obj.tet_object.clear();
-    obj.rest_positions.resize(0, 3);
-    const Eigen::RowVector3d lo = obj.positions.colwise().minCoeff(), hi = obj.positions.colwise().maxCoeff();
-    const double size = (hi - lo).maxCoeff();
-    for (Eigen::Index v = 0; v < obj.positions.rows(); ++v)
-        obj.positions.row(v) -= 0.5 * (lo + hi);
-    int k = 1;
-    while (k * k * k < objects)
-        ++k;
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(-1, 1);
-    Positions p(static_cast<Eigen::Index>(objects) * obj.positions.rows(), 3);
-    Tets t(static_cast<Eigen::Index>(objects) * obj.tets.rows(), 4);
-    TetMesh scene;
-    for (int o = 0; o < objects; ++o) {
-        const Eigen::Matrix3d rot =
-            Eigen::AngleAxisd(3.14159 * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized())
-                .toRotationMatrix();
-        const Eigen::RowVector3d c(0.6 * size * (o % k), 0.6 * size * ((o / k) % k), 0.6 * size * (o / (k * k)));
-        const Eigen::Index vb = o * obj.positions.rows(), tb = o * obj.tets.rows();
-        for (Eigen::Index v = 0; v < obj.positions.rows(); ++v)
-            p.row(vb + v) = (rot * obj.positions.row(v).transpose()).transpose() + c;
-        t.middleRows(tb, obj.tets.rows()) = (obj.tets.array() + static_cast<Index>(vb)).matrix();
-        scene.vertex_object.insert(scene.vertex_object.end(), obj.positions.rows(), o);
-        scene.tet_object.insert(scene.tet_object.end(), obj.tets.rows(), o);
-    }
-    scene.positions = std::move(p);
-    scene.tets = std::move(t);
-    return scene;
-}
-
-// ---- the plain 2003 baseline -------------------------------------------------------------------------
-
-/// Teschner et al. 2003 as written: hash table of per-bucket vertex lists, stamped with the step instead of
-/// cleared; each tet looks up every cell its box touches (xor-prime hash mod a prime), checks box and own
-/// vertices, and computes barycentric coordinates in double (no exactness). Pairs found through several
-/// cells sharing a bucket are filtered by comparing the vertex's cell with the visited cell.
-class Baseline {
-  public:
-    void run(const TetMesh& m, double l, std::vector<std::pair<Index, Index>>& out)
-    {
-        const Index n = m.num_vertices();
-        if (m_table == 0) {
-            m_table = static_cast<std::size_t>(next_prime(2 * n));
-            m_buckets.assign(m_table, {});
-            m_stamp.assign(m_table, 0);
-        }
-        ++m_step;
-        m_cell.resize(3 * static_cast<std::size_t>(n));
-        const double inv = 1.0 / l;
-        for (Index v = 0; v < n; ++v) {
-            const std::int32_t c[3] = {static_cast<std::int32_t>(std::floor(m.positions(v, 0) * inv)),
-                                       static_cast<std::int32_t>(std::floor(m.positions(v, 1) * inv)),
-                                       static_cast<std::int32_t>(std::floor(m.positions(v, 2) * inv))};
-            for (int k = 0; k < 3; ++k)
-                m_cell[3 * v + k] = c[k];
-            const std::size_t b = teschner_hash(c[0], c[1], c[2]) % m_table;
-            if (m_stamp[b] != m_step) {
-                m_stamp[b] = m_step;
-                m_buckets[b].clear();
-            }
-            m_buckets[b].push_back(v);
-        }
-        out.clear();
-        for (Index t = 0; t < m.num_tets(); ++t) {
-            const Index id[4] = {m.tets(t, 0), m.tets(t, 1), m.tets(t, 2), m.tets(t, 3)};
-            Eigen::Vector3d p[4];
-            for (int k = 0; k < 4; ++k)
-                p[k] = m.positions.row(id[k]).transpose();
-            const Eigen::Vector3d lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]).cwiseMin(p[3]);
-            const Eigen::Vector3d hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]).cwiseMax(p[3]);
-            const Eigen::Vector3d e1 = p[1] - p[0], e2 = p[2] - p[0], e3 = p[3] - p[0];
-            const double vol = e1.dot(e2.cross(e3));
-            if (vol == 0) continue;
-            std::int32_t c0[3], c1[3];
-            for (int k = 0; k < 3; ++k) {
-                c0[k] = static_cast<std::int32_t>(std::floor(lo[k] * inv));
-                c1[k] = static_cast<std::int32_t>(std::floor(hi[k] * inv));
-            }
-            for (std::int32_t x = c0[0]; x <= c1[0]; ++x)
-                for (std::int32_t y = c0[1]; y <= c1[1]; ++y)
-                    for (std::int32_t z = c0[2]; z <= c1[2]; ++z) {
-                        const std::size_t b = teschner_hash(x, y, z) % m_table;
-                        if (m_stamp[b] != m_step) continue;
-                        for (Index v : m_buckets[b]) {
-                            if (v == id[0] || v == id[1] || v == id[2] || v == id[3]) continue;
-                            if (m_cell[3 * v] != x || m_cell[3 * v + 1] != y || m_cell[3 * v + 2] != z) continue;
-                            const Eigen::Vector3d q = m.positions.row(v).transpose();
-                            if ((q.array() < lo.array()).any() || (q.array() > hi.array()).any()) continue;
-                            const Eigen::Vector3d d = q - p[0];
-                            const double b1 = d.dot(e2.cross(e3)) / vol, b2 = e1.dot(d.cross(e3)) / vol,
-                                         b3 = e1.dot(e2.cross(d)) / vol;
-                            if (b1 >= 0 && b2 >= 0 && b3 >= 0 && b1 + b2 + b3 <= 1) out.emplace_back(v, t);
-                        }
-                    }
-        }
-    }
-
-  private:
-    std::size_t m_table = 0;
-    std::vector<std::vector<Index>> m_buckets;
-    std::vector<std::uint32_t> m_stamp;
-    std::uint32_t m_step = 0;
-    std::vector<std::int32_t> m_cell;
-};
 
 // ---- measuring -------------------------------------------------------------------------------------
 
@@ -218,7 +101,7 @@ Measured measure(const TetMesh& m, DetectParams p, int repeat)
 
 double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& contacts, double& cpu_ms)
 {
-    Baseline b;
+    bench::Baseline2003 b;
     std::vector<std::pair<Index, Index>> out;
     b.run(m, l, out);
     std::vector<double> ms, cpu;
@@ -244,13 +127,14 @@ __attribute__((noinline)) std::size_t profile_detects(Detector& det, const TetMe
     return n;
 }
 
-double g_table_factor = 0; ///< --table-factor F (0: automatic table size)
-
-void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline)
+/// One scene: tethash at 1 and all threads, its statistics, and the baseline. `table_factor` > 0: the table size
+/// is the power of two nearest to table_factor × vertices (0: automatic).
+void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline,
+            double table_factor)
 {
     DetectParams p1 = base;
-    if (g_table_factor > 0) { // --table-factor: the power of two nearest to F × vertices
-        const double want = g_table_factor * m.num_vertices();
+    if (table_factor > 0) {
+        const double want = table_factor * m.num_vertices();
         std::int64_t n = 1;
         while (static_cast<double>(n) * 1.41421356 < want)
             n <<= 1;
@@ -274,13 +158,15 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
     std::snprintf(label, sizeof label, "%d threads", all.stats.threads);
     line(label, all);
     const DetectStats& s = one.stats;
-    std::printf("  cell %.4g  table %lld  cells %lld  scanned %lld  collisions %lld  box-rejected %lld  own %lld  "
-                "inside tests %lld  exact %lld  degenerate %lld  memory %.1f B/tet\n",
-                s.cell_size, static_cast<long long>(s.table_size), static_cast<long long>(s.cells_visited),
-                static_cast<long long>(s.entries_scanned), static_cast<long long>(s.hash_collisions),
-                static_cast<long long>(s.box_rejections), static_cast<long long>(s.own_vertex_skips),
-                static_cast<long long>(s.inside_tests), static_cast<long long>(s.exact_fallbacks),
-                static_cast<long long>(s.degenerate_tets), double(s.memory_bytes) / std::max(1, m.num_tets()));
+    std::printf(" ");
+    for (const study::StatField& f : study::k_detect_stats)
+        if (f.use & study::in_bench) {
+            if (f.kind == study::StatKind::count)
+                std::printf(" %s %lld ", f.bench_label, static_cast<long long>(f.get(s)));
+            else
+                std::printf(" %s %.4g ", f.bench_label, f.get(s));
+        }
+    std::printf(" memory %.1f B/tet\n", double(s.memory_bytes) / std::max(1, m.num_tets()));
     if (all.stats.contacts != one.stats.contacts) std::printf("  ERROR: contact counts differ between thread counts\n");
     if (baseline) {
         std::size_t bc = 0;
@@ -292,74 +178,6 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
     }
     std::fflush(stdout);
 }
-
-// ---- moving scenes (candidate reuse with a skin) --------------------------------------------------
-
-/// The objects of `m` moving rigidly, each by its own small rotation about its centroid and translation per step
-/// (random axis and direction per object; the fastest vertex moves about `speed` × mean edge per step), plus a
-/// random perturbation of both per step (a quarter of that); the translations reverse every 40 steps, so objects
-/// move apart and together again.
-class MovingScene {
-  public:
-    MovingScene(const TetMesh& m, double mean_edge, double speed, std::uint32_t seed)
-        : m_mesh(m), m_positions(m.positions), m_rng(seed), m_step_length(speed * mean_edge)
-    {
-        const int objects = m.num_objects();
-        m_members.assign(static_cast<std::size_t>(objects), {});
-        for (Eigen::Index v = 0; v < m.positions.rows(); ++v)
-            m_members[static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)])].push_back(
-                static_cast<Index>(v));
-        std::normal_distribution<double> g;
-        for (int o = 0; o < objects; ++o) {
-            Eigen::Vector3d dir(g(m_rng), g(m_rng), g(m_rng)), axis(g(m_rng), g(m_rng), g(m_rng));
-            m_velocity.push_back(0.5 * m_step_length * dir.normalized());
-            m_axis.push_back(axis.normalized());
-            double radius = 1e-12;
-            const Eigen::RowVector3d c = centroid(o);
-            for (Index v : m_members[static_cast<std::size_t>(o)])
-                radius = std::max(radius, (m_positions.row(v) - c).norm());
-            m_omega.push_back(0.5 * m_step_length / radius); // rim speed: half a step length
-        }
-    }
-    const Positions& positions() const { return m_positions; }
-    void step()
-    {
-        ++m_step;
-        std::normal_distribution<double> g;
-        const double sign = (m_step / 40) % 2 ? -1.0 : 1.0;
-        for (std::size_t o = 0; o < m_members.size(); ++o) {
-            const Eigen::RowVector3d c = centroid(static_cast<int>(o));
-            const Eigen::Vector3d jitter_axis = Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
-            const Eigen::Matrix3d R = (Eigen::AngleAxisd(m_omega[o], m_axis[o]) *
-                                       Eigen::AngleAxisd(0.25 * m_omega[o] * g(m_rng), jitter_axis))
-                                          .toRotationMatrix();
-            const Eigen::Vector3d shift =
-                sign * m_velocity[o] +
-                0.25 * 0.5 * m_step_length * Eigen::Vector3d(g(m_rng), g(m_rng), g(m_rng)).normalized();
-            for (Index v : m_members[o]) {
-                const Eigen::Vector3d p = (m_positions.row(v) - c).transpose();
-                m_positions.row(v) = (R * p + c.transpose() + shift).transpose();
-            }
-        }
-    }
-
-  private:
-    Eigen::RowVector3d centroid(int o) const
-    {
-        Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
-        for (Index v : m_members[static_cast<std::size_t>(o)])
-            c += m_positions.row(v);
-        return c / std::max<double>(1.0, static_cast<double>(m_members[static_cast<std::size_t>(o)].size()));
-    }
-    const TetMesh& m_mesh;
-    Positions m_positions;
-    std::mt19937 m_rng;
-    double m_step_length;
-    int m_step = 0;
-    std::vector<std::vector<Index>> m_members;
-    std::vector<Eigen::Vector3d> m_velocity, m_axis;
-    std::vector<double> m_omega;
-};
 
 /// --moving: ms per step over `steps` steps of a moving scenario at skin off and several skins (factors of the cell
 /// size), 1 thread (CPU time) and all threads (wall); then, in a second pass over the same steps with statistics,
@@ -383,7 +201,7 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
             p.skin = skin;
             Detector det(p);
             det.set_topology(m);
-            MovingScene scene(m, edge, speed, 11);
+            bench::MovingScene scene(m, edge, speed, 11);
             det.detect(scene.positions()); // warm-up (auto cell size, buffers): the first step
             std::vector<double> t;
             for (int s = 1; s < steps; ++s) {
@@ -410,7 +228,7 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
         p.skin = skin;
         Detector det(p);
         det.set_topology(m);
-        MovingScene scene(m, edge, speed, 11);
+        bench::MovingScene scene(m, edge, speed, 11);
         DetectStats st;
         det.detect(scene.positions(), &st);
         int rebuilds = 0;
@@ -443,53 +261,40 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
 int main(int argc, char** argv)
 {
     int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100;
-    bool sweep = false, meshes = true, baseline = true, moving = false;
-    double speed = 0.01;
-    double cell_factor = 1.0;
+    bool sweep = false, no_meshes = false, no_baseline = false, moving = false;
+    double speed = 0.01, cell_factor = 1.0, table_factor = 0;
     std::string hash = "column";
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) {
-                std::fprintf(stderr, "tethash_bench: %s needs a value\n", a.c_str());
-                std::exit(2);
-            }
-            return argv[++i];
-        };
-        if (a == "--repeat")
-            repeat = std::max(1, std::stoi(next()));
-        else if (a == "--threads")
-            threads = std::stoi(next());
-        else if (a == "--scenario")
-            only = std::stoi(next());
-        else if (a == "--sweep")
-            sweep = true;
-        else if (a == "--no-meshes")
-            meshes = false;
-        else if (a == "--no-baseline")
-            baseline = false;
-        else if (a == "--profile")
-            profile = std::stoi(next());
-        else if (a == "--table-factor")
-            g_table_factor = std::stod(next());
-        else if (a == "--cell-factor")
-            cell_factor = std::stod(next());
-        else if (a == "--hash")
-            hash = next();
-        else if (a == "--moving")
-            moving = true;
-        else if (a == "--steps")
-            steps = std::max(2, std::stoi(next()));
-        else if (a == "--speed")
-            speed = std::stod(next());
-        else {
-            std::fprintf(stderr,
-                         "usage: tethash_bench [--repeat K] [--threads N] [--scenario 1..5] [--sweep] [--no-meshes] "
-                         "[--no-baseline] [--profile N] [--table-factor F] [--cell-factor F] [--hash column|teschner]\n"
-                         "       tethash_bench --moving [--scenario 1..5] [--steps N] [--speed F] [--threads N]\n");
-            return 2;
-        }
+    CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
+                 "threads for the five scenarios of Teschner et al. 2003 and ../shared/meshes, against a plain "
+                 "implementation of the 2003 algorithm"};
+    app.add_option("--repeat", repeat, "measured detections per scene (median; at least 1)")->capture_default_str();
+    app.add_option("--threads", threads, "threads of the 'all threads' runs; 0 = every hardware thread")
+        ->capture_default_str();
+    app.add_option("--scenario", only, "only this scenario (1..5); with --moving or --profile: which one")
+        ->check(CLI::Range(1, 5));
+    app.add_flag("--sweep", sweep, "flatness sweep: ns per tet from 1,000 to 1,000,000 tets at 1 thread");
+    app.add_flag("--no-meshes", no_meshes, "skip the meshes of ../shared/meshes");
+    app.add_flag("--no-baseline", no_baseline, "skip the 2003 baseline");
+    app.add_option("--profile", profile,
+                   "N detections of one scenario without statistics, for callgrind "
+                   "(--toggle-collect='*profile_detects*')");
+    app.add_option("--table-factor", table_factor,
+                   "table size: the power of two nearest to F × vertices (default: automatic)");
+    app.add_option("--cell-factor", cell_factor, "cell size as a factor of the mean edge length")
+        ->capture_default_str();
+    app.add_option("--hash", hash, "hash function: column or teschner")->capture_default_str();
+    app.add_flag("--moving", moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
+    app.add_option("--steps", steps, "--moving: steps (at least 2)")->capture_default_str();
+    app.add_option("--speed", speed, "--moving: fastest vertex per step, as a factor of the mean edge")
+        ->capture_default_str();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
     }
+    repeat = std::max(1, repeat);
+    steps = std::max(2, steps);
+    const bool meshes = !no_meshes, baseline = !no_baseline;
 #ifdef _OPENMP
     const int threads_all = threads > 0 ? threads : omp_get_max_threads();
 #else
@@ -518,7 +323,7 @@ int main(int argc, char** argv)
     if (sweep) {
         std::printf("flatness sweep: copies of the scenario-5 object (551 tets) packed as in scenario 5, 1 thread\n");
         for (int tets : {1000, 3000, 10000, 30000, 100000, 300000, 1000000}) {
-            const TetMesh m = lattice_scene(std::max(2, (tets + 275) / 551), 7);
+            const TetMesh m = bench::lattice_scene(std::max(2, (tets + 275) / 551), 7);
             DetectParams p = base;
             p.threads = 1;
             const Measured r = measure(m, p, std::max(3, repeat / (tets >= 300000 ? 4 : 1)));
@@ -556,7 +361,7 @@ int main(int argc, char** argv)
         char name[96];
         std::snprintf(name, sizeof name, "scenario %d (%s r%d; paper %d/%d/%d)", k + 1, sc.shape.c_str(), sc.resolution,
                       sc.spec.objects, sc.spec.tets, sc.spec.vertices);
-        report(name, sc.mesh, base, threads_all, repeat, baseline);
+        report(name, sc.mesh, base, threads_all, repeat, baseline, table_factor);
     }
     if (meshes && only < 0) {
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;
@@ -578,7 +383,8 @@ int main(int argc, char** argv)
                     TetMesh two = one;
                     two.positions.rowwise() += 0.2 * (hi - lo);
                     one.append(two);
-                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), baseline);
+                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), baseline,
+                           table_factor);
                 } catch (const std::exception& e) {
                     std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
                 }

@@ -6,6 +6,8 @@
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/penetration.hpp"
+#include "tethash/study/json.hpp"
+#include "tethash/study/stats_table.hpp"
 
 #include <fmt/format.h>
 
@@ -231,28 +233,23 @@ void run(const DetectOptions& o)
         }
     }
     if (!o.stats_path.empty()) {
-        std::string msl;
-        for (std::size_t i = 0; i < ms.size(); ++i)
-            msl += fmt::format("{}{:.6f}", i ? ", " : "", ms[i]);
-        std::string f = "{\n";
-        f += fmt::format("  \"objects\": {},\n  \"vertices\": {},\n  \"tets\": {},\n  \"contacts\": {},\n", num_objects,
-                         nv, nt, contacts.size());
-        f += fmt::format("  \"threads\": {},\n  \"cell_size\": {:.17g},\n  \"table_size\": {},\n  \"hash\": \"{}\",\n",
-                         stats.threads, stats.cell_size, stats.table_size, to_string(params.hash));
-        f +=
-            fmt::format("  \"repeat\": {},\n  \"median_ms\": {:.6f},\n  \"run_ms\": [{}],\n", o.repeat, median_ms, msl);
-        f += fmt::format(
-            "  \"ms_vertices\": {:.6f},\n  \"ms_tets\": {:.6f},\n  \"ms_inside\": {:.6f},\n  \"ms_sort\": {:.6f},\n",
-            stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort);
-        f += fmt::format("  \"cells_visited\": {},\n  \"entries_scanned\": {},\n  \"hash_collisions\": {},\n",
-                         stats.cells_visited, stats.entries_scanned, stats.hash_collisions);
-        f += fmt::format("  \"box_rejections\": {},\n  \"own_vertex_skips\": {},\n  \"inside_tests\": {},\n",
-                         stats.box_rejections, stats.own_vertex_skips, stats.inside_tests);
-        f += fmt::format("  \"exact_fallbacks\": {},\n  \"degenerate_tets\": {},\n  \"table_load\": {:.6f},\n",
-                         stats.exact_fallbacks, stats.degenerate_tets, stats.table_load);
-        f += fmt::format("  \"skin\": {:.17g},\n  \"reused\": {},\n  \"cached_candidates\": {},\n", stats.skin,
-                         stats.reused, stats.cached_candidates);
-        f += fmt::format("  \"memory_bytes\": {}\n}}\n", stats.memory_bytes);
+        study::JsonWriter j;
+        j.begin_object()
+            .member("objects", num_objects)
+            .member("vertices", nv)
+            .member("tets", nt)
+            .member("contacts", contacts.size())
+            .member("hash", to_string(params.hash))
+            .member("repeat", o.repeat)
+            .member("median_ms", median_ms);
+        j.key("run_ms").begin_array();
+        for (const double t : ms)
+            j.value(t);
+        j.end_array();
+        for (const study::StatField& field : study::k_detect_stats)
+            if (field.use & study::in_detect) study::write_stat(j, field, stats);
+        j.end_object();
+        const std::string f = j.str() + "\n";
         io::write_text_file(o.stats_path, f);
     }
 }

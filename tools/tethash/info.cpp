@@ -4,12 +4,14 @@
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/study/json.hpp"
 
 #include <fmt/format.h>
 
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tethash::cli {
@@ -71,69 +73,56 @@ Summary summarize(const std::string& name, const TetMesh& mesh, const io::ReadNo
     return s;
 }
 
-std::string json_string(const std::string& s)
+/// The members of one summary's JSON object.
+void write_members(study::JsonWriter& j, const Summary& s)
 {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\')
-            out += '\\', out += c;
-        else if (static_cast<unsigned char>(c) < 0x20)
-            out += fmt::format("\\u{:04x}", c);
-        else
-            out += c;
-    }
-    return out + "\"";
-}
-
-std::string json_number(double v)
-{
-    return std::isfinite(v) ? fmt::format("{}", v) : "null";
-}
-
-std::string to_json(const Summary& s, const std::string& indent)
-{
+    using study::JsonWriter;
     const auto& r = s.report;
-    std::string o = "{\n";
-    auto kv = [&](const std::string& k, const std::string& v, bool last = false) {
-        o += indent + "  " + json_string(k) + ": " + v + (last ? "\n" : ",\n");
+    j.member("name", s.name).member("vertices", s.vertices).member("tets", s.tets).member("objects", s.objects);
+    j.key("bounding_box").begin_object(JsonWriter::inline_layout);
+    for (const auto& [key, corner] :
+         {std::pair<const char*, const Eigen::Vector3d*>{"min", &s.box_min}, {"max", &s.box_max}}) {
+        j.key(key).begin_array();
+        for (int k = 0; k < 3; ++k)
+            j.value((*corner)[k]);
+        j.end_array();
+    }
+    j.end_object();
+    const auto spread = [&j](const char* key, const char* first, auto first_value, double min, double mean,
+                             double max) {
+        j.key(key)
+            .begin_object(JsonWriter::inline_layout)
+            .member(first, first_value)
+            .member("min", min)
+            .member("mean", mean)
+            .member("max", max)
+            .end_object();
     };
-    kv("name", json_string(s.name));
-    kv("vertices", std::to_string(s.vertices));
-    kv("tets", std::to_string(s.tets));
-    kv("objects", std::to_string(s.objects));
-    kv("bounding_box", fmt::format("{{\"min\": [{}, {}, {}], \"max\": [{}, {}, {}]}}", json_number(s.box_min.x()),
-                                   json_number(s.box_min.y()), json_number(s.box_min.z()), json_number(s.box_max.x()),
-                                   json_number(s.box_max.y()), json_number(s.box_max.z())));
-    kv("edges", fmt::format("{{\"count\": {}, \"min\": {}, \"mean\": {}, \"max\": {}}}", s.edges.count,
-                            json_number(s.edges.min), json_number(s.edges.mean), json_number(s.edges.max)));
-    kv("volume", fmt::format("{{\"total\": {}, \"min\": {}, \"mean\": {}, \"max\": {}}}", json_number(s.volume.total),
-                             json_number(s.volume.min), json_number(s.volume.mean), json_number(s.volume.max)));
-    kv("boundary_faces", std::to_string(s.boundary_faces));
-    kv("components", std::to_string(s.components));
-    kv("min_dihedral_deg", json_number(s.min_dihedral));
-    kv("max_dihedral_deg", json_number(s.max_dihedral));
-    kv("max_aspect_ratio", json_number(s.max_aspect));
-    std::string hist = "[";
+    spread("edges", "count", s.edges.count, s.edges.min, s.edges.mean, s.edges.max);
+    spread("volume", "total", s.volume.total, s.volume.min, s.volume.mean, s.volume.max);
+    j.member("boundary_faces", s.boundary_faces)
+        .member("components", s.components)
+        .member("min_dihedral_deg", s.min_dihedral)
+        .member("max_dihedral_deg", s.max_dihedral)
+        .member("max_aspect_ratio", s.max_aspect);
+    j.key("quality_histogram").begin_array();
     for (std::size_t i = 0; i < kDihedralEdges.size(); ++i)
-        hist += fmt::format("{}{{\"min_dihedral_from_deg\": {}, \"tets\": {}}}", i ? ", " : "", kDihedralEdges[i],
-                            s.histogram[i]);
-    kv("quality_histogram", hist + "]");
-    kv("inverted_tets", std::to_string(r.inverted_tets));
-    kv("degenerate_tets", std::to_string(r.degenerate_tets));
-    kv("unreferenced_vertices", std::to_string(r.unreferenced_vertices));
-    kv("index_out_of_range", std::to_string(r.index_out_of_range));
-    kv("repeated_index", std::to_string(r.repeated_index));
-    kv("non_finite_vertices", std::to_string(r.non_finite));
-    kv("non_manifold_faces", std::to_string(r.non_manifold_faces));
-    std::string problems = "[";
-    for (std::size_t i = 0; i < r.problems().size(); ++i)
-        problems += (i ? ", " : "") + json_string(r.problems()[i]);
-    kv("problems", problems + "]");
-    std::string notes = "[";
-    for (std::size_t i = 0; i < s.notes.size(); ++i)
-        notes += (i ? ", " : "") + json_string(s.notes[i]);
-    kv("notes", notes + "]", true);
-    return o + indent + "}";
+        j.begin_object().member("min_dihedral_from_deg", kDihedralEdges[i]).member("tets", s.histogram[i]).end_object();
+    j.end_array();
+    j.member("inverted_tets", r.inverted_tets)
+        .member("degenerate_tets", r.degenerate_tets)
+        .member("unreferenced_vertices", r.unreferenced_vertices)
+        .member("index_out_of_range", r.index_out_of_range)
+        .member("repeated_index", r.repeated_index)
+        .member("non_finite_vertices", r.non_finite)
+        .member("non_manifold_faces", r.non_manifold_faces);
+    j.key("problems").begin_array();
+    for (const auto& p : r.problems())
+        j.value(p);
+    j.end_array().key("notes").begin_array();
+    for (const auto& n : s.notes)
+        j.value(n);
+    j.end_array();
 }
 
 void print_text(const Summary& s)
@@ -199,15 +188,21 @@ void run(const InfoOptions& opt)
     }
     Summary total = summaries.size() == 1 ? summaries.front() : summarize("scene", scene, all_notes);
     if (opt.json) {
-        std::string out = to_json(total, "");
+        // The scene; with several files, each file's summary in "files".
+        study::JsonWriter j;
+        j.begin_object();
+        write_members(j, total);
         if (summaries.size() > 1) {
-            out.pop_back(); // closing brace
-            out.pop_back(); // newline before it: to_json ends with "\n}" -> reopen the object
-            out += ",\n  \"files\": [";
-            for (std::size_t i = 0; i < summaries.size(); ++i)
-                out += (i ? ", " : "") + to_json(summaries[i], "  ");
-            out += "]\n}";
+            j.key("files").begin_array(study::JsonWriter::block_layout);
+            for (const auto& one : summaries) {
+                j.begin_object();
+                write_members(j, one);
+                j.end_object();
+            }
+            j.end_array();
         }
+        j.end_object();
+        const std::string out = j.str();
         fmt::print("{}\n", out);
         return;
     }
