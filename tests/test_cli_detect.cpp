@@ -94,6 +94,36 @@ TEST(CliDetect, ContactsCsvMatchesOracleSortedWithHeader)
     EXPECT_NE(js.find("\"contacts\": " + std::to_string(want.size())), std::string::npos) << js;
 }
 
+TEST(CliDetect, FirstCallIsReportedApartAndStagesAddUpToTheTotal)
+{
+    // The first call carries the one-off set-up (the automatic cell size); the timed calls follow it, and their
+    // stages plus "other" are the printed total.
+    const auto dir = temp_dir();
+    const Files f = two_objects(dir);
+    const auto r = run_tethash("detect " + quote(f.a) + " " + quote(f.b) + " --repeat 3 --threads 1 --stats " +
+                               quote(dir / "s.json"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto at = r.out.find("first call: ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("set-up", at), std::string::npos) << r.out;
+    double total = 0, v = 0, t = 0, in = 0, so = 0, other = 0;
+    int k = 0;
+    const auto line = r.out.find("time: ");
+    ASSERT_NE(line, std::string::npos) << r.out;
+    ASSERT_EQ(std::sscanf(r.out.c_str() + line,
+                          "time: %lf ms per detection (median of %d after the first): vertices %lf, tets %lf, inside "
+                          "%lf, sort %lf, other %lf",
+                          &total, &k, &v, &t, &in, &so, &other),
+              7)
+        << r.out;
+    EXPECT_EQ(k, 3);
+    EXPECT_NEAR(v + t + in + so + other, total, 0.003) << r.out;
+    EXPECT_LE(other, 0.5 * total + 0.01) << "the stages should be most of a call: " << r.out;
+    const std::string js = read_text(dir / "s.json");
+    for (const char* key : {"\"first_call_ms\"", "\"setup_ms\"", "\"ms_setup\": 0"})
+        EXPECT_NE(js.find(key), std::string::npos) << key << " in\n" << js;
+}
+
 TEST(CliDetect, NoSelfAndStaticObjects)
 {
     const auto dir = temp_dir();

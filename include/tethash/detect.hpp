@@ -102,9 +102,11 @@ long long parse_integer(const std::string& text, const std::string& option);
 /// The smallest power of two ≥ n (n ≥ 1).
 std::int64_t next_power_of_two(std::int64_t n);
 
-/// Statistics of one detect() call. Times in milliseconds.
+/// Statistics of one detect() call. Times in milliseconds: ms_total is the whole call; ms_setup the one-off set-up
+/// of the first call after set_topology()/set_params() (automatic cell size, the static vertices' table; 0 on later
+/// calls); the stages (ms_vertices … ms_sort, each the slowest thread's) follow it.
 struct DetectStats {
-    double ms_total = 0, ms_vertices = 0, ms_tets = 0, ms_inside = 0, ms_sort = 0;
+    double ms_total = 0, ms_setup = 0, ms_vertices = 0, ms_tets = 0, ms_inside = 0, ms_sort = 0;
     double cell_size = 0;        ///< l actually used
     std::int64_t table_size = 0; ///< n actually used
     int threads = 1;

@@ -37,7 +37,7 @@ struct StatField {
 
 /// Every field of DetectStats once (tests/test_study_stats_table.cpp checks it), plus derived ratios.
 /// Order: the parameters used, the scene, the work counters, the result and memory, candidate reuse, the timings.
-inline constexpr std::array<StatField, 25> k_detect_stats = {{
+inline constexpr std::array<StatField, 26> k_detect_stats = {{
     {"cell_size", "length", StatKind::real, [](const DetectStats& s) { return s.cell_size; },
      in_study | in_detect | in_bench, "cell"},
     {"table_size", "buckets", StatKind::count, [](const DetectStats& s) { return double(s.table_size); },
@@ -78,6 +78,7 @@ inline constexpr std::array<StatField, 25> k_detect_stats = {{
     {"cached_candidates", "", StatKind::count, [](const DetectStats& s) { return double(s.cached_candidates); },
      in_detect, nullptr},
     {"ms_total", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_total; }, in_study, nullptr},
+    {"ms_setup", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_setup; }, in_detect, nullptr},
     {"ms_vertices", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_vertices; }, in_study | in_detect,
      nullptr},
     {"ms_tets", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_tets; }, in_study | in_detect, nullptr},
