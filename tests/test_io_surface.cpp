@@ -2,7 +2,9 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
+#include "tethash/meshing/winding_number.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
 
@@ -21,10 +23,10 @@ namespace {
 
 io::SurfaceMesh sphere_surface(int resolution)
 {
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = "sphere";
     p.resolution = resolution;
-    return io::boundary_surface(io::generate(p));
+    return io::boundary_surface(meshing::generate(p));
 }
 
 /// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).
@@ -48,10 +50,10 @@ double volume(const TetMesh& m)
 
 TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
 {
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = "box";
     p.resolution = 5;
-    const TetMesh m = io::generate(p);
+    const TetMesh m = meshing::generate(p);
     const io::SurfaceMesh s = io::boundary_surface(m);
     EXPECT_EQ(s.triangles.rows(), boundary_faces(m.tets).rows());
     EXPECT_LT(s.vertices.rows(), m.num_vertices()); // interior vertices dropped
@@ -126,7 +128,7 @@ TEST(Surface, ReadsHandWrittenObjWithQuads)
     EXPECT_EQ(s.triangles.rows(), 12);
     EXPECT_EQ(s.vertices.rows(), 8);
     EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);
-    const TetMesh m = io::tetrahedralize(s, {8, true});
+    const TetMesh m = meshing::tetrahedralize(s, {8, true});
     EXPECT_NEAR(volume(m), 1.0, 0.02);
     EXPECT_EQ(validate(m).inverted_tets, 0);
 }
@@ -134,7 +136,7 @@ TEST(Surface, ReadsHandWrittenObjWithQuads)
 TEST(Tetrahedralize, WindingNumbersInsideAndOutside)
 {
     const io::SurfaceMesh s = sphere_surface(8);
-    const auto w = io::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
+    const auto w = meshing::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
                                            Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
     // Far triangle groups are dipoles: a few per cent off, far from the 1/2 that decides inside.
     EXPECT_NEAR(w[0], 1.0, 0.06);
@@ -147,7 +149,7 @@ TEST(Tetrahedralize, RecoversTheVolumeOfAGeneratedSphere)
 {
     const io::SurfaceMesh s = sphere_surface(16);
     const double expect = enclosed_volume(s);
-    const TetMesh m = io::tetrahedralize(s, {16, true});
+    const TetMesh m = meshing::tetrahedralize(s, {16, true});
     EXPECT_NEAR(volume(m), expect, 0.03 * expect);
     const ValidationReport r = validate(m);
     EXPECT_TRUE(r.ok());
@@ -155,7 +157,7 @@ TEST(Tetrahedralize, RecoversTheVolumeOfAGeneratedSphere)
     EXPECT_EQ(r.degenerate_tets, 0);
     EXPECT_EQ(r.unreferenced_vertices, 0);
     // Deterministic.
-    const TetMesh again = io::tetrahedralize(s, {16, true});
+    const TetMesh again = meshing::tetrahedralize(s, {16, true});
     EXPECT_TRUE(again.positions == m.positions);
     EXPECT_TRUE(again.tets == m.tets);
 }
@@ -167,13 +169,13 @@ TEST(Tetrahedralize, ToleratesAHoleAndAnInwardOrientation)
     // Cut two triangles out: a small hole.
     io::SurfaceMesh holed = s;
     holed.triangles = s.triangles.bottomRows(s.triangles.rows() - 2);
-    const TetMesh m = io::tetrahedralize(holed, {12, true});
+    const TetMesh m = meshing::tetrahedralize(holed, {12, true});
     EXPECT_NEAR(volume(m), expect, 0.05 * expect);
     EXPECT_EQ(validate(m).inverted_tets, 0);
     // Every triangle flipped.
     io::SurfaceMesh flipped = s;
     flipped.triangles.col(1).swap(flipped.triangles.col(2));
-    EXPECT_NEAR(volume(io::tetrahedralize(flipped, {12, true})), expect, 0.05 * expect);
+    EXPECT_NEAR(volume(meshing::tetrahedralize(flipped, {12, true})), expect, 0.05 * expect);
 }
 
 TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
@@ -184,21 +186,21 @@ TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
     tri.triangles.resize(1, 3);
     tri.triangles << 0, 1, 2;
     try {
-        io::tetrahedralize(tri, {8, true});
+        meshing::tetrahedralize(tri, {8, true});
         FAIL() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
     }
     io::SurfaceMesh empty;
-    EXPECT_THROW(io::tetrahedralize(empty, {8, true}), Error);
+    EXPECT_THROW(meshing::tetrahedralize(empty, {8, true}), Error);
     tri.triangles << 0, 1, 7;
     try {
-        io::tetrahedralize(tri, {8, true});
+        meshing::tetrahedralize(tri, {8, true});
         FAIL() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("triangle 0"), std::string::npos) << e.what();
     }
-    EXPECT_THROW(io::tetrahedralize(sphere_surface(4), {0, true}), Error);
+    EXPECT_THROW(meshing::tetrahedralize(sphere_surface(4), {0, true}), Error);
 }
 
 TEST(Surface, PlyIsReadByTethashInEveryEncoding)
