@@ -4,7 +4,6 @@
 #include "tethash/error.hpp"
 #include "tethash/meshing/generate.hpp"
 #include "tethash/meshing/tetrahedralize.hpp"
-#include "tethash/meshing/winding_number.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
 
@@ -131,76 +130,6 @@ TEST(Surface, ReadsHandWrittenObjWithQuads)
     const TetMesh m = meshing::tetrahedralize(s, {8, true});
     EXPECT_NEAR(volume(m), 1.0, 0.02);
     EXPECT_EQ(validate(m).inverted_tets, 0);
-}
-
-TEST(Tetrahedralize, WindingNumbersInsideAndOutside)
-{
-    const io::SurfaceMesh s = sphere_surface(8);
-    const auto w = meshing::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
-                                           Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
-    // Far triangle groups are dipoles: a few per cent off, far from the 1/2 that decides inside.
-    EXPECT_NEAR(w[0], 1.0, 0.06);
-    EXPECT_NEAR(w[1], 1.0, 0.06);
-    EXPECT_NEAR(w[2], 0.0, 0.06);
-    EXPECT_NEAR(w[3], 0.0, 0.06);
-}
-
-TEST(Tetrahedralize, RecoversTheVolumeOfAGeneratedSphere)
-{
-    const io::SurfaceMesh s = sphere_surface(16);
-    const double expect = enclosed_volume(s);
-    const TetMesh m = meshing::tetrahedralize(s, {16, true});
-    EXPECT_NEAR(volume(m), expect, 0.03 * expect);
-    const ValidationReport r = validate(m);
-    EXPECT_TRUE(r.ok());
-    EXPECT_EQ(r.inverted_tets, 0);
-    EXPECT_EQ(r.degenerate_tets, 0);
-    EXPECT_EQ(r.unreferenced_vertices, 0);
-    // Deterministic.
-    const TetMesh again = meshing::tetrahedralize(s, {16, true});
-    EXPECT_TRUE(again.positions == m.positions);
-    EXPECT_TRUE(again.tets == m.tets);
-}
-
-TEST(Tetrahedralize, ToleratesAHoleAndAnInwardOrientation)
-{
-    io::SurfaceMesh s = sphere_surface(12);
-    const double expect = enclosed_volume(s);
-    // Cut two triangles out: a small hole.
-    io::SurfaceMesh holed = s;
-    holed.triangles = s.triangles.bottomRows(s.triangles.rows() - 2);
-    const TetMesh m = meshing::tetrahedralize(holed, {12, true});
-    EXPECT_NEAR(volume(m), expect, 0.05 * expect);
-    EXPECT_EQ(validate(m).inverted_tets, 0);
-    // Every triangle flipped.
-    io::SurfaceMesh flipped = s;
-    flipped.triangles.col(1).swap(flipped.triangles.col(2));
-    EXPECT_NEAR(volume(meshing::tetrahedralize(flipped, {12, true})), expect, 0.05 * expect);
-}
-
-TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
-{
-    io::SurfaceMesh tri;
-    tri.vertices.resize(3, 3);
-    tri.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0.5;
-    tri.triangles.resize(1, 3);
-    tri.triangles << 0, 1, 2;
-    try {
-        meshing::tetrahedralize(tri, {8, true});
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
-    }
-    io::SurfaceMesh empty;
-    EXPECT_THROW(meshing::tetrahedralize(empty, {8, true}), Error);
-    tri.triangles << 0, 1, 7;
-    try {
-        meshing::tetrahedralize(tri, {8, true});
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("triangle 0"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(meshing::tetrahedralize(sphere_surface(4), {0, true}), Error);
 }
 
 TEST(Surface, PlyIsReadByTethashInEveryEncoding)

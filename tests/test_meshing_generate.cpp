@@ -2,7 +2,6 @@
 // volume, keep good tets, and reject bad parameters.
 #include "tethash/error.hpp"
 #include "tethash/meshing/generate.hpp"
-#include "tethash/meshing/tetrahedralize.hpp"
 #include "tethash/mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -13,6 +12,10 @@
 #include <map>
 #include <numbers>
 #include <numeric>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 using namespace tethash;
 
@@ -138,6 +141,29 @@ TEST(Generate, IsDeterministic)
     }
 }
 
+TEST(Generate, BitIdenticalAtOneAndTwoThreads)
+{
+#ifndef _OPENMP
+    GTEST_SKIP() << "built without OpenMP";
+#else
+    // The inside test and the snapping targets run in parallel loops; the mesh must not depend on it.
+    const int saved = omp_get_max_threads();
+    for (const char* shape : {"sphere", "blob", "box"}) {
+        TetMesh m[2];
+        for (int threads : {1, 2}) {
+            omp_set_num_threads(threads);
+            m[threads - 1] = meshing::generate(params(shape, 14));
+        }
+        ASSERT_EQ(m[0].num_vertices(), m[1].num_vertices()) << shape;
+        EXPECT_TRUE(m[0].tets == m[1].tets) << shape;
+        EXPECT_EQ(0, std::memcmp(m[0].positions.data(), m[1].positions.data(),
+                                 sizeof(double) * static_cast<std::size_t>(m[0].positions.size())))
+            << shape;
+    }
+    omp_set_num_threads(saved);
+#endif
+}
+
 TEST(Generate, VolumesMatchTheAnalyticShapes)
 {
     const double pi = std::numbers::pi;
@@ -228,24 +254,4 @@ TEST(Generate, RejectsBadParameters)
     p.scale = 1;
     p.size = Eigen::Vector3d(1, 0, 1);
     EXPECT_THROW(meshing::generate(p), Error);
-}
-
-TEST(TetrahedralizeSdf, CustomFunctionAndEmptyInside)
-{
-    // A ball of radius 0.3 off-centre in a 1-box.
-    auto ball = [](const Eigen::Vector3d& p) { return (p - Eigen::Vector3d(0.1, 0, 0)).norm() - 0.3; };
-    const TetMesh m =
-        meshing::tetrahedralize_sdf(ball, Eigen::Vector3d(-0.2, -0.3, -0.3), Eigen::Vector3d(0.4, 0.3, 0.3), 16, true);
-    const double expect = 4.0 / 3.0 * std::numbers::pi * 0.027;
-    EXPECT_NEAR(volume(m), expect, 0.03 * expect);
-    EXPECT_EQ(validate(m).inverted_tets, 0);
-    // Everything outside: an error that says so.
-    auto nothing = [](const Eigen::Vector3d&) { return 1.0; };
-    try {
-        meshing::tetrahedralize_sdf(nothing, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), 4, true);
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(meshing::tetrahedralize_sdf(ball, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 1), 4, true), Error);
 }

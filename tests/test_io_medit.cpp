@@ -2,7 +2,7 @@
 // ways, bad input, the shared Medit meshes.
 #include "io_formats_support.hpp"
 
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/medit.hpp"
 
 using namespace tethash;
 using namespace tethash::test;

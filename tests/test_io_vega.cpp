@@ -2,7 +2,7 @@
 // the shared quintupleTorus mesh. meshio has no .veg format, so every file here is hand-made.
 #include "io_formats_support.hpp"
 
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/vega.hpp"
 
 using namespace tethash;
 using namespace tethash::test;
