@@ -1,11 +1,12 @@
-// Tests of io/surface.hpp (assimp bridge) and of tetrahedralize() / winding_numbers() on surfaces.
+// Tests of io/surface.hpp: the assimp bridge, tethash's own PLY reader, boundary surfaces.
 #include "support.hpp"
+#include "surface_support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/meshing/generate.hpp"
-#include "tethash/meshing/tetrahedralize.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 
 #include <Eigen/Geometry>
 
@@ -13,37 +14,15 @@
 #include <numbers>
 
 using namespace tethash;
+using tethash::test::sphere_surface;
+using tethash::test::enclosed_volume;
+using tethash::test::volume;
 using tethash::test::temp_dir;
 
 namespace {
 
 #define SKIP_WITHOUT_ASSIMP()                                                                                          \
     if (!io::have_assimp()) GTEST_SKIP() << "built without assimp"
-
-io::SurfaceMesh sphere_surface(int resolution)
-{
-    meshing::GenerateParams p;
-    p.shape = "sphere";
-    p.resolution = resolution;
-    return io::boundary_surface(meshing::generate(p));
-}
-
-/// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).
-double enclosed_volume(const io::SurfaceMesh& s)
-{
-    double v = 0;
-    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
-        const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)), b = s.vertices.row(s.triangles(t, 1)),
-                              c = s.vertices.row(s.triangles(t, 2));
-        v += a.dot(b.cross(c)) / 6.0;
-    }
-    return v;
-}
-
-double volume(const TetMesh& m)
-{
-    return volume_stats(m.positions, m.tets).total;
-}
 
 } // namespace
 

@@ -1,11 +1,10 @@
 // meshing/tetrahedralize.hpp: signed-distance functions and closed surfaces to tets on the BCC lattice.
+#include "surface_support.hpp"
+
 #include "tethash/error.hpp"
-#include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
-#include "tethash/meshing/generate.hpp"
 #include "tethash/meshing/tetrahedralize.hpp"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -16,33 +15,11 @@
 #endif
 
 using namespace tethash;
+using tethash::test::sphere_surface;
+using tethash::test::enclosed_volume;
+using tethash::test::volume;
 
 namespace {
-
-io::SurfaceMesh sphere_surface(int resolution)
-{
-    meshing::GenerateParams p;
-    p.shape = "sphere";
-    p.resolution = resolution;
-    return io::boundary_surface(meshing::generate(p));
-}
-
-/// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).
-double enclosed_volume(const io::SurfaceMesh& s)
-{
-    double v = 0;
-    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
-        const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)), b = s.vertices.row(s.triangles(t, 1)),
-                              c = s.vertices.row(s.triangles(t, 2));
-        v += a.dot(b.cross(c)) / 6.0;
-    }
-    return v;
-}
-
-double volume(const TetMesh& m)
-{
-    return volume_stats(m.positions, m.tets).total;
-}
 
 bool bit_identical(const TetMesh& a, const TetMesh& b)
 {

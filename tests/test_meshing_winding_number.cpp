@@ -1,24 +1,13 @@
 // meshing/winding_number.hpp: generalized winding numbers of a triangle surface.
+#include "surface_support.hpp"
+
 #include "tethash/error.hpp"
-#include "tethash/io/surface.hpp"
-#include "tethash/meshing/generate.hpp"
 #include "tethash/meshing/winding_number.hpp"
 
 #include <gtest/gtest.h>
 
 using namespace tethash;
-
-namespace {
-
-io::SurfaceMesh sphere_surface(int resolution)
-{
-    meshing::GenerateParams p;
-    p.shape = "sphere";
-    p.resolution = resolution;
-    return io::boundary_surface(meshing::generate(p));
-}
-
-} // namespace
+using tethash::test::sphere_surface;
 
 TEST(WindingNumber, InsideAndOutside)
 {
