@@ -15,12 +15,7 @@ const char* k_good = "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\
 std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
                              const std::string& name)
 {
-    std::string text = k_good;
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    write_text(dir / name, text);
-    return dir / name;
+    return write_edited(dir / name, k_good, from, to);
 }
 
 } // namespace
