@@ -23,6 +23,17 @@ inline std::filesystem::path data_file(const std::string& rel)
 inline std::string q(const std::filesystem::path& p) { return quote(p); }
 
 /// 1-based number of the first line of `text` that contains `needle` (0 if none).
+/// Writes `good` with its first `from` replaced by `to` (a failure if there is none) to `path`.
+inline std::filesystem::path write_edited(const std::filesystem::path& path, std::string good, const std::string& from,
+                                          const std::string& to)
+{
+    const std::size_t at = good.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) good.replace(at, from.size(), to);
+    write_text(path, good);
+    return path;
+}
+
 inline int line_of(const std::string& text, const std::string& needle)
 {
     const std::size_t at = text.find(needle);

@@ -3,7 +3,7 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/penetration.hpp"
 
 #include <Eigen/LU>
@@ -17,11 +17,11 @@ namespace {
 
 TetMesh box(int res, double size, const Eigen::Vector3d& at)
 {
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = res;
     g.size = Eigen::Vector3d::Constant(size);
-    TetMesh m = io::generate(g);
+    TetMesh m = meshing::generate(g);
     m.positions.rowwise() += at.transpose();
     m.rest_positions.resize(0, 3);
     return m;

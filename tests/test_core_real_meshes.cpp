@@ -42,14 +42,7 @@ void check_mesh(const std::string& name)
 {
     const auto path = test::shared_mesh(name);
     if (!path) GTEST_SKIP() << name << " not present";
-    TetMesh one;
-    try {
-        one = io::read_mesh(path->string());
-    } catch (const Error& e) {
-        if (std::string(e.what()).find("not implemented") != std::string::npos)
-            GTEST_SKIP() << "reader not implemented yet: " << e.what();
-        throw;
-    }
+    const TetMesh one = io::read_mesh(path->string());
     ASSERT_GT(one.num_tets(), 0);
     const double edge = mean_edge_length(one.positions, one.tets);
     const Index n = one.num_vertices(), m = one.num_tets();

@@ -1,10 +1,12 @@
-// Tests of io/surface.hpp (assimp bridge) and of tetrahedralize() / winding_numbers() on surfaces.
+// Tests of io/surface.hpp: the assimp bridge, tethash's own PLY reader, boundary surfaces.
 #include "support.hpp"
+#include "surface_support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 
 #include <Eigen/Geometry>
 
@@ -12,6 +14,9 @@
 #include <numbers>
 
 using namespace tethash;
+using tethash::test::sphere_surface;
+using tethash::test::enclosed_volume;
+using tethash::test::volume;
 using tethash::test::temp_dir;
 
 namespace {
@@ -19,39 +24,14 @@ namespace {
 #define SKIP_WITHOUT_ASSIMP()                                                                                          \
     if (!io::have_assimp()) GTEST_SKIP() << "built without assimp"
 
-io::SurfaceMesh sphere_surface(int resolution)
-{
-    io::GenerateParams p;
-    p.shape = "sphere";
-    p.resolution = resolution;
-    return io::boundary_surface(io::generate(p));
-}
-
-/// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).
-double enclosed_volume(const io::SurfaceMesh& s)
-{
-    double v = 0;
-    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
-        const Eigen::Vector3d a = s.vertices.row(s.triangles(t, 0)), b = s.vertices.row(s.triangles(t, 1)),
-                              c = s.vertices.row(s.triangles(t, 2));
-        v += a.dot(b.cross(c)) / 6.0;
-    }
-    return v;
-}
-
-double volume(const TetMesh& m)
-{
-    return volume_stats(m.positions, m.tets).total;
-}
-
 } // namespace
 
 TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
 {
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = "box";
     p.resolution = 5;
-    const TetMesh m = io::generate(p);
+    const TetMesh m = meshing::generate(p);
     const io::SurfaceMesh s = io::boundary_surface(m);
     EXPECT_EQ(s.triangles.rows(), boundary_faces(m.tets).rows());
     EXPECT_LT(s.vertices.rows(), m.num_vertices()); // interior vertices dropped
@@ -126,79 +106,9 @@ TEST(Surface, ReadsHandWrittenObjWithQuads)
     EXPECT_EQ(s.triangles.rows(), 12);
     EXPECT_EQ(s.vertices.rows(), 8);
     EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);
-    const TetMesh m = io::tetrahedralize(s, {8, true});
+    const TetMesh m = meshing::tetrahedralize(s, {8, true});
     EXPECT_NEAR(volume(m), 1.0, 0.02);
     EXPECT_EQ(validate(m).inverted_tets, 0);
-}
-
-TEST(Tetrahedralize, WindingNumbersInsideAndOutside)
-{
-    const io::SurfaceMesh s = sphere_surface(8);
-    const auto w = io::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
-                                           Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
-    // Far triangle groups are dipoles: a few per cent off, far from the 1/2 that decides inside.
-    EXPECT_NEAR(w[0], 1.0, 0.06);
-    EXPECT_NEAR(w[1], 1.0, 0.06);
-    EXPECT_NEAR(w[2], 0.0, 0.06);
-    EXPECT_NEAR(w[3], 0.0, 0.06);
-}
-
-TEST(Tetrahedralize, RecoversTheVolumeOfAGeneratedSphere)
-{
-    const io::SurfaceMesh s = sphere_surface(16);
-    const double expect = enclosed_volume(s);
-    const TetMesh m = io::tetrahedralize(s, {16, true});
-    EXPECT_NEAR(volume(m), expect, 0.03 * expect);
-    const ValidationReport r = validate(m);
-    EXPECT_TRUE(r.ok());
-    EXPECT_EQ(r.inverted_tets, 0);
-    EXPECT_EQ(r.degenerate_tets, 0);
-    EXPECT_EQ(r.unreferenced_vertices, 0);
-    // Deterministic.
-    const TetMesh again = io::tetrahedralize(s, {16, true});
-    EXPECT_TRUE(again.positions == m.positions);
-    EXPECT_TRUE(again.tets == m.tets);
-}
-
-TEST(Tetrahedralize, ToleratesAHoleAndAnInwardOrientation)
-{
-    io::SurfaceMesh s = sphere_surface(12);
-    const double expect = enclosed_volume(s);
-    // Cut two triangles out: a small hole.
-    io::SurfaceMesh holed = s;
-    holed.triangles = s.triangles.bottomRows(s.triangles.rows() - 2);
-    const TetMesh m = io::tetrahedralize(holed, {12, true});
-    EXPECT_NEAR(volume(m), expect, 0.05 * expect);
-    EXPECT_EQ(validate(m).inverted_tets, 0);
-    // Every triangle flipped.
-    io::SurfaceMesh flipped = s;
-    flipped.triangles.col(1).swap(flipped.triangles.col(2));
-    EXPECT_NEAR(volume(io::tetrahedralize(flipped, {12, true})), expect, 0.05 * expect);
-}
-
-TEST(Tetrahedralize, RejectsSurfacesWithoutInside)
-{
-    io::SurfaceMesh tri;
-    tri.vertices.resize(3, 3);
-    tri.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0.5;
-    tri.triangles.resize(1, 3);
-    tri.triangles << 0, 1, 2;
-    try {
-        io::tetrahedralize(tri, {8, true});
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
-    }
-    io::SurfaceMesh empty;
-    EXPECT_THROW(io::tetrahedralize(empty, {8, true}), Error);
-    tri.triangles << 0, 1, 7;
-    try {
-        io::tetrahedralize(tri, {8, true});
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("triangle 0"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(io::tetrahedralize(sphere_surface(4), {0, true}), Error);
 }
 
 TEST(Surface, PlyIsReadByTethashInEveryEncoding)

@@ -1,9 +1,11 @@
-// VTK legacy (.vtk), VTK XML (.vtu) and .pvd: round trips through our writers and readers,
+// VTK legacy (.vtk) and VTK XML (.vtu): round trips through our writers and readers,
 // interoperability with meshio in both directions, the shared real .vtu mesh.
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/vtk.hpp"
+#include "tethash/io/pvd.hpp"
+#include "tethash/io/vtk_legacy.hpp"
+#include "tethash/io/vtu.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -167,26 +169,6 @@ TEST(IoVtk, ReadMeshDispatchAndEmptyMesh)
     const TetMesh m = grid_mesh(1, 1, 1);
     io::write_mesh((dir / "m.vtu").string(), m);
     expect_same_mesh(m, io::read_mesh((dir / "m.vtu").string()), 0, "read_mesh .vtu");
-}
-
-TEST(IoVtk, PvdListsFrames)
-{
-    const auto dir = temp_dir();
-    const TetMesh m = grid_mesh(1, 1, 1);
-    std::vector<std::pair<double, std::string>> frames;
-    for (int i = 0; i < 3; ++i) {
-        const std::string name = "frame_" + std::to_string(i) + ".vtu";
-        io::write_vtu((dir / name).string(), m);
-        frames.emplace_back(0.1 * i, name);
-    }
-    io::write_pvd((dir / "series.pvd").string(), frames);
-    const auto back = io::read_pvd((dir / "series.pvd").string());
-    EXPECT_EQ(back, frames);
-    const std::string text = read_text(dir / "series.pvd");
-    EXPECT_NE(text.find("type=\"Collection\""), std::string::npos);
-    EXPECT_NE(text.find("file=\"frame_2.vtu\""), std::string::npos);
-    EXPECT_THROW(io::write_pvd((dir / "bad.pvd").string(), {{std::nan(""), "x.vtu"}}), Error);
-    EXPECT_FALSE(std::filesystem::exists(dir / "bad.pvd"));
 }
 
 TEST(IoVtk, WriterRejectsBadFieldsAndLeavesNoFile)

@@ -3,7 +3,9 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/vtk.hpp"
+#include "tethash/io/pvd.hpp"
+#include "tethash/io/vtk_legacy.hpp"
+#include "tethash/io/vtu.hpp"
 
 #include <functional>
 #include <unistd.h>

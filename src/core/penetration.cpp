@@ -1,5 +1,7 @@
 #include "tethash/penetration.hpp"
 
+#include "triangle_bvh.hpp"
+
 #include "tethash/geometry.hpp"
 
 #include "tethash/error.hpp"
@@ -59,141 +61,49 @@ double segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3&
     return (t >= 0 && t <= 1) ? t : -1;
 }
 
-/// Axis-aligned bounding-box tree over some boundary faces at fixed positions.
+/// The triangle tree over some boundary faces at fixed positions.
 class Bvh {
   public:
-    struct Node {
-        Vec3 lo, hi;
-        Index left = -1, right = -1; // children (inner) or −1
-        Index first = 0, count = 0;  // face range in m_order (leaf)
-    };
-
     void build(const PositionsRef& x, const std::vector<Face>& faces)
     {
         m_faces = &faces;
-        m_nodes.clear();
-        m_order.resize(faces.size());
-        std::iota(m_order.begin(), m_order.end(), 0);
-        m_lo.resize(faces.size());
-        m_hi.resize(faces.size());
-        m_center.resize(faces.size());
-        for (size_t f = 0; f < faces.size(); ++f) {
-            const Vec3 a = pos(x, faces[f].v[0]), b = pos(x, faces[f].v[1]), c = pos(x, faces[f].v[2]);
-            m_lo[f] = a.cwiseMin(b).cwiseMin(c);
-            m_hi[f] = a.cwiseMax(b).cwiseMax(c);
-            m_center[f] = (a + b + c) / 3.0;
-        }
-        if (!faces.empty()) build_node(0, static_cast<Index>(faces.size()));
+        m_tree.build(
+            static_cast<Index>(faces.size()),
+            [&](Index f, Vec3& a, Vec3& b, Vec3& c) {
+                const Face& fc = faces[static_cast<size_t>(f)];
+                a = pos(x, fc.v[0]);
+                b = pos(x, fc.v[1]);
+                c = pos(x, fc.v[2]);
+            },
+            4);
     }
 
-    bool empty() const { return m_nodes.empty(); }
+    bool empty() const { return m_tree.empty(); }
 
     /// Visits faces whose box meets the segment's box.
     template <class F> void for_segment(const Vec3& p, const Vec3& q, F&& visit) const
     {
-        if (m_nodes.empty()) return;
-        const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
-        Index stack[128];
-        int top = 0;
-        stack[top++] = 0;
-        while (top) {
-            const Node& n = m_nodes[static_cast<size_t>(stack[--top])];
-            if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
-            if (n.left < 0) {
-                for (Index k = n.first; k < n.first + n.count; ++k)
-                    visit(m_order[static_cast<size_t>(k)]);
-            } else if (top < 126) {
-                stack[top++] = n.left;
-                stack[top++] = n.right;
-            }
-        }
+        m_tree.for_box(p.cwiseMin(q), p.cwiseMax(q), visit);
     }
 
     /// Closest point over faces accepted by `accept(face)`: returns face id (−1 if none) and fills point, dist².
     template <class A>
     Index closest(const PositionsRef& x, const Vec3& p, A&& accept, Vec3& best_point, double& best_d2) const
     {
-        best_d2 = std::numeric_limits<double>::infinity();
-        Index best = -1;
-        if (m_nodes.empty()) return best;
-        Index stack[128];
-        int top = 0;
-        stack[top++] = 0;
-        while (top) {
-            const Node& n = m_nodes[static_cast<size_t>(stack[--top])];
-            const Vec3 d = (n.lo - p).cwiseMax(p - n.hi).cwiseMax(Vec3::Zero());
-            if (d.squaredNorm() >= best_d2) continue;
-            if (n.left < 0) {
-                for (Index k = n.first; k < n.first + n.count; ++k) {
-                    const Index f = m_order[static_cast<size_t>(k)];
-                    const Face& fc = (*m_faces)[static_cast<size_t>(f)];
-                    if (!accept(fc)) continue;
-                    const Vec3 c = closest_point_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
-                    const double d2 = (c - p).squaredNorm();
-                    if (d2 < best_d2) {
-                        best_d2 = d2;
-                        best_point = c;
-                        best = f;
-                    }
-                }
-            } else if (top < 126) {
-                // Nearer child last so that it is popped first.
-                const Node& l = m_nodes[static_cast<size_t>(n.left)];
-                const Node& r = m_nodes[static_cast<size_t>(n.right)];
-                const double dl = (l.lo - p).cwiseMax(p - l.hi).cwiseMax(Vec3::Zero()).squaredNorm();
-                const double dr = (r.lo - p).cwiseMax(p - r.hi).cwiseMax(Vec3::Zero()).squaredNorm();
-                if (dl < dr) {
-                    stack[top++] = n.right;
-                    stack[top++] = n.left;
-                } else {
-                    stack[top++] = n.left;
-                    stack[top++] = n.right;
-                }
-            }
-        }
-        return best;
+        return m_tree.closest(
+            p,
+            [&](Index f, Vec3& q) {
+                const Face& fc = (*m_faces)[static_cast<size_t>(f)];
+                if (!accept(fc)) return false;
+                q = closest_point_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+                return true;
+            },
+            best_point, best_d2);
     }
 
   private:
-    Index build_node(Index first, Index count)
-    {
-        const Index id = static_cast<Index>(m_nodes.size());
-        m_nodes.emplace_back();
-        Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-        Vec3 clo = lo, chi = hi;
-        for (Index k = first; k < first + count; ++k) {
-            const size_t f = static_cast<size_t>(m_order[static_cast<size_t>(k)]);
-            lo = lo.cwiseMin(m_lo[f]);
-            hi = hi.cwiseMax(m_hi[f]);
-            clo = clo.cwiseMin(m_center[f]);
-            chi = chi.cwiseMax(m_center[f]);
-        }
-        m_nodes[static_cast<size_t>(id)].lo = lo;
-        m_nodes[static_cast<size_t>(id)].hi = hi;
-        // Depth is bounded by the median split: log2(faces) levels (the traversal stack holds 128).
-        if (count <= 4) {
-            m_nodes[static_cast<size_t>(id)].first = first;
-            m_nodes[static_cast<size_t>(id)].count = count;
-            return id;
-        }
-        int axis = 0;
-        (chi - clo).maxCoeff(&axis);
-        const Index mid = first + count / 2;
-        std::nth_element(m_order.begin() + first, m_order.begin() + mid, m_order.begin() + first + count,
-                         [&](Index a, Index b) {
-                             return m_center[static_cast<size_t>(a)][axis] < m_center[static_cast<size_t>(b)][axis];
-                         });
-        const Index l = build_node(first, mid - first);
-        const Index r = build_node(mid, first + count - mid);
-        m_nodes[static_cast<size_t>(id)].left = l;
-        m_nodes[static_cast<size_t>(id)].right = r;
-        return id;
-    }
-
     const std::vector<Face>* m_faces = nullptr;
-    std::vector<Node> m_nodes;
-    std::vector<Index> m_order;
-    std::vector<Vec3> m_lo, m_hi, m_center;
+    detail::TriangleBvh m_tree;
 };
 
 } // namespace

@@ -7,6 +7,7 @@
 #include "tethash/io/gmsh.hpp"
 
 #include "tethash/error.hpp"
+#include "number.hpp"
 #include "text_reader.hpp"
 
 #include <algorithm>
@@ -308,11 +309,11 @@ class MshReader {
         if (m_r.peek().empty())
             m_r.next(std::string("the ") + names[axis] + " coordinate of node " + std::to_string(tag));
         const std::string_view tok = m_r.next("a coordinate");
-        double v = 0;
-        if (!detail::parse_double(tok, v) || !std::isfinite(v))
+        const auto v = detail::parse_double(tok);
+        if (!v || !std::isfinite(*v))
             m_r.fail(std::string("a finite ") + names[axis] + " coordinate of node " + std::to_string(tag),
                      TextReader::describe(tok));
-        return v;
+        return *v;
     }
 
     void expect_end(std::string_view marker)
@@ -862,7 +863,7 @@ void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
     }
     o.end_binary();
     o.s += "$EndElements\n";
-    write_atomically(path, [&](const std::string& tmp) { detail::write_file_bytes(tmp, o.s); });
+    write_text_file(path, o.s);
 }
 
 } // namespace tethash::io

@@ -4,9 +4,10 @@
 // Tetrahedra (v0 v1 v2 v3 ref, 1-based -> TetMesh::tet_label), End. Other blocks (Triangles, Edges,
 // Corners, Ridges, Normals, ...) are skipped: known ones by their entry size, unknown ones as
 // "KEYWORD count" followed by count lines. '#' starts a comment.
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/medit.hpp"
 
 #include "tethash/error.hpp"
+#include "number.hpp"
 #include "text_reader.hpp"
 
 #include <algorithm>
@@ -23,12 +24,7 @@ using detail::TextReader;
 
 constexpr std::int64_t k_max_int32 = std::numeric_limits<std::int32_t>::max();
 
-std::string lower(std::string_view s)
-{
-    std::string out(s);
-    std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
-    return out;
-}
+using detail::to_lower;
 
 /// Tokens per entry of blocks that are skipped (lower-case keyword).
 int medit_entry_tokens(const std::string& keyword)
@@ -69,7 +65,7 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
     TextReader r(path, '#');
     {
         const std::string_view first = r.next("MeshVersionFormatted");
-        if (lower(first) != "meshversionformatted") r.fail("MeshVersionFormatted", TextReader::describe(first));
+        if (to_lower(first) != "meshversionformatted") r.fail("MeshVersionFormatted", TextReader::describe(first));
         const std::int64_t version = r.next_int("the MeshVersionFormatted number");
         if (version < 1 || version > 4)
             r.fail("MeshVersionFormatted 1, 2, 3 or 4", "version " + std::to_string(version));
@@ -80,7 +76,7 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
     std::map<std::string, std::int64_t> skipped;
     while (!r.at_end()) {
         const std::string_view tok = r.next("a keyword");
-        const std::string key = lower(tok);
+        const std::string key = to_lower(tok);
         if (key == "end") break;
         if (key == "dimension") {
             const std::int64_t d = r.next_int("the dimension");
@@ -99,11 +95,11 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
             for (std::int64_t i = 0; i < n; ++i) {
                 for (int a = 0; a < 3; ++a) {
                     const std::string_view t = r.next("a coordinate");
-                    double v = 0;
-                    if (!detail::parse_double(t, v) || !std::isfinite(v))
+                    const auto v = detail::parse_double(t);
+                    if (!v || !std::isfinite(*v))
                         r.fail(std::string("a finite ") + axis[a] + " coordinate of vertex " + std::to_string(i + 1),
                                TextReader::describe(t));
-                    mesh.positions(static_cast<Index>(i), a) = v;
+                    mesh.positions(static_cast<Index>(i), a) = *v;
                 }
                 mesh.vertex_label[static_cast<std::size_t>(i)] =
                     static_cast<Index>(r.next_int_in("the reference of vertex " + std::to_string(i + 1),
@@ -214,7 +210,7 @@ void write_medit(const std::string& path, const TetMesh& mesh)
         s += '\n';
     }
     s += "\nEnd\n";
-    write_atomically(path, [&](const std::string& tmp) { detail::write_file_bytes(tmp, s); });
+    write_text_file(path, s);
 }
 
 } // namespace tethash::io

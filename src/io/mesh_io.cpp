@@ -3,36 +3,31 @@
 #include "tethash/error.hpp"
 #include "tethash/io/gmsh.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/io/medit.hpp"
 #include "tethash/io/tetgen.hpp"
-#include "tethash/io/vtk.hpp"
+#include "tethash/io/vega.hpp"
+#include "tethash/io/vtk_legacy.hpp"
+#include "tethash/io/vtu.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <cctype>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <fcntl.h>
+#include <array>
 #include <filesystem>
-#include <memory>
-#include <unistd.h>
+#include <string_view>
 
 namespace tethash::io {
 
-std::string extension_of(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    return ext;
-}
-
-bool is_tet_mesh_path(const std::string& path)
-{
-    const std::string e = extension_of(path);
-    return e == ".vtk" || e == ".vtu" || e == ".msh" || e == ".node" || e == ".ele" || e == ".mesh" || e == ".veg";
-}
-
 namespace {
+
+// The extensions of the tet-mesh formats read_mesh and write_mesh know, and of the surfaces written.
+constexpr std::array<std::string_view, 7> k_tet_read{".vtk", ".vtu", ".msh", ".node", ".ele", ".mesh", ".veg"};
+constexpr std::array<std::string_view, 6> k_tet_write{".vtu", ".vtk", ".msh", ".mesh", ".node", ".ele"};
+constexpr std::array<std::string_view, 5> k_surface_write{".obj", ".ply", ".stl", ".gltf", ".glb"};
+constexpr const char* k_write_formats = "(expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)";
+
+template <std::size_t N> bool is_one_of(const std::string& e, const std::array<std::string_view, N>& list)
+{
+    return std::find(list.begin(), list.end(), e) != list.end();
+}
 
 /// After --linearize: the mid-edge nodes of quadratic tets are vertices of no tet, and would be found lying on the
 /// edges of their tets. Drops every vertex of no tet; the rest keep their order, and notes->vertex_ids their
@@ -78,6 +73,11 @@ void drop_unused_vertices(TetMesh& mesh, ReadNotes* notes)
 }
 
 } // namespace
+
+bool is_tet_mesh_path(const std::string& path)
+{
+    return is_one_of(extension_of(path), k_tet_read);
+}
 
 TetMesh read_mesh(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
@@ -145,175 +145,16 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
     else if (is_surface_path(path))
         write_surface(path, boundary_surface(mesh));
     else
-        throw Error(path + ": unknown output format '" + e +
-                    "' (expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
-}
-
-namespace {
-
-namespace fs = std::filesystem;
-
-/// Folder that will hold `target` ("." for a bare file name).
-fs::path folder_of(const fs::path& target)
-{
-    return target.has_parent_path() ? target.parent_path() : fs::path(".");
-}
-
-/// A unique hidden temporary name next to `target`.
-fs::path temporary_for(const fs::path& target)
-{
-    static std::atomic<int> counter{0};
-    std::string name = target.filename().string(); // appended piecewise: g++ 12 warns falsely on "." + string
-    name.insert(name.begin(), '.');
-    name.append(".tmp").append(std::to_string(::getpid())).append("_").append(std::to_string(counter++));
-    return folder_of(target) / name;
-}
-
-/// `text` with every occurrence of `from` replaced by `to`.
-std::string replace_all(std::string text, const std::string& from, const std::string& to)
-{
-    if (from.empty()) return text;
-    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
-        text.replace(at, from.size(), to);
-    return text;
-}
-
-/// Temporary files being written, for remove_temporaries_now(): fixed slots so that a signal handler
-/// can walk them without locks or allocation. A path that does not fit or finds no slot is not tracked.
-struct TemporarySlot {
-    std::atomic<bool> used{false};
-    char path[4096] = {};
-};
-TemporarySlot g_temporaries[16];
-std::atomic<bool> g_claimed[16];
-
-/// Tracks `path` while alive.
-class TrackedTemporary {
-  public:
-    explicit TrackedTemporary(const std::string& path)
-    {
-        if (path.size() >= sizeof(TemporarySlot::path)) return;
-        for (int i = 0; i < 16; ++i) {
-            bool expected = false;
-            if (g_claimed[i].compare_exchange_strong(expected, true)) {
-                std::memcpy(g_temporaries[i].path, path.c_str(), path.size() + 1);
-                g_temporaries[i].used.store(true, std::memory_order_release);
-                m_slot = i;
-                return;
-            }
-        }
-    }
-    ~TrackedTemporary()
-    {
-        if (m_slot < 0) return;
-        g_temporaries[m_slot].used.store(false, std::memory_order_release);
-        g_claimed[m_slot].store(false);
-    }
-    TrackedTemporary(const TrackedTemporary&) = delete;
-    TrackedTemporary& operator=(const TrackedTemporary&) = delete;
-
-  private:
-    int m_slot = -1;
-};
-
-void check_target(const std::string& path)
-{
-    const fs::path target(path);
-    if (path.empty()) throw Error("empty output file name");
-    if (fs::is_directory(target)) throw Error(path + ": is a directory, expected a file name");
-    const fs::path dir = folder_of(target);
-    if (!fs::exists(dir)) throw Error(path + ": folder '" + dir.string() + "' does not exist");
-    if (!fs::is_directory(dir)) throw Error(path + ": '" + dir.string() + "' is not a folder");
-}
-
-} // namespace
-
-void write_atomically(const std::vector<std::string>& paths,
-                      const std::function<void(const std::vector<std::string>&)>& write)
-{
-    for (const std::string& p : paths)
-        check_target(p);
-    std::vector<std::string> tmps;
-    for (const std::string& p : paths)
-        tmps.push_back(temporary_for(p).string());
-    std::vector<std::unique_ptr<TrackedTemporary>> tracked;
-    for (const std::string& t : tmps)
-        tracked.push_back(std::make_unique<TrackedTemporary>(t));
-    auto remove_temporaries = [&] {
-        for (const std::string& t : tmps) {
-            std::error_code ec;
-            fs::remove(t, ec);
-        }
-    };
-    try {
-        write(tmps);
-        for (std::size_t i = 0; i < paths.size(); ++i) {
-            std::error_code ec;
-            fs::rename(tmps[i], paths[i], ec);
-            if (ec) throw Error(paths[i] + ": cannot move the temporary file into place: " + ec.message());
-        }
-    } catch (const Error& e) {
-        remove_temporaries();
-        std::string msg = e.what();
-        for (std::size_t i = 0; i < paths.size(); ++i)
-            msg = replace_all(msg, tmps[i], paths[i]);
-        throw Error(msg);
-    } catch (...) {
-        remove_temporaries();
-        throw;
-    }
-}
-
-void remove_temporaries_now() noexcept
-{
-    for (auto& slot : g_temporaries)
-        if (slot.used.load(std::memory_order_acquire)) ::unlink(slot.path);
-}
-
-void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write)
-{
-    write_atomically(std::vector<std::string>{path}, [&](const std::vector<std::string>& tmps) { write(tmps[0]); });
-}
-
-void write_text_file(const std::string& path, const std::string& text)
-{
-    write_atomically(path, [&](const std::string& tmp) {
-        std::FILE* f = std::fopen(tmp.c_str(), "wb");
-        if (!f) throw Error(path + ": cannot create file: " + std::strerror(errno));
-        errno = 0;
-        const bool wrote = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-        const bool flushed = std::fflush(f) == 0;
-        const int err = errno;
-        const bool closed = std::fclose(f) == 0;
-        if (!wrote || !flushed || !closed) throw Error(path + ": write failed: " + std::strerror(err ? err : EIO));
-    });
-}
-
-void check_output_file(const std::string& path, const std::string& what)
-{
-    try {
-        check_target(path);
-    } catch (const Error& e) {
-        throw Error(what + ": " + e.what());
-    }
-    // Probe the folder: permissions, read-only file systems and special folders all show up here.
-    const fs::path probe = temporary_for(fs::path(path));
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
-    if (fd < 0)
-        throw Error(what + ": " + path + ": cannot create files in folder '" + folder_of(fs::path(path)).string() +
-                    "': " + std::strerror(errno));
-    ::close(fd);
-    ::unlink(probe.c_str());
+        throw Error(path + ": unknown output format '" + e + "' " + k_write_formats);
 }
 
 void check_mesh_output_file(const std::string& path, const std::string& what)
 {
     const std::string e = extension_of(path);
-    const bool tet = e == ".vtu" || e == ".vtk" || e == ".msh" || e == ".mesh" || e == ".node" || e == ".ele";
-    const bool surface = e == ".obj" || e == ".ply" || e == ".stl" || e == ".gltf" || e == ".glb";
-    if (!fs::is_directory(path) && !tet && !surface)
-        throw Error(what + ": " + path + ": unknown output format '" + e +
-                    "' (expected .vtu .vtk .msh .mesh .node, or a surface .obj .ply .stl .gltf .glb)");
+    const bool tet = is_one_of(e, k_tet_write);
+    const bool surface = is_one_of(e, k_surface_write);
+    if (!std::filesystem::is_directory(path) && !tet && !surface)
+        throw Error(what + ": " + path + ": unknown output format '" + e + "' " + k_write_formats);
     if (surface && !have_assimp())
         throw Error(what + ": " + path + ": cannot write surfaces: tethash was built without assimp");
     check_output_file(path, what);

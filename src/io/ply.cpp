@@ -5,10 +5,10 @@
 #include "ply.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/io/file.hpp"
 #include "vtk_detail.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -278,11 +278,7 @@ class PlyReader {
 
 void read_ply(const std::string& path, std::vector<double>& xyz, std::vector<Index>& tri)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open file for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    PlyReader(path, ss.str()).read(xyz, tri);
+    PlyReader(path, read_file(path)).read(xyz, tri);
 }
 
 } // namespace tethash::io::detail

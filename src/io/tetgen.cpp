@@ -8,6 +8,7 @@
 #include "tethash/io/tetgen.hpp"
 
 #include "tethash/error.hpp"
+#include "number.hpp"
 #include "text_reader.hpp"
 
 #include <cmath>
@@ -208,10 +209,7 @@ void write_tetgen(const std::string& path, const TetMesh& mesh)
     }
     // Both files are complete before either replaces an existing one: a failed write never leaves a
     // new .node beside an old .ele.
-    write_atomically(std::vector<std::string>{node_path, ele_path}, [&](const std::vector<std::string>& tmp) {
-        detail::write_file_bytes(tmp[0], s);
-        detail::write_file_bytes(tmp[1], e);
-    });
+    write_text_files({node_path, ele_path}, {s, e});
 }
 
 } // namespace tethash::io

@@ -1,39 +1,18 @@
 #include "text_reader.hpp"
 
+#include "number.hpp"
+#include "tethash/io/file.hpp"
+
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace tethash::io::detail {
-
-std::string read_file_bytes(const std::string& path)
-{
-    if (std::filesystem::is_directory(path)) throw Error(path + ": is a directory, expected a file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw Error(path + ": read error");
-    return ss.str();
-}
-
-void write_file_bytes(const std::string& path, const std::string& content)
-{
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path + ": cannot open for writing");
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.close();
-    if (!out) throw Error(path + ": write error (disk full?)");
-}
 
 TextReader::TextReader(std::string path, char comment, char extra_separator)
     : m_path(std::move(path)), m_comment(comment), m_extra(extra_separator)
 {
-    m_data = read_file_bytes(m_path);
+    m_data = read_file(m_path);
 }
 
 TextReader::TextReader(std::string path, std::string content, char comment, char extra_separator)
@@ -110,9 +89,9 @@ void TextReader::expect(std::string_view word, bool ignore_case)
 std::int64_t TextReader::next_int(std::string_view what)
 {
     const std::string_view tok = next(what);
-    std::int64_t v = 0;
-    if (!parse_int(tok, v)) fail(std::string(what) + " (an integer)", describe(tok));
-    return v;
+    const auto v = parse_int(tok);
+    if (!v) fail(std::string(what) + " (an integer)", describe(tok));
+    return *v;
 }
 
 std::int64_t TextReader::next_int_in(std::string_view what, std::int64_t lo, std::int64_t hi)
@@ -126,18 +105,18 @@ std::int64_t TextReader::next_int_in(std::string_view what, std::int64_t lo, std
 double TextReader::next_double(std::string_view what)
 {
     const std::string_view tok = next(what);
-    double v = 0;
-    if (!parse_double(tok, v)) fail(std::string(what) + " (a number)", describe(tok));
-    if (!std::isfinite(v)) fail(std::string(what) + " (a finite number)", describe(tok));
-    return v;
+    const auto v = parse_double(tok);
+    if (!v) fail(std::string(what) + " (a number)", describe(tok));
+    if (!std::isfinite(*v)) fail(std::string(what) + " (a finite number)", describe(tok));
+    return *v;
 }
 
 double TextReader::next_double_any(std::string_view what)
 {
     const std::string_view tok = next(what);
-    double v = 0;
-    if (!parse_double(tok, v)) fail(std::string(what) + " (a number)", describe(tok));
-    return v;
+    const auto v = parse_double(tok);
+    if (!v) fail(std::string(what) + " (a number)", describe(tok));
+    return *v;
 }
 
 void TextReader::skip_rest_of_line()
@@ -243,43 +222,6 @@ void TextReader::skip_bytes(std::size_t count, std::string_view what)
         fail_at_byte(m_pos, "expected " + std::string(what) + " (" + std::to_string(count) +
                                 " bytes), found end of file after " + std::to_string(m_data.size() - m_pos) + " bytes");
     m_pos += count;
-}
-
-bool parse_int(std::string_view token, std::int64_t& value)
-{
-    if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-    if (token.empty()) return false;
-    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    return ec == std::errc() && ptr == token.data() + token.size();
-}
-
-bool parse_double(std::string_view token, double& value)
-{
-    if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-    if (token.empty()) return false;
-    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (ec == std::errc::result_out_of_range) {
-        // Denormal or huge: let strtod decide (it gives 0 or ±HUGE_VAL, which the finite check catches).
-        value = std::strtod(std::string(token).c_str(), nullptr);
-        return ptr == token.data() + token.size();
-    }
-    return ec == std::errc() && ptr == token.data() + token.size();
-}
-
-void append_double(std::string& out, double value)
-{
-    char buf[64];
-    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);
-    (void)ec;
-    out.append(buf, ptr);
-}
-
-void append_int(std::string& out, std::int64_t value)
-{
-    char buf[32];
-    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);
-    (void)ec;
-    out.append(buf, ptr);
 }
 
 } // namespace tethash::io::detail

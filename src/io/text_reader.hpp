@@ -2,8 +2,7 @@
 /// \file text_reader.hpp
 /// Internal to tethash::io: a tokenizer over a whole file held in memory that tracks line numbers
 /// (for "FILE:LINE: expected X, found Y" messages) and can also read raw binary values at the current
-/// byte offset (for formats that mix text and binary, such as binary Gmsh files), plus small helpers
-/// for writing numbers as text that read back exactly.
+/// byte offset (for formats that mix text and binary, such as binary Gmsh files).
 
 #include "tethash/error.hpp"
 
@@ -15,9 +14,6 @@
 #include <utility>
 
 namespace tethash::io::detail {
-
-/// Reads a whole file into a string; throws Error "PATH: cannot open ..." when it cannot.
-std::string read_file_bytes(const std::string& path);
 
 /// Whitespace-separated tokens with line numbers; optional end-of-line comments and extra separators.
 class TextReader {
@@ -119,17 +115,5 @@ class TextReader {
     char m_extra = '\0';
     bool m_swap = false;
 };
-
-/// Parses a whole token as an integer; false if it is not one.
-bool parse_int(std::string_view token, std::int64_t& value);
-/// Parses a whole token as a double (a leading '+' allowed; "nan"/"inf" parse); false if it is not one.
-bool parse_double(std::string_view token, double& value);
-
-/// Appends the shortest text that reads back as exactly `value`.
-void append_double(std::string& out, double value);
-void append_int(std::string& out, std::int64_t value);
-
-/// Writes `content` to `path` (binary mode); throws Error if the file cannot be written.
-void write_file_bytes(const std::string& path, const std::string& content);
 
 } // namespace tethash::io::detail

@@ -5,7 +5,7 @@
 // "id v0 v1 v2 v3" (1-based). Other sections (*MATERIAL, *REGION, *SET, *SOLVER ...) are skipped up to
 // the next '*' keyword; *INCLUDE is rejected (the included file would be needed). '#' starts a
 // comment and commas separate values like spaces.
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/vega.hpp"
 
 #include "tethash/error.hpp"
 #include "text_reader.hpp"

@@ -1,6 +1,7 @@
 #pragma once
 // Private helpers shared by the VTK legacy (.vtk) and XML (.vtu/.pvd) readers and writers:
-// scalar types, byte order, number parsing and formatting, label fields, base64.
+// scalar types, byte order, label fields, base64 (numbers as text: number.hpp).
+#include "number.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 #include <cstdint>
@@ -30,13 +31,9 @@ void convert_to_double(const unsigned char* src, Scalar t, std::size_t count, bo
 /// Same, to int64 (floating values are truncated toward zero; callers use integer types for indices).
 void convert_to_int64(const unsigned char* src, Scalar t, std::size_t count, bool big_endian, std::int64_t* out);
 
-/// Parses a whole token as a number; nullopt if it is not one. Accepts a leading '+', nan and inf.
-std::optional<double> parse_double(std::string_view token);
-/// Parses a whole token as an integer; nullopt if it is not one (no fraction, no exponent).
-std::optional<std::int64_t> parse_int(std::string_view token);
-
-/// Shortest text that reads back to exactly `v` ("0.1", "1e-300", "nan").
-std::string format_double(double v);
+using detail::format_double;
+using detail::parse_double;
+using detail::parse_int;
 
 /// A token for an error message: printable, at most ~24 characters, in quotes.
 std::string quote_token(std::string_view token);

@@ -1,13 +1,12 @@
 // Legacy VTK (.vtk) UNSTRUCTURED_GRID reader and writer.
 #include "tethash/error.hpp"
-#include "tethash/io/vtk.hpp"
+#include "tethash/io/file.hpp"
+#include "tethash/io/vtk_legacy.hpp"
 #include "vtk_detail.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 namespace tethash::io {
 namespace {
@@ -19,22 +18,7 @@ bool is_space(char c)
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
 }
 
-std::string lower(std::string_view s)
-{
-    std::string r(s);
-    for (char& c : r)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return r;
-}
-
-std::string read_file(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path + ": cannot open file for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+using detail::to_lower;
 
 /// Where an array's values start, to name the place of value k in an error message.
 struct ArrayPlace {
@@ -298,8 +282,8 @@ void LegacyReader::read_field_block(bool in_data, std::size_t count, std::vector
     const std::int64_t arrays = expect_int("the number of arrays of FIELD " + field_name, 0);
     for (std::int64_t a = 0; a < arrays; ++a) {
         const std::string name = expect_word("an array name in FIELD " + field_name);
-        if (lower(name) == "null_array") continue;
-        if (lower(name) == "metadata") {
+        if (to_lower(name) == "null_array") continue;
+        if (to_lower(name) == "metadata") {
             skip_metadata();
             --a;
             continue;
@@ -330,7 +314,7 @@ void LegacyReader::read_attribute(const std::string& key, std::size_t count, std
         std::int64_t comps = 1;
         if (token_on_line()) comps = expect_int("the number of components of " + what, 1);
         const std::string where = at_token();
-        if (lower(peek_token()) == "lookup_table") {
+        if (to_lower(peek_token()) == "lookup_table") {
             next_token();
             expect_word("the lookup table name of " + what);
         }
@@ -364,7 +348,7 @@ TetMesh LegacyReader::read()
     // ---- header: version line, title, ASCII/BINARY
     const std::string first = read_line();
     const std::string magic = "# vtk datafile version";
-    if (lower(first.substr(0, magic.size())) != magic)
+    if (to_lower(first.substr(0, magic.size())) != magic)
         fail(at_line(1), "expected '# vtk DataFile Version X.Y', found " + quote_token(first));
     std::string version = first.substr(magic.size());
     while (!version.empty() && is_space(version.front()))
@@ -387,15 +371,15 @@ TetMesh LegacyReader::read()
         format.pop_back();
     while (!format.empty() && is_space(format.front()))
         format.erase(format.begin());
-    if (lower(format) == "binary")
+    if (to_lower(format) == "binary")
         m_binary = true;
-    else if (lower(format) != "ascii")
+    else if (to_lower(format) != "ascii")
         fail(at_line(3), "expected ASCII or BINARY, found " + quote_token(format));
 
     next_token();
-    if (lower(m_tok) != "dataset") fail(at_token(), "expected DATASET, found " + found_token());
+    if (to_lower(m_tok) != "dataset") fail(at_token(), "expected DATASET, found " + found_token());
     next_token();
-    if (lower(m_tok) != "unstructured_grid")
+    if (to_lower(m_tok) != "unstructured_grid")
         fail(at_token(), "expected UNSTRUCTURED_GRID (the only dataset tethash reads), found " + found_token());
 
     // ---- sections
@@ -415,7 +399,7 @@ TetMesh LegacyReader::read()
     for (;;) {
         next_token();
         if (m_tok.empty()) break;
-        const std::string key = lower(m_tok);
+        const std::string key = to_lower(m_tok);
         if (key == "points") {
             if (have_points) fail(at_token(), "expected one POINTS section, found a second one");
             num_points = expect_int("the number of points", 0);
@@ -435,7 +419,7 @@ TetMesh LegacyReader::read()
             cells_where = at_token();
             const std::int64_t a = expect_int("the number of cells", 0);
             const std::int64_t b = expect_int("the size of the cell list", 0);
-            if (lower(peek_token()) == "offsets") {
+            if (to_lower(peek_token()) == "offsets") {
                 // Version 5.x layout: OFFSETS (a values) then CONNECTIVITY (b values).
                 next_token();
                 const Scalar ot = expect_type("OFFSETS");
@@ -444,7 +428,7 @@ TetMesh LegacyReader::read()
                 ArrayPlace offsets_place;
                 offsets = read_values<std::int64_t>(static_cast<std::size_t>(a), ot, "OFFSETS", &offsets_place);
                 next_token();
-                if (lower(m_tok) != "connectivity") fail(at_token(), "expected CONNECTIVITY, found " + found_token());
+                if (to_lower(m_tok) != "connectivity") fail(at_token(), "expected CONNECTIVITY, found " + found_token());
                 const Scalar ct = expect_type("CONNECTIVITY");
                 if (ct == Scalar::Bit)
                     fail(at_token(), "expected the data type of CONNECTIVITY to be an integer type, found bit");
@@ -682,13 +666,7 @@ void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& field
     write_arrays(out, binary, "POINT_DATA", n, point_arrays);
     write_arrays(out, binary, "CELL_DATA", m, cell_arrays);
 
-    write_atomically(path, [&](const std::string& tmp) {
-        std::ofstream f(tmp, std::ios::binary);
-        if (!f) throw Error(path + ": cannot open '" + tmp + "' for writing");
-        f.write(out.data(), static_cast<std::streamsize>(out.size()));
-        f.close();
-        if (!f) throw Error(path + ": writing failed (disk full?)");
-    });
+    write_text_file(path, out);
 }
 
 } // namespace tethash::io

@@ -2,7 +2,7 @@
 #include "command.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 #include <fmt/core.h>
@@ -48,7 +48,7 @@ void run_generate(const GenerateOptions& o)
         throw Error("--list prints the shapes and makes nothing: give it alone, or drop --list to make '" +
                     (o.shape.empty() ? std::string("SHAPE") : o.shape) + "'");
     if (o.list) {
-        for (const io::ShapeInfo& s : io::shape_catalog())
+        for (const meshing::ShapeInfo& s : meshing::shape_catalog())
             fmt::print("{:<10} {:.4g} x {:.4g} x {:.4g}  {}\n", s.name, s.natural_size.x(), s.natural_size.y(),
                        s.natural_size.z(), s.description);
         return;
@@ -58,7 +58,7 @@ void run_generate(const GenerateOptions& o)
     if (o.resolution < 1 || o.resolution > 1000)
         throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1 and at most 1000");
     io::check_mesh_output_file(o.out, "--out");
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = o.shape;
     p.resolution = o.resolution;
     p.snap = !o.no_snap;
@@ -72,7 +72,7 @@ void run_generate(const GenerateOptions& o)
                                         o.size[2]));
         p.size = Eigen::Vector3d(o.size[0], o.size[1], o.size[2]);
     }
-    const TetMesh mesh = io::generate(p);
+    const TetMesh mesh = meshing::generate(p);
     io::write_mesh(o.out, mesh);
     fmt::print("generated {} at resolution {}{}: {} -> {}\n", o.shape, o.resolution, p.snap ? "" : " (not snapped)",
                describe_made_mesh(mesh), o.out);

@@ -3,7 +3,8 @@
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "tethash/io/vtk.hpp"
+#include "tethash/io/pvd.hpp"
+#include "tethash/io/vtu.hpp"
 #include "tethash/sim/simulation.hpp"
 
 #include <fmt/format.h>

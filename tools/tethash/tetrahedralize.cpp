@@ -2,7 +2,7 @@
 #include "command.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
 
@@ -108,7 +108,7 @@ void run_tetrahedralize(const TetrahedralizeOptions& o)
                                 "'tethash convert' changes the format of tet meshes");
     io::check_mesh_output_file(o.out, "--out");
     const io::SurfaceMesh s = io::read_surface(o.surface);
-    io::TetrahedralizeParams p;
+    meshing::TetrahedralizeParams p;
     p.resolution = o.resolution;
     p.snap = !o.no_snap;
     const std::int64_t open = open_edges(s);
@@ -119,7 +119,7 @@ void run_tetrahedralize(const TetrahedralizeOptions& o)
                      o.surface.c_str(), static_cast<long long>(open));
     TetMesh mesh;
     try {
-        mesh = io::tetrahedralize(s, p);
+        mesh = meshing::tetrahedralize(s, p);
     } catch (const Error& e) {
         throw Error(o.surface + ": " + e.what());
     }

@@ -1,15 +1,14 @@
 #pragma once
 /// \file io/mesh_io.hpp
-/// Reading and writing tet meshes by file extension, and the helpers every format shares.
+/// Reading and writing tet meshes by file extension, and the types every format shares.
 ///
 /// Readers throw tethash::Error with a message "FILE:LINE: expected X, found Y" (or "FILE: byte
-/// OFFSET: ..." for binary data). Writers write to a temporary name in the target folder and rename
-/// when complete, so a failed write never leaves half a file where a good one was.
+/// OFFSET: ..." for binary data). Writers write atomically (io/file.hpp).
 
+#include "tethash/io/file.hpp"
 #include "tethash/mesh.hpp"
 
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -65,28 +64,6 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
 /// True if `path` has an extension read_mesh knows.
 bool is_tet_mesh_path(const std::string& path);
 
-/// Lower-case extension with the dot (".vtu"), "" if none.
-std::string extension_of(const std::string& path);
-
-/// Writes a file through a temporary name next to it; `write` gets the temporary path.
-/// On success renames over `path`; on any exception removes the temporary and rethrows (an Error
-/// that names the temporary is rethrown naming `path` instead). Throws Error before calling
-/// `write` when `path` is a directory or its folder is missing.
-void write_atomically(const std::string& path, const std::function<void(const std::string& tmp_path)>& write);
-/// The same for files that belong together (TetGen .node + .ele): every file is written to its
-/// temporary first; only when all are complete are they renamed into place.
-void write_atomically(const std::vector<std::string>& paths,
-                      const std::function<void(const std::vector<std::string>& tmp_paths)>& write);
-/// Removes every temporary file that write_atomically is writing at this moment. Async-signal-safe:
-/// for the handler of SIGINT/SIGTERM in a program, so that an interrupted write leaves nothing behind.
-void remove_temporaries_now() noexcept;
-
-/// Writes `text` to `path` through write_atomically, checking every write (Error naming `path`).
-void write_text_file(const std::string& path, const std::string& text);
-
-/// Checks, before any work, that a file can be created at `path`: not a directory, its folder
-/// exists and accepts new files. Throws Error naming `what` (e.g. "--contacts") and the path.
-void check_output_file(const std::string& path, const std::string& what = "output");
 /// check_output_file plus: the extension is one write_mesh knows.
 void check_mesh_output_file(const std::string& path, const std::string& what = "output");
 

@@ -3,13 +3,11 @@
 /// Triangle surfaces through assimp (OBJ, STL, PLY, OFF, glTF, ...): import for obstacles and for
 /// tetrahedralization, export of a tet mesh's boundary. Without assimp these throw Error saying so.
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/surface_mesh.hpp"
 
 namespace tethash::io {
 
-struct SurfaceMesh {
-    Positions vertices;  ///< k × 3
-    Triangles triangles; ///< t × 3
-};
+using meshing::SurfaceMesh;
 
 /// True when tethash was built with assimp.
 bool have_assimp();

@@ -2,7 +2,7 @@
 // ways, bad input, the shared Medit meshes.
 #include "io_formats_support.hpp"
 
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/medit.hpp"
 
 using namespace tethash;
 using namespace tethash::test;
@@ -15,12 +15,7 @@ const char* k_good = "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\
 std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
                              const std::string& name)
 {
-    std::string text = k_good;
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    write_text(dir / name, text);
-    return dir / name;
+    return write_edited(dir / name, k_good, from, to);
 }
 
 } // namespace

@@ -2,7 +2,7 @@
 #include "vtk_detail.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/vtk.hpp"
+#include "number.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -17,15 +17,6 @@
 static_assert(std::endian::native == std::endian::little, "the VTK readers and writers assume a little-endian host");
 
 namespace tethash::io {
-
-bool vtu_zlib_supported()
-{
-#ifdef TETHASH_HAVE_ZLIB
-    return true;
-#else
-    return false;
-#endif
-}
 
 namespace vtk_detail {
 
@@ -99,15 +90,7 @@ std::optional<Scalar> scalar_from_xml(std::string_view n)
     return std::nullopt;
 }
 
-namespace {
-std::string lower(std::string_view s)
-{
-    std::string r(s);
-    for (char& c : r)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return r;
-}
-} // namespace
+using detail::to_lower;
 
 std::optional<Scalar> scalar_from_legacy(std::string_view name)
 {
@@ -136,7 +119,7 @@ std::optional<Scalar> scalar_from_legacy(std::string_view name)
         {"vtktypefloat32", Scalar::Float32},
         {"vtktypefloat64", Scalar::Float64},
     };
-    const std::string n = lower(name);
+    const std::string n = to_lower(name);
     for (const auto& [key, t] : table)
         if (n == key) return t;
     return std::nullopt;
@@ -216,37 +199,6 @@ void convert_to_double(const unsigned char* src, Scalar t, std::size_t count, bo
 void convert_to_int64(const unsigned char* src, Scalar t, std::size_t count, bool big_endian, std::int64_t* out)
 {
     convert(src, t, count, big_endian, out);
-}
-
-std::optional<double> parse_double(std::string_view s)
-{
-    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
-    if (s.empty()) return std::nullopt;
-    double v = 0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec == std::errc::result_out_of_range) {
-        // Denormal or huge: fall back to strtod, which saturates to ±inf/0.
-        return std::strtod(std::string(s).c_str(), nullptr);
-    }
-    if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
-    return v;
-}
-
-std::optional<std::int64_t> parse_int(std::string_view s)
-{
-    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
-    if (s.empty()) return std::nullopt;
-    std::int64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
-    return v;
-}
-
-std::string format_double(double v)
-{
-    char buf[64];
-    const auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v);
-    return ec == std::errc() ? std::string(buf, ptr) : std::string("nan");
 }
 
 std::string quote_token(std::string_view token)
@@ -340,7 +292,7 @@ bool all_integers(const std::vector<double>& v, double min_value)
 
 bool is_label_array_name(std::string_view name, bool cell)
 {
-    const std::string n = lower(name);
+    const std::string n = to_lower(name);
     if (rank_in(n, k_object_names) >= 0) return true;
     return cell ? rank_in(n, k_cell_label_names) >= 0 : rank_in(n, k_point_label_names) >= 0;
 }
@@ -359,7 +311,7 @@ void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arra
         const NamedArray* best = nullptr;
         int best_rank = 1 << 30;
         for (const NamedArray& a : arrays) {
-            const int r = rank_in(lower(a.name), names);
+            const int r = rank_in(to_lower(a.name), names);
             if (r < 0 || r >= best_rank) continue;
             if (a.values.size() != expected) {
                 note(a.where + ": array '" + a.name + "' has " + std::to_string(a.values.size()) +

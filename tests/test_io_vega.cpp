@@ -2,7 +2,7 @@
 // the shared quintupleTorus mesh. meshio has no .veg format, so every file here is hand-made.
 #include "io_formats_support.hpp"
 
-#include "tethash/io/tetgen.hpp"
+#include "tethash/io/vega.hpp"
 
 using namespace tethash;
 using namespace tethash::test;
@@ -15,12 +15,7 @@ const char* k_good = "# comment\n*VERTICES\n5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n
 std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
                              const std::string& name)
 {
-    std::string text = k_good;
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    write_text(dir / name, text);
-    return dir / name;
+    return write_edited(dir / name, k_good, from, to);
 }
 
 } // namespace

@@ -1,7 +1,6 @@
 #pragma once
-/// \file io/vtk.hpp
-/// VTK legacy (.vtk UNSTRUCTURED_GRID, ASCII and BINARY big-endian), VTK XML (.vtu: ascii, base64
-/// binary, raw appended, zlib-compressed if zlib is available) and ParaView .pvd time series.
+/// \file io/vtk_legacy.hpp
+/// VTK legacy .vtk UNSTRUCTURED_GRID, ASCII and BINARY (big-endian).
 ///
 /// Readers keep the tetrahedra (VTK_TETRA, type 10) in file order and skip every other cell type,
 /// counting them in ReadNotes::skipped_cells. Cell arrays named "object" become tet_object, and
@@ -14,8 +13,6 @@
 /// (a user field of the same name takes precedence).
 #include "tethash/io/mesh_io.hpp"
 
-#include <utility>
-
 namespace tethash::io {
 
 /// Legacy .vtk UNSTRUCTURED_GRID, versions 1.0 to 5.1 (both the classic CELLS layout and the
@@ -24,20 +21,5 @@ TetMesh read_vtk(const std::string& path, ReadNotes* notes = nullptr, const Read
 /// Legacy .vtk version 4.2 (classic CELLS layout, read by every VTK/ParaView version);
 /// BINARY (big-endian) unless `binary` is false. Point/cell fields go into FIELD blocks.
 void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& fields = {}, bool binary = true);
-
-/// VTK XML UnstructuredGrid (.vtu): format ascii, binary (base64) or appended (raw or base64),
-/// either byte order, UInt32 or UInt64 headers, vtkZLibDataCompressor (when built with zlib),
-/// several Pieces (concatenated).
-TetMesh read_vtu(const std::string& path, ReadNotes* notes = nullptr, const ReadOptions& options = {});
-/// Binary appended raw data (no base64), little-endian, UInt32 header (UInt64 if an array
-/// exceeds 4 GiB).
-void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields = {});
-/// True if read_vtu can read zlib-compressed files (tethash was built with zlib).
-bool vtu_zlib_supported();
-
-/// (time, file name relative to the .pvd) entries.
-void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries);
-/// The (timestep, file) entries of a ParaView collection, in file order.
-std::vector<std::pair<double, std::string>> read_pvd(const std::string& path);
 
 } // namespace tethash::io

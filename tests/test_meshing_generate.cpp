@@ -1,7 +1,7 @@
 // Tests of io/generate.hpp: shapes on the BCC lattice validate, are deterministic, have the analytic
 // volume, keep good tets, and reject bad parameters.
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +12,10 @@
 #include <map>
 #include <numbers>
 #include <numeric>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 using namespace tethash;
 
@@ -81,9 +85,9 @@ long boundary_manifold_problems(const TetMesh& m)
     return bad;
 }
 
-io::GenerateParams params(const std::string& shape, int resolution, bool snap = true)
+meshing::GenerateParams params(const std::string& shape, int resolution, bool snap = true)
 {
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = shape;
     p.resolution = resolution;
     p.snap = snap;
@@ -94,11 +98,11 @@ io::GenerateParams params(const std::string& shape, int resolution, bool snap = 
 
 TEST(Generate, EveryShapeValidatesSnappedAndUnsnapped)
 {
-    for (const std::string& shape : io::generate_shapes())
+    for (const std::string& shape : meshing::generate_shapes())
         for (bool snap : {false, true})
             for (int res : {8, 12}) {
                 SCOPED_TRACE(shape + " resolution " + std::to_string(res) + (snap ? " snapped" : ""));
-                const TetMesh m = io::generate(params(shape, res, snap));
+                const TetMesh m = meshing::generate(params(shape, res, snap));
                 ASSERT_GT(m.num_tets(), 0);
                 const ValidationReport r = validate(m);
                 EXPECT_TRUE(r.ok());
@@ -113,20 +117,20 @@ TEST(Generate, EveryShapeValidatesSnappedAndUnsnapped)
 
 TEST(Generate, ShapesAreListedWithTheirSizes)
 {
-    const auto names = io::generate_shapes();
+    const auto names = meshing::generate_shapes();
     for (const char* required : {"box", "bar", "sphere", "torus", "cylinder", "capsule"})
         EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
-    EXPECT_EQ(names.size(), io::shape_catalog().size());
-    const Eigen::Vector3d bar = io::shape_natural_size("bar");
+    EXPECT_EQ(names.size(), meshing::shape_catalog().size());
+    const Eigen::Vector3d bar = meshing::shape_natural_size("bar");
     EXPECT_DOUBLE_EQ(bar.x(), 4 * bar.y());
-    EXPECT_THROW(io::shape_natural_size("nope"), Error);
+    EXPECT_THROW(meshing::shape_natural_size("nope"), Error);
 }
 
 TEST(Generate, IsDeterministic)
 {
     for (const char* shape : {"sphere", "blob", "torus"}) {
-        const TetMesh a = io::generate(params(shape, 14));
-        const TetMesh b = io::generate(params(shape, 14));
+        const TetMesh a = meshing::generate(params(shape, 14));
+        const TetMesh b = meshing::generate(params(shape, 14));
         ASSERT_EQ(a.num_vertices(), b.num_vertices()) << shape;
         ASSERT_EQ(a.num_tets(), b.num_tets()) << shape;
         EXPECT_TRUE(a.tets == b.tets) << shape;
@@ -137,33 +141,56 @@ TEST(Generate, IsDeterministic)
     }
 }
 
+TEST(Generate, BitIdenticalAtOneAndTwoThreads)
+{
+#ifndef _OPENMP
+    GTEST_SKIP() << "built without OpenMP";
+#else
+    // The inside test and the snapping targets run in parallel loops; the mesh must not depend on it.
+    const int saved = omp_get_max_threads();
+    for (const char* shape : {"sphere", "blob", "box"}) {
+        TetMesh m[2];
+        for (int threads : {1, 2}) {
+            omp_set_num_threads(threads);
+            m[threads - 1] = meshing::generate(params(shape, 14));
+        }
+        ASSERT_EQ(m[0].num_vertices(), m[1].num_vertices()) << shape;
+        EXPECT_TRUE(m[0].tets == m[1].tets) << shape;
+        EXPECT_EQ(0, std::memcmp(m[0].positions.data(), m[1].positions.data(),
+                                 sizeof(double) * static_cast<std::size_t>(m[0].positions.size())))
+            << shape;
+    }
+    omp_set_num_threads(saved);
+#endif
+}
+
 TEST(Generate, VolumesMatchTheAnalyticShapes)
 {
     const double pi = std::numbers::pi;
     // Snapped meshes: within a few per cent at moderate resolution.
-    EXPECT_NEAR(volume(io::generate(params("sphere", 24))), 4.0 / 3.0 * pi * 0.125, 0.02 * (4.0 / 3.0 * pi * 0.125));
+    EXPECT_NEAR(volume(meshing::generate(params("sphere", 24))), 4.0 / 3.0 * pi * 0.125, 0.02 * (4.0 / 3.0 * pi * 0.125));
     const double torus = 2 * pi * pi * 0.35 * 0.15 * 0.15;
-    EXPECT_NEAR(volume(io::generate(params("torus", 32))), torus, 0.03 * torus);
-    EXPECT_NEAR(volume(io::generate(params("cylinder", 20))), pi * 0.25, 0.03 * pi * 0.25);
+    EXPECT_NEAR(volume(meshing::generate(params("torus", 32))), torus, 0.03 * torus);
+    EXPECT_NEAR(volume(meshing::generate(params("cylinder", 20))), pi * 0.25, 0.03 * pi * 0.25);
     const double capsule = pi * 0.0625 * 1.0 + 4.0 / 3.0 * pi * 0.25 * 0.25 * 0.25;
-    EXPECT_NEAR(volume(io::generate(params("capsule", 24))), capsule, 0.03 * capsule);
+    EXPECT_NEAR(volume(meshing::generate(params("capsule", 24))), capsule, 0.03 * capsule);
     // Boxes snap exactly, including edges and corners, for any size.
-    EXPECT_NEAR(volume(io::generate(params("box", 7))), 1.0, 1e-9);
-    EXPECT_NEAR(volume(io::generate(params("bar", 16))), 4.0, 1e-9);
-    io::GenerateParams p = params("box", 9);
+    EXPECT_NEAR(volume(meshing::generate(params("box", 7))), 1.0, 1e-9);
+    EXPECT_NEAR(volume(meshing::generate(params("bar", 16))), 4.0, 1e-9);
+    meshing::GenerateParams p = params("box", 9);
     p.size = Eigen::Vector3d(1, 2, 3);
-    EXPECT_NEAR(volume(io::generate(p)), 6.0, 1e-9);
+    EXPECT_NEAR(volume(meshing::generate(p)), 6.0, 1e-9);
     // Unsnapped, the sphere is a staircase: still close, but it is the snapping that gets within 1 %.
-    const double unsnapped = volume(io::generate(params("sphere", 24, false)));
+    const double unsnapped = volume(meshing::generate(params("sphere", 24, false)));
     EXPECT_NEAR(unsnapped, 4.0 / 3.0 * pi * 0.125, 0.06 * (4.0 / 3.0 * pi * 0.125));
 }
 
 TEST(Generate, SizeAndScaleSetTheBoundingBox)
 {
-    io::GenerateParams p = params("sphere", 16);
+    meshing::GenerateParams p = params("sphere", 16);
     p.size = Eigen::Vector3d(2, 1, 1);
     p.scale = 3;
-    const TetMesh m = io::generate(p);
+    const TetMesh m = meshing::generate(p);
     const auto [lo, hi] = bounding_box(m.positions);
     const Eigen::Vector3d ext = hi - lo;
     EXPECT_NEAR(ext.x(), 6.0, 0.15);
@@ -174,9 +201,9 @@ TEST(Generate, SizeAndScaleSetTheBoundingBox)
     const double expect = 4.0 / 3.0 * std::numbers::pi * 3 * 1.5 * 1.5;
     EXPECT_NEAR(volume(m), expect, 0.03 * expect);
 
-    io::GenerateParams bar = params("bar", 8);
+    meshing::GenerateParams bar = params("bar", 8);
     bar.scale = 0.5;
-    const auto [blo, bhi] = bounding_box(io::generate(bar).positions);
+    const auto [blo, bhi] = bounding_box(meshing::generate(bar).positions);
     EXPECT_NEAR(bhi.x() - blo.x(), 2.0, 1e-9);
     EXPECT_NEAR(bhi.y() - blo.y(), 0.5, 1e-9);
 }
@@ -184,23 +211,23 @@ TEST(Generate, SizeAndScaleSetTheBoundingBox)
 TEST(Generate, TetQualityStaysBounded)
 {
     // The unsnapped BCC lattice of a cube-proportioned shape: every dihedral angle is 60 or 90 degrees.
-    const auto [lo, hi] = dihedral_range(io::generate(params("sphere", 12, false)));
+    const auto [lo, hi] = dihedral_range(meshing::generate(params("sphere", 12, false)));
     EXPECT_NEAR(lo, 60.0, 1e-6);
     EXPECT_NEAR(hi, 90.0, 1e-6);
     // Snapping never goes below the 10-degree guard; boxes keep far better tets.
-    for (const std::string& shape : io::generate_shapes()) {
-        const auto [slo, shi] = dihedral_range(io::generate(params(shape, 12)));
+    for (const std::string& shape : meshing::generate_shapes()) {
+        const auto [slo, shi] = dihedral_range(meshing::generate(params(shape, 12)));
         EXPECT_GE(slo, 10.0) << shape;
         EXPECT_LT(shi, 170.0) << shape;
     }
-    EXPECT_GE(dihedral_range(io::generate(params("box", 10))).first, 40.0);
+    EXPECT_GE(dihedral_range(meshing::generate(params("box", 10))).first, 40.0);
 }
 
 TEST(Generate, ResolutionSetsTheCellCountAlongTheLongestExtent)
 {
     // Mean edge length ~ h: doubling the resolution halves it.
-    const TetMesh a = io::generate(params("bar", 8, false));
-    const TetMesh b = io::generate(params("bar", 16, false));
+    const TetMesh a = meshing::generate(params("bar", 8, false));
+    const TetMesh b = meshing::generate(params("bar", 16, false));
     const double ea = edge_stats(a.positions, a.tets).mean, eb = edge_stats(b.positions, b.tets).mean;
     EXPECT_NEAR(ea / eb, 2.0, 0.2);
     EXPECT_NEAR(ea, 4.0 / 8 * 0.9, 0.15); // BCC edges: h·√3/2 and h, mean ≈ 0.9 h
@@ -209,42 +236,22 @@ TEST(Generate, ResolutionSetsTheCellCountAlongTheLongestExtent)
 TEST(Generate, RejectsBadParameters)
 {
     try {
-        io::generate(params("dodecahedron", 8));
+        meshing::generate(params("dodecahedron", 8));
         FAIL() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("unknown shape 'dodecahedron'"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("sphere"), std::string::npos) << e.what();
     }
     try {
-        io::generate(params("box", 0));
+        meshing::generate(params("box", 0));
         FAIL() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("resolution 0"), std::string::npos) << e.what();
     }
-    io::GenerateParams p = params("box", 4);
+    meshing::GenerateParams p = params("box", 4);
     p.scale = -1;
-    EXPECT_THROW(io::generate(p), Error);
+    EXPECT_THROW(meshing::generate(p), Error);
     p.scale = 1;
     p.size = Eigen::Vector3d(1, 0, 1);
-    EXPECT_THROW(io::generate(p), Error);
-}
-
-TEST(TetrahedralizeSdf, CustomFunctionAndEmptyInside)
-{
-    // A ball of radius 0.3 off-centre in a 1-box.
-    auto ball = [](const Eigen::Vector3d& p) { return (p - Eigen::Vector3d(0.1, 0, 0)).norm() - 0.3; };
-    const TetMesh m =
-        io::tetrahedralize_sdf(ball, Eigen::Vector3d(-0.2, -0.3, -0.3), Eigen::Vector3d(0.4, 0.3, 0.3), 16, true);
-    const double expect = 4.0 / 3.0 * std::numbers::pi * 0.027;
-    EXPECT_NEAR(volume(m), expect, 0.03 * expect);
-    EXPECT_EQ(validate(m).inverted_tets, 0);
-    // Everything outside: an error that says so.
-    auto nothing = [](const Eigen::Vector3d&) { return 1.0; };
-    try {
-        io::tetrahedralize_sdf(nothing, Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), 4, true);
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("nothing is inside"), std::string::npos) << e.what();
-    }
-    EXPECT_THROW(io::tetrahedralize_sdf(ball, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 1), 4, true), Error);
+    EXPECT_THROW(meshing::generate(p), Error);
 }

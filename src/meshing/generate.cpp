@@ -1,12 +1,15 @@
 // Shapes for `tethash generate`: signed-distance functions meshed on the BCC lattice (tetrahedralize.cpp).
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
+
+#include "tethash/meshing/tetrahedralize.hpp"
 
 #include "tethash/error.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
-namespace tethash::io {
+namespace tethash::meshing {
 
 namespace {
 
@@ -193,4 +196,4 @@ TetMesh generate(const GenerateParams& params)
     }
 }
 
-} // namespace tethash::io
+} // namespace tethash::meshing

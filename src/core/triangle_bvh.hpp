@@ -1,0 +1,174 @@
+#pragma once
+// Private to tethash, shared by core (penetration depth) and meshing (winding numbers, snapping): an
+// axis-aligned bounding-box tree over triangles at fixed positions. Median split along the widest extent
+// of the triangle centres, ties broken by triangle index, so the tree depends on the input only.
+// Depth is bounded by the median split (log2 of the triangle count); the traversal stacks hold 128.
+#include "tethash/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cstddef>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+namespace tethash::detail {
+
+class TriangleBvh {
+  public:
+    using Vec3 = Eigen::Vector3d;
+
+    struct Node {
+        Vec3 lo, hi;                 ///< bounding box of the node's triangles
+        Index left = -1, right = -1; ///< children (inner node) or -1 (leaf)
+        Index first = 0, count = 0;  ///< the node's triangles: item(first) .. item(first + count - 1)
+    };
+
+    /// Builds the tree over triangles 0 .. n-1; `corners(t, a, b, c)` sets the corners of triangle t.
+    /// Nodes with at most `leaf_size` triangles are leaves. `on_node(id, node)`, called for every node
+    /// before its range is split, may gather per-node data (nodes() has `id` + 1 entries at that time;
+    /// its children come later).
+    template <class Corners, class OnNode>
+    void build(Index n, Corners&& corners, Index leaf_size, OnNode&& on_node)
+    {
+        m_nodes.clear();
+        m_order.resize(static_cast<std::size_t>(n));
+        std::iota(m_order.begin(), m_order.end(), Index(0));
+        m_centre.resize(static_cast<std::size_t>(n));
+        std::vector<Vec3> lo(static_cast<std::size_t>(n)), hi(static_cast<std::size_t>(n));
+        for (Index t = 0; t < n; ++t) {
+            Vec3 a, b, c;
+            corners(t, a, b, c);
+            const auto k = static_cast<std::size_t>(t);
+            lo[k] = a.cwiseMin(b).cwiseMin(c);
+            hi[k] = a.cwiseMax(b).cwiseMax(c);
+            m_centre[k] = (a + b + c) / 3.0;
+        }
+        if (n > 0) build_node(0, n, lo, hi, leaf_size, on_node);
+    }
+    template <class Corners> void build(Index n, Corners&& corners, Index leaf_size)
+    {
+        build(n, corners, leaf_size, [](Index, const Node&) {});
+    }
+
+    bool empty() const { return m_nodes.empty(); }
+    const std::vector<Node>& nodes() const { return m_nodes; }
+    /// The triangle at position k of the tree's order (a node holds positions first .. first + count - 1).
+    Index item(Index k) const { return m_order[static_cast<std::size_t>(k)]; }
+    /// Centre (mean of the corners) of triangle t.
+    const Vec3& centre(Index t) const { return m_centre[static_cast<std::size_t>(t)]; }
+
+    /// Squared distance from p to the box of `node` (0 inside).
+    static double squared_distance(const Node& node, const Vec3& p)
+    {
+        return (node.lo - p).cwiseMax(p - node.hi).cwiseMax(Vec3::Zero()).squaredNorm();
+    }
+
+    /// Visits every triangle of a leaf whose box meets the box lo..hi.
+    template <class Visit> void for_box(const Vec3& lo, const Vec3& hi, Visit&& visit) const
+    {
+        if (m_nodes.empty()) return;
+        Index stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top) {
+            const Node& n = m_nodes[static_cast<std::size_t>(stack[--top])];
+            if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
+            if (n.left < 0) {
+                for (Index k = n.first; k < n.first + n.count; ++k)
+                    visit(item(k));
+            } else if (top < 126) {
+                stack[top++] = n.left;
+                stack[top++] = n.right;
+            }
+        }
+    }
+
+    /// The closest point to p over the triangles for which `point_of(t, q)` sets a point q (and returns
+    /// true; false skips the triangle). Returns the triangle (-1 if none) and sets best_point and its
+    /// squared distance best_d2. Nearer children first, so most of the tree is pruned.
+    template <class PointOf> Index closest(const Vec3& p, PointOf&& point_of, Vec3& best_point, double& best_d2) const
+    {
+        best_d2 = std::numeric_limits<double>::infinity();
+        Index best = -1;
+        if (m_nodes.empty()) return best;
+        Index stack[128];
+        int top = 0;
+        stack[top++] = 0;
+        while (top) {
+            const Node& n = m_nodes[static_cast<std::size_t>(stack[--top])];
+            if (squared_distance(n, p) >= best_d2) continue;
+            if (n.left < 0) {
+                for (Index k = n.first; k < n.first + n.count; ++k) {
+                    const Index t = item(k);
+                    Vec3 q;
+                    if (!point_of(t, q)) continue;
+                    const double d2 = (q - p).squaredNorm();
+                    if (d2 < best_d2) {
+                        best_d2 = d2;
+                        best_point = q;
+                        best = t;
+                    }
+                }
+            } else if (top < 126) {
+                // Nearer child last so that it is popped first.
+                const Node& l = m_nodes[static_cast<std::size_t>(n.left)];
+                const Node& r = m_nodes[static_cast<std::size_t>(n.right)];
+                if (squared_distance(l, p) < squared_distance(r, p)) {
+                    stack[top++] = n.right;
+                    stack[top++] = n.left;
+                } else {
+                    stack[top++] = n.left;
+                    stack[top++] = n.right;
+                }
+            }
+        }
+        return best;
+    }
+
+  private:
+    template <class OnNode>
+    Index build_node(Index first, Index count, const std::vector<Vec3>& lo, const std::vector<Vec3>& hi,
+                     Index leaf_size, OnNode& on_node)
+    {
+        const Index id = static_cast<Index>(m_nodes.size());
+        m_nodes.emplace_back();
+        Vec3 blo = Vec3::Constant(std::numeric_limits<double>::infinity()), bhi = -blo;
+        Vec3 clo = blo, chi = bhi;
+        for (Index k = first; k < first + count; ++k) {
+            const auto t = static_cast<std::size_t>(item(k));
+            blo = blo.cwiseMin(lo[t]);
+            bhi = bhi.cwiseMax(hi[t]);
+            clo = clo.cwiseMin(m_centre[t]);
+            chi = chi.cwiseMax(m_centre[t]);
+        }
+        Node& node = m_nodes[static_cast<std::size_t>(id)];
+        node.lo = blo;
+        node.hi = bhi;
+        node.first = first;
+        node.count = count;
+        on_node(id, static_cast<const Node&>(node));
+        if (count <= leaf_size) return id;
+        int axis = 0;
+        (chi - clo).maxCoeff(&axis);
+        const Index mid = first + count / 2;
+        std::nth_element(m_order.begin() + first, m_order.begin() + mid, m_order.begin() + first + count,
+                         [&](Index a, Index b) {
+                             const double ca = m_centre[static_cast<std::size_t>(a)][axis];
+                             const double cb = m_centre[static_cast<std::size_t>(b)][axis];
+                             return ca < cb || (ca == cb && a < b);
+                         });
+        const Index l = build_node(first, mid - first, lo, hi, leaf_size, on_node);
+        const Index r = build_node(mid, first + count - mid, lo, hi, leaf_size, on_node);
+        m_nodes[static_cast<std::size_t>(id)].left = l;
+        m_nodes[static_cast<std::size_t>(id)].right = r;
+        return id;
+    }
+
+    std::vector<Node> m_nodes;
+    std::vector<Index> m_order;
+    std::vector<Vec3> m_centre;
+};
+
+} // namespace tethash::detail
