@@ -4,7 +4,7 @@
 #include "core_scenes.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "tethash/hash_grid.hpp"
+#include "../src/core/hash_grid.hpp"
 #include "tethash/oracle.hpp"
 
 #include <gtest/gtest.h>

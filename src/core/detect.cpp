@@ -7,10 +7,11 @@
 #include "scan.hpp"
 #include "team.hpp"
 #include "tethash/error.hpp"
-#include "tethash/hash_grid.hpp"
+#include "hash_grid.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -826,7 +827,11 @@ void DetectorImpl::merge_contacts()
                 bt = rc.tet;
             }
         }
+        assert(best >= 0); // total counts every thread's contacts, so one is left while out < total
         const RawContact& rc = threads[static_cast<std::size_t>(best)].contacts[pos[best]++];
+        // The output is sorted by (vertex, tet) and has no duplicate: each thread's run is, and runs are disjoint.
+        assert(out == 0 || contacts[out - 1].vertex < rc.vertex ||
+               (contacts[out - 1].vertex == rc.vertex && contacts[out - 1].tet < rc.tet));
         Contact& c = contacts[out];
         c.vertex = rc.vertex;
         c.tet = rc.tet;

@@ -2,7 +2,7 @@
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "tethash/hash_grid.hpp"
+#include "hash_grid.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -1,5 +1,5 @@
 // Stage 1: counting sort of the vertices by bucket into one contiguous structure of arrays.
-#include "tethash/hash_grid.hpp"
+#include "hash_grid.hpp"
 
 #include "team.hpp"
 

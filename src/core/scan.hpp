@@ -1,6 +1,6 @@
 #pragma once
 // The bucket-range scan of stage 2 (private header): scalar and AVX2 versions, chosen at run time.
-#include "tethash/hash_grid.hpp"
+#include "hash_grid.hpp"
 
 #include <cstdint>
 

@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -336,6 +337,8 @@ void BlockDescent::gather_contacts()
 double BlockDescent::solve_group(std::int32_t gi, double* x, double h) const
 {
     const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
+    assert(grp.lanes >= 1 && grp.lanes <= 4 && grp.spring_end <= static_cast<std::int32_t>(m_springs.size()) &&
+           grp.tet_end <= static_cast<std::int32_t>(m_tets.size()));
     LaneTerms terms;
     const double inv_h = 1.0 / h;
     m_gather(grp, m_springs.data(), m_tets.data(), x, inv_h, terms);

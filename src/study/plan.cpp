@@ -7,7 +7,6 @@
 #include "value_list.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/hash_grid.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/study/scenarios.hpp"
 

@@ -1,5 +1,6 @@
 // Embeds the detector the way an FEM code would: its own xyz and tet arrays, mapped without copies.
 #include <tethash/detect.hpp>
+#include <tethash/oracle.hpp>
 
 #include <cstdio>
 #include <vector>
@@ -17,5 +18,10 @@ int main()
     const auto& contacts = det.detect(positions);
     for (const tethash::Contact& c : contacts)
         std::printf("contact vertex %d tet %d\n", c.vertex, c.tet);
-    return contacts.size() == 1 && contacts[0].vertex == 7 && contacts[0].tet == 0 ? 0 : 1;
+    // The installed oracle: what an embedding code tests its use of the detector against.
+    const std::vector<tethash::Contact> oracle =
+        tethash::brute_force_contacts(positions, topology, vertex_object, tet_object);
+    const bool same = oracle.size() == contacts.size() && oracle.size() == 1 && oracle[0].vertex == contacts[0].vertex &&
+                      oracle[0].tet == contacts[0].tet;
+    return same && contacts[0].vertex == 7 && contacts[0].tet == 0 ? 0 : 1;
 }

@@ -1,5 +1,5 @@
 #pragma once
-/// \file hash_grid.hpp
+/// \file hash_grid.hpp (private to the core)
 /// The infinite uniform grid and the hash table of vertices used by the Detector (stage 1).
 ///
 /// A point p lies in cell floor(p · (1/l)) per axis (negative coordinates included); cell coordinates
@@ -86,16 +86,7 @@ struct TableModulus {
     }
 };
 
-/// The default table size for `vertices` hashed vertices: for the column hash the smallest power of two
-/// ≥ 2·vertices (so 2V..4V buckets; bucket ranges are masks), for Teschner's hash the smallest prime ≥ 2·vertices
-/// (the xor-product hash needs an odd modulus). At least 1.
-/// Measured (tethash_bench --table-factor, scenario 5: 19,600 vertices, CPU ms at one thread, ±5 %):
-/// 16,384 buckets (0.84 V) 6.3–7.3, 32,768 (1.7 V) 6.0, 65,536 (3.3 V, the default) 5.7, 131,072 (6.7 V) 5.9:
-/// below 2V the hash collisions scanned cost more than they save in table memory, beyond 4V the bigger offset
-/// array no longer stays in cache.
-std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices);
-/// Smallest prime ≥ n (n ≥ 2).
-std::int64_t next_prime(std::int64_t n);
+// auto_table_size() and next_prime() are declared in detect.hpp (the table-size grammar uses them).
 
 /// Stage 1: the vertex table. Keeps its buffers across builds.
 class VertexTable {
