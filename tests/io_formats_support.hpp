@@ -20,7 +20,10 @@ inline std::filesystem::path data_file(const std::string& rel)
 }
 
 /// Shell-quoted path (support.hpp's quote()).
-inline std::string q(const std::filesystem::path& p) { return quote(p); }
+inline std::string q(const std::filesystem::path& p)
+{
+    return quote(p);
+}
 
 /// 1-based number of the first line of `text` that contains `needle` (0 if none).
 /// Writes `good` with its first `from` replaced by `to` (a failure if there is none) to `path`.

@@ -61,9 +61,8 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
 {
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
-    const auto r =
-        run_tethash("simulate " + quote(dir / "s.toml") +
-                    " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --out " + quote(dir / "out"));
+    const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
+                               " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --out " + quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("vbd"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("steps: 3 "), std::string::npos) << r.out;
@@ -187,13 +186,14 @@ TEST(CliSimulate, TimeStepIsCheckedAndAcceptsFractions)
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
     for (const char* bad : {"nan", "inf", "0", "-1/240", "1/0", "fast", "1/"}) {
-        const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --dt " + quote(bad) + " --out " +
-                                   quote(dir / "out"));
+        const auto r =
+            run_tethash("simulate " + quote(dir / "s.toml") + " --dt " + quote(bad) + " --out " + quote(dir / "out"));
         EXPECT_EQ(r.status, 2) << bad << ": " << r.err;
         EXPECT_NE(r.err.find("--dt"), std::string::npos) << bad << ": " << r.err;
         EXPECT_NE(r.err.find(bad), std::string::npos) << bad << ": " << r.err;
     }
-    const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --dt 1/500 --steps 1 --out " + quote(dir / "out"));
+    const auto r =
+        run_tethash("simulate " + quote(dir / "s.toml") + " --dt 1/500 --steps 1 --out " + quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("dt 0.002 s"), std::string::npos) << r.out;
 }

@@ -174,7 +174,8 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     io::write_mesh((dir / "box.vtu").string(), io::generate(p));
     const auto r = run_tethash("study stability --mesh " + quote(dir / "box.vtu") +
                                " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all --duration 0.6 "
-                               "--no-plot --quiet --out " + quote(dir / "s"));
+                               "--no-plot --quiet --out " +
+                               quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     const Table t = Table::read_csv((dir / "s" / "study.csv").string());
     for (const char* col : {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction",

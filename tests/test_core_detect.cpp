@@ -1,10 +1,10 @@
 // Detector vs the brute-force oracle over many seeded scenes and every parameter kind; determinism;
 // object rules; API errors.
+#include "../src/core/hash_grid.hpp"
 #include "../src/core/scan.hpp"
 #include "core_scenes.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "../src/core/hash_grid.hpp"
 #include "tethash/oracle.hpp"
 
 #include <gtest/gtest.h>

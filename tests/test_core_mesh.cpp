@@ -302,8 +302,8 @@ TEST(MeshLabels, JoinMergesOnlyLabelsThatTouch)
 TEST(Geometry, ClosestPointOnTriangleRegions)
 {
     const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-    EXPECT_TRUE(closest_point_on_triangle({-1, -1, 3}, a, b, c).isApprox(a));       // vertex region
-    EXPECT_TRUE(closest_point_on_triangle({2, -0.5, 0}, a, b, c).isApprox(b));      // vertex region
+    EXPECT_TRUE(closest_point_on_triangle({-1, -1, 3}, a, b, c).isApprox(a));                           // vertex region
+    EXPECT_TRUE(closest_point_on_triangle({2, -0.5, 0}, a, b, c).isApprox(b));                          // vertex region
     EXPECT_TRUE(closest_point_on_triangle({0.5, -2, 1}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0, 0))); // edge ab
     EXPECT_TRUE(closest_point_on_triangle({1, 1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));  // edge bc
     EXPECT_TRUE(closest_point_on_triangle({0.2, 0.3, -4}, a, b, c).isApprox(Eigen::Vector3d(0.2, 0.3, 0))); // face

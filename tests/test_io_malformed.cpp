@@ -77,9 +77,9 @@ std::string vtu_with_zlib_block(std::uint64_t points)
 </Piece></UnstructuredGrid>
 <AppendedData encoding="raw">_)";
     const std::string stream("\x78\x9c\x03\x00\x00\x00\x00\x01", 8); // zlib of zero bytes
-    put<std::uint64_t>(s, 1);                                           // blocks
-    put<std::uint64_t>(s, 3 * 8 * points);                              // block size
-    put<std::uint64_t>(s, 0);                                           // last block: full
+    put<std::uint64_t>(s, 1);                                        // blocks
+    put<std::uint64_t>(s, 3 * 8 * points);                           // block size
+    put<std::uint64_t>(s, 0);                                        // last block: full
     put<std::uint64_t>(s, stream.size());
     s += stream;
     s += "\n</AppendedData></VTKFile>\n";
@@ -184,8 +184,8 @@ TEST(IoMalformed, LegacyBitPointsAreRejectedBeforeDecoding)
     const auto dir = temp_dir();
     // 11,184,810 points as bits: 4 MB of file, which decoded cost a double per bit (256 MB) and more.
     const std::size_t n = 11184810;
-    std::string s = "# vtk DataFile Version 3.0\nbits\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(n) +
-                    " bit\n";
+    std::string s =
+        "# vtk DataFile Version 3.0\nbits\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS " + std::to_string(n) + " bit\n";
     s.append((3 * n + 7) / 8, '\x55');
     const fs::path p = dir / "bit_points.vtk";
     write_text(p, s);

@@ -44,8 +44,7 @@ TEST(IoPvd, ReadErrorsNameFileAndLine)
         io::read_pvd((dir / "t.pvd").string());
         FAIL() << "no error";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("t.pvd:4: expected a number for timestep"), std::string::npos)
-            << e.what();
+        EXPECT_NE(std::string(e.what()).find("t.pvd:4: expected a number for timestep"), std::string::npos) << e.what();
     }
     write_text(dir / "u.pvd", "<VTKFile type=\"UnstructuredGrid\"></VTKFile>\n");
     EXPECT_THROW(io::read_pvd((dir / "u.pvd").string()), Error);

@@ -14,10 +14,10 @@
 #include <numbers>
 
 using namespace tethash;
-using tethash::test::sphere_surface;
 using tethash::test::enclosed_volume;
-using tethash::test::volume;
+using tethash::test::sphere_surface;
 using tethash::test::temp_dir;
+using tethash::test::volume;
 
 namespace {
 

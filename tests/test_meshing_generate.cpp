@@ -1,8 +1,8 @@
 // Tests of io/generate.hpp: shapes on the BCC lattice validate, are deterministic, have the analytic
 // volume, keep good tets, and reject bad parameters.
 #include "tethash/error.hpp"
-#include "tethash/meshing/generate.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/meshing/generate.hpp"
 
 #include <gtest/gtest.h>
 
@@ -168,7 +168,8 @@ TEST(Generate, VolumesMatchTheAnalyticShapes)
 {
     const double pi = std::numbers::pi;
     // Snapped meshes: within a few per cent at moderate resolution.
-    EXPECT_NEAR(volume(meshing::generate(params("sphere", 24))), 4.0 / 3.0 * pi * 0.125, 0.02 * (4.0 / 3.0 * pi * 0.125));
+    EXPECT_NEAR(volume(meshing::generate(params("sphere", 24))), 4.0 / 3.0 * pi * 0.125,
+                0.02 * (4.0 / 3.0 * pi * 0.125));
     const double torus = 2 * pi * pi * 0.35 * 0.15 * 0.15;
     EXPECT_NEAR(volume(meshing::generate(params("torus", 32))), torus, 0.03 * torus);
     EXPECT_NEAR(volume(meshing::generate(params("cylinder", 20))), pi * 0.25, 0.03 * pi * 0.25);

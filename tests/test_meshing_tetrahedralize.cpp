@@ -15,8 +15,8 @@
 #endif
 
 using namespace tethash;
-using tethash::test::sphere_surface;
 using tethash::test::enclosed_volume;
+using tethash::test::sphere_surface;
 using tethash::test::volume;
 
 namespace {

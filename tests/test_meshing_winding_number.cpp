@@ -13,7 +13,7 @@ TEST(WindingNumber, InsideAndOutside)
 {
     const io::SurfaceMesh s = sphere_surface(8);
     const auto w = meshing::winding_numbers(s, {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0.1, -0.1),
-                                           Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
+                                                Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(0.7, 0.7, 0)});
     // Far triangle groups are dipoles: a few per cent off, far from the 1/2 that decides inside.
     EXPECT_NEAR(w[0], 1.0, 0.06);
     EXPECT_NEAR(w[1], 1.0, 0.06);

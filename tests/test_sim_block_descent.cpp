@@ -138,8 +138,8 @@ TEST(SimBlockDescent, SweepsGrowWithTheSubstepUnlessTheSceneSetsThem)
     struct Case {
         double dt;
         int substeps, iterations, want;
-    } cases[] = {{1e-3, 1, 0, 6}, {1.0 / 240, 1, 0, 6}, {1.0 / 120, 1, 0, 9}, {1.0 / 60, 1, 0, 12},
-                 {1.0 / 60, 4, 0, 4 * 6}, {1.0 / 60, 1, 7, 7}};
+    } cases[] = {{1e-3, 1, 0, 6},      {1.0 / 240, 1, 0, 6},    {1.0 / 120, 1, 0, 9},
+                 {1.0 / 60, 1, 0, 12}, {1.0 / 60, 4, 0, 4 * 6}, {1.0 / 60, 1, 7, 7}};
     for (const Case& c : cases) {
         Scene s = cantilever(4, 0.2, 1e5);
         s.dt = c.dt;
@@ -269,7 +269,8 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
             Simulation sim(drop(mesh, dt));
             const Positions start = sim.positions();
             const std::string failure = run_for(sim, 0.6);
-            if (!failure.empty() && dt > 1.0 / 200 && (std::string(name) == "screw.msh" || std::string(name) == "P1.msh")) {
+            if (!failure.empty() && dt > 1.0 / 200 &&
+                (std::string(name) == "screw.msh" || std::string(name) == "P1.msh")) {
                 // Open (docs/simulator.md): these crumple at 1/60; what must hold is that the run says so.
                 EXPECT_NE(failure.find("crumpled"), std::string::npos) << name << ": " << failure;
                 continue;

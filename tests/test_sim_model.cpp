@@ -87,8 +87,8 @@ TEST(SimModel, StiffnessDirectOrFromTheVolumeAroundTheEdge)
     ASSERT_EQ(around.size(), ma.springs.k.size());
     for (size_t e = 0; e < ma.springs.k.size(); ++e) {
         const Index i = ma.springs.edges(static_cast<Index>(e), 0), j = ma.springs.edges(static_cast<Index>(e), 1);
-        const double expected = 3e5 * around.at({std::min(i, j), std::max(i, j)}) /
-                                (ma.springs.rest[e] * ma.springs.rest[e]);
+        const double expected =
+            3e5 * around.at({std::min(i, j), std::max(i, j)}) / (ma.springs.rest[e] * ma.springs.rest[e]);
         EXPECT_NEAR(ma.springs.k[e], expected, 1e-9 * expected);
     }
     Material b;

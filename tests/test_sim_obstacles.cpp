@@ -103,9 +103,9 @@ TEST(SimFriction, GroundFrictionDeceleratesAndStopsASlidingBox)
     };
     // μ = 1 stays below the tipping threshold of this 0.4 × 0.2 box (μ = width / height = 2).
     const double free = slide(0.0), some = slide(0.3), high = slide(1.0);
-    EXPECT_GT(free, 1.8);                    // without friction it keeps sliding
+    EXPECT_GT(free, 1.8);                           // without friction it keeps sliding
     EXPECT_NEAR(some, 2.0 - 0.3 * 9.81 * 0.4, 0.1); // Coulomb: μ g t ≈ 1.18 less after 0.4 s
-    EXPECT_LT(high, 0.03);                   // μ = 1 stops it within ~0.2 s
+    EXPECT_LT(high, 0.03);                          // μ = 1 stops it within ~0.2 s
 }
 
 TEST(SimFriction, ContactFrictionOnAStaticObstacle)

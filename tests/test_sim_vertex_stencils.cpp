@@ -156,8 +156,8 @@ TEST(SimVertexStencils, ForceAndHessianAreTheEnergysDerivativesInEveryLane)
                     for (int q = 0; q < 3; ++q) {
                         const double hess = -(tp.f[q][l] - tm.f[q][l]) / (2 * h);
                         EXPECT_NEAR(t.H[sym[q][r]][l], hess, 1e-5 * (1 + std::fabs(hess)))
-                            << gather_kernel_name(fn) << " seed " << seed << " lane " << l << " H(" << q << ","
-                            << r << ")";
+                            << gather_kernel_name(fn) << " seed " << seed << " lane " << l << " H(" << q << "," << r
+                            << ")";
                     }
                 }
             }

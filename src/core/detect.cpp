@@ -4,10 +4,10 @@
 #include "tethash/detect.hpp"
 
 #include "detect_checks.hpp"
+#include "hash_grid.hpp"
 #include "scan.hpp"
 #include "team.hpp"
 #include "tethash/error.hpp"
-#include "hash_grid.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>

@@ -1,8 +1,8 @@
 // The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
+#include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "hash_grid.hpp"
 
 #include <algorithm>
 #include <cctype>

@@ -29,8 +29,7 @@ class TriangleBvh {
     /// Nodes with at most `leaf_size` triangles are leaves. `on_node(id, node)`, called for every node
     /// before its range is split, may gather per-node data (nodes() has `id` + 1 entries at that time;
     /// its children come later).
-    template <class Corners, class OnNode>
-    void build(Index n, Corners&& corners, Index leaf_size, OnNode&& on_node)
+    template <class Corners, class OnNode> void build(Index n, Corners&& corners, Index leaf_size, OnNode&& on_node)
     {
         m_nodes.clear();
         m_order.resize(static_cast<std::size_t>(n));

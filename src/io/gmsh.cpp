@@ -6,8 +6,8 @@
 // tag of the element, or the second (elementary) tag where the physical tag is 0 or absent.
 #include "tethash/io/gmsh.hpp"
 
-#include "tethash/error.hpp"
 #include "number.hpp"
+#include "tethash/error.hpp"
 #include "text_reader.hpp"
 
 #include <algorithm>

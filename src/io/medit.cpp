@@ -6,8 +6,8 @@
 // "KEYWORD count" followed by count lines. '#' starts a comment.
 #include "tethash/io/medit.hpp"
 
-#include "tethash/error.hpp"
 #include "number.hpp"
+#include "tethash/error.hpp"
 #include "text_reader.hpp"
 
 #include <algorithm>

@@ -2,8 +2,8 @@
 
 #include "tethash/error.hpp"
 #include "tethash/io/gmsh.hpp"
-#include "tethash/io/surface.hpp"
 #include "tethash/io/medit.hpp"
+#include "tethash/io/surface.hpp"
 #include "tethash/io/tetgen.hpp"
 #include "tethash/io/vega.hpp"
 #include "tethash/io/vtk_legacy.hpp"

@@ -1,9 +1,9 @@
 // ParaView collections (.pvd): a list of (time, file) entries.
 #include "tethash/io/pvd.hpp"
 
+#include "number.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
-#include "number.hpp"
 #include "xml.hpp"
 
 #include <cmath>
@@ -17,7 +17,8 @@ void write_pvd(const std::string& path, const std::vector<std::pair<double, std:
     for (const auto& [time, file] : entries) {
         if (!std::isfinite(time))
             throw Error(path + ": time " + detail::format_double(time) + " of '" + file + "' is not finite");
-        if (file.empty()) throw Error(path + ": an entry at time " + detail::format_double(time) + " has an empty file name");
+        if (file.empty())
+            throw Error(path + ": an entry at time " + detail::format_double(time) + " has an empty file name");
         xml += "    <DataSet timestep=\"" + detail::format_double(time) + "\" group=\"\" part=\"0\" file=\"" +
                detail::xml_escape(file) + "\"/>\n";
     }

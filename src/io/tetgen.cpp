@@ -7,8 +7,8 @@
 // nodes (the first four indices), with a note.
 #include "tethash/io/tetgen.hpp"
 
-#include "tethash/error.hpp"
 #include "number.hpp"
+#include "tethash/error.hpp"
 #include "text_reader.hpp"
 
 #include <cmath>

@@ -1,8 +1,8 @@
 // Helpers shared by the VTK legacy and XML readers/writers (see vtk_detail.hpp).
 #include "vtk_detail.hpp"
 
-#include "tethash/error.hpp"
 #include "number.hpp"
+#include "tethash/error.hpp"
 
 #include <algorithm>
 #include <bit>

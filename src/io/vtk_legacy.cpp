@@ -1,7 +1,7 @@
 // Legacy VTK (.vtk) UNSTRUCTURED_GRID reader and writer.
+#include "tethash/io/vtk_legacy.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
-#include "tethash/io/vtk_legacy.hpp"
 #include "vtk_detail.hpp"
 
 #include <algorithm>
@@ -428,7 +428,8 @@ TetMesh LegacyReader::read()
                 ArrayPlace offsets_place;
                 offsets = read_values<std::int64_t>(static_cast<std::size_t>(a), ot, "OFFSETS", &offsets_place);
                 next_token();
-                if (to_lower(m_tok) != "connectivity") fail(at_token(), "expected CONNECTIVITY, found " + found_token());
+                if (to_lower(m_tok) != "connectivity")
+                    fail(at_token(), "expected CONNECTIVITY, found " + found_token());
                 const Scalar ct = expect_type("CONNECTIVITY");
                 if (ct == Scalar::Bit)
                     fail(at_token(), "expected the data type of CONNECTIVITY to be an integer type, found bit");
@@ -549,9 +550,9 @@ TetMesh LegacyReader::read()
         const std::size_t first = static_cast<std::size_t>(offsets[cs]) + (old_layout ? 1 : 0);
         const std::size_t size = static_cast<std::size_t>(offsets[cs + 1]) - first;
         if (size != (quadratic ? 10u : 4u))
-            fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
-                                                " but " + std::to_string(size) + " points, expected " +
-                                                (quadratic ? "10" : "4"));
+            fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type " +
+                                                (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") + " but " +
+                                                std::to_string(size) + " points, expected " + (quadratic ? "10" : "4"));
         for (std::size_t k = 0; k < 4; ++k) {
             const std::int64_t v = conn[first + k];
             if (v < 0 || v >= num_points)

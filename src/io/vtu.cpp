@@ -17,9 +17,9 @@ namespace tethash::io {
 namespace {
 
 using namespace vtk_detail;
+using detail::xml_escape;
 using detail::XmlDocument;
 using detail::XmlElement;
-using detail::xml_escape;
 constexpr auto is_space = detail::is_xml_space;
 
 // ---- .vtu reader ---------------------------------------------------------------------------
@@ -470,8 +470,9 @@ TetMesh VtuReader::read()
                 }
                 const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
                 if (offsets[c] - first != (quadratic ? 10 : 4))
-                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
-                                               " but " + std::to_string(offsets[c] - first) + " points, expected " +
+                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type " +
+                                               (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") + " but " +
+                                               std::to_string(offsets[c] - first) + " points, expected " +
                                                (quadratic ? "10" : "4"));
                 for (int k = 0; k < 4; ++k) {
                     const std::int64_t v = conn[static_cast<std::size_t>(first + k)];

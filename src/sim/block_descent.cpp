@@ -99,20 +99,20 @@ class BlockDescent final : public StepIntegrator {
     std::vector<LaneGroup> m_groups;
     std::vector<SpringLanes> m_springs;
     std::vector<TetLanes> m_tets;
-    std::vector<std::int32_t> m_order;            ///< the free vertices
-    std::vector<double> m_max_step;               ///< vertex id → largest local step (a fifth of its object's mean edge)
-    std::vector<double> m_ground_k, m_ground_c;   ///< vertex id → ground penalty and damping
+    std::vector<std::int32_t> m_order; ///< the free vertices
+    std::vector<double> m_max_step;    ///< vertex id → largest local step (a fifth of its object's mean edge)
+    std::vector<double> m_ground_k, m_ground_c; ///< vertex id → ground penalty and damping
     detail::GatherFn m_gather = nullptr;
     detail::StartFn m_start = nullptr;
     detail::SolveFn m_solve = nullptr;
     int m_threads = 1;
     // Per-substep state, buffers reused.
-    Positions m_xt;          ///< positions at the start of the substep
+    Positions m_xt; ///< positions at the start of the substep
     struct alignas(32) Point4 {
         double c[4];
     };
-    std::vector<Point4> m_x4; ///< the positions the sweeps work on (stride 4: aligned row loads)
-    std::vector<double> m_y; ///< inertial target, flat 3n
+    std::vector<Point4> m_x4;             ///< the positions the sweeps work on (stride 4: aligned row loads)
+    std::vector<double> m_y;              ///< inertial target, flat 3n
     std::vector<double> m_prev1, m_prev2; ///< the iterates of the two previous sweeps (Chebyshev acceleration)
     // Contacts of the substep: per contact depth, direction, weighted stiffness and damping, relative
     // displacement since the start (refreshed each iteration); per vertex its incidences.
@@ -524,7 +524,8 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         }
         double largest = 0;
         for (int c = 0; c < colours; ++c) {
-            const std::int32_t begin = m_colour_start[static_cast<size_t>(c)], end = m_colour_start[static_cast<size_t>(c) + 1];
+            const std::int32_t begin = m_colour_start[static_cast<size_t>(c)],
+                               end = m_colour_start[static_cast<size_t>(c) + 1];
 #ifdef TETHASH_HAVE_OPENMP
             if (m_threads > 1 && end - begin > 64) {
                 double colour_largest = 0;

@@ -33,7 +33,8 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
     m_mu = scene.contact.friction;
     m_object_k.assign(scene.objects.size(), 0.0);
     for (Index e = 0; e < model.springs.edges.rows(); ++e) {
-        double& ko = m_object_k[static_cast<size_t>(model.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
+        double& ko =
+            m_object_k[static_cast<size_t>(model.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
         ko = std::max(ko, model.springs.k[static_cast<size_t>(e)]);
     }
     int dynamic_objects = 0;

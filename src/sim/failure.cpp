@@ -64,8 +64,8 @@ std::string FailureCheck::check_inverted(const Model& model, const Scene& scene,
     for (Index t = 0; t < nt; ++t) {
         const auto tet = model.volumes.tets.row(t);
         const Eigen::Vector3d a = x.row(tet(0)).transpose();
-        const double w = (x.row(tet(1)).transpose() - a)
-                             .dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
+        const double w =
+            (x.row(tet(1)).transpose() - a).dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
         inverted += w > 0 ? 0 : 1;
     }
     if (inverted * 100 <= nt) {
@@ -108,7 +108,8 @@ std::string FailureCheck::check_inverted(const Model& model, const Scene& scene,
     std::string cause;
     if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
         cause = "the time step " + short_number(h) + " s exceeds the explicit stability limit ≈ " +
-                short_number(dt_limit) + " s (stiffness/mass too high for symplectic_euler): use substeps, a smaller "
+                short_number(dt_limit) +
+                " s (stiffness/mass too high for symplectic_euler): use substeps, a smaller "
                 "dt or vbd";
     else if (worst > 0.3)
         cause = name(worst_o) + " cannot carry its own weight: density × g × height / young = " + short_number(worst) +
@@ -117,7 +118,8 @@ std::string FailureCheck::check_inverted(const Model& model, const Scene& scene,
         cause = name(dense_o) + " is " + short_number(densest / lightest) + " times denser than " + name(light_o) +
                 ", which it crushes: raise the lighter body's young or lower the density ratio";
     else
-        cause = "the time step " + short_number(h) + " s is too large for this material and its contacts: lower dt, "
+        cause = "the time step " + short_number(h) +
+                " s is too large for this material and its contacts: lower dt, "
                 "raise substeps or (vbd) iterations";
     return what + "; likely cause: " + cause;
 }
@@ -143,8 +145,9 @@ std::string FailureCheck::check_substep(const Model& model, const Positions& x, 
         kinetic += 0.5 * model.mass[static_cast<size_t>(i)] * vi.squaredNorm();
     }
     if (far > reach)
-        return "vertex " + std::to_string(far_vertex) + " is " + short_number(far) + " from the scene centre, beyond the " +
-               short_number(reach) + " it could reach on the energy available at start";
+        return "vertex " + std::to_string(far_vertex) + " is " + short_number(far) +
+               " from the scene centre, beyond the " + short_number(reach) +
+               " it could reach on the energy available at start";
     const double kinetic_bound = 1e3 * m_energy_ref + m_msum * g * (reach + m_radius0);
     if (kinetic > kinetic_bound)
         return "the kinetic energy grew to " + short_number(kinetic) + ", " + short_number(kinetic / m_energy_ref) +
@@ -161,10 +164,12 @@ std::string FailureCheck::check_energy(double internal) const
     return {};
 }
 
-std::string FailureCheck::likely_cause(const Scene& scene, double h, double dt_limit, const ContactResponse& contacts) const
+std::string FailureCheck::likely_cause(const Scene& scene, double h, double dt_limit,
+                                       const ContactResponse& contacts) const
 {
     if (scene.integrator == Integrator::symplectic_euler && h > dt_limit)
-        return "the time step " + short_number(h) + " s exceeds the explicit stability limit ≈ " + short_number(dt_limit) +
+        return "the time step " + short_number(h) + " s exceeds the explicit stability limit ≈ " +
+               short_number(dt_limit) +
                " s (stiffness/mass too high for symplectic_euler): use substeps, a smaller dt or vbd";
     double depth = 0, kmax = 0;
     for (size_t q = 0; q < contacts.contacts().size(); ++q)
@@ -175,8 +180,8 @@ std::string FailureCheck::likely_cause(const Scene& scene, double h, double dt_l
     if (depth > 0)
         return "contact response (max penetration " + short_number(depth) + ", contact stiffness up to " +
                short_number(kmax) + "): lower contact.stiffness or dt, or raise substeps";
-    return "stiffness too high for the time step " + short_number(h) + " s (explicit limit ≈ " + short_number(dt_limit) +
-           " s): lower dt or raise substeps" +
+    return "stiffness too high for the time step " + short_number(h) + " s (explicit limit ≈ " +
+           short_number(dt_limit) + " s): lower dt or raise substeps" +
            (scene.integrator == Integrator::vbd ? std::string(" or iterations") : std::string(", or use vbd"));
 }
 

@@ -41,7 +41,7 @@ class FailureCheck {
     Eigen::Vector3d m_centre0{0, 0, 0};
     double m_radius0 = 0;
     double m_speed_bound = 0;
-    double m_inverted_since = -1; ///< time at which more than 1 % of the tets became inverted (−1: not now)
+    double m_inverted_since = -1;        ///< time at which more than 1 % of the tets became inverted (−1: not now)
     std::vector<double> m_object_height; ///< per object: extent along gravity at start (0: static or none)
 };
 

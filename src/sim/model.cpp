@@ -59,7 +59,8 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     Index objects = 0;
     m.vertex_object.assign(static_cast<size_t>(n), 0);
     for (Index i = 0; i < n; ++i) {
-        m.vertex_object[static_cast<size_t>(i)] = mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
+        m.vertex_object[static_cast<size_t>(i)] =
+            mesh.vertex_object.empty() ? 0 : mesh.vertex_object[static_cast<size_t>(i)];
         objects = std::max(objects, m.vertex_object[static_cast<size_t>(i)] + 1);
     }
     objects = std::max<Index>(objects, static_cast<Index>(materials.size()));
@@ -137,7 +138,8 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         for (size_t q = 0; q < dyn.size(); ++q)
             for (int a = 0; a < 4; ++a)
                 for (int b = a + 1; b < 4; ++b) {
-                    const Index e = find_edge(m.volumes.tets(static_cast<Index>(q), a), m.volumes.tets(static_cast<Index>(q), b));
+                    const Index e =
+                        find_edge(m.volumes.tets(static_cast<Index>(q), a), m.volumes.tets(static_cast<Index>(q), b));
                     if (e >= 0) edge_volume[static_cast<size_t>(e)] += m.volumes.rest[q];
                 }
     }
@@ -154,7 +156,8 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
             throw Error("model: edge (" + std::to_string(i) + ", " + std::to_string(j) + ") has zero rest length");
         const Index o = m.vertex_object[static_cast<size_t>(i)];
         const Material& mat = material(o);
-        const double k = mat.stiffness > 0 ? mat.stiffness : mat.young * edge_volume[static_cast<size_t>(e)] / (len * len);
+        const double k =
+            mat.stiffness > 0 ? mat.stiffness : mat.young * edge_volume[static_cast<size_t>(e)] / (len * len);
         m.springs.rest[static_cast<size_t>(e)] = len;
         m.springs.k[static_cast<size_t>(e)] = k;
         m.springs.c[static_cast<size_t>(e)] = mat.damping * k;

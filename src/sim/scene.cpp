@@ -312,9 +312,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     Scene s;
     s.source = source_name;
     r.check_keys(root, "",
-                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance", "acceleration",
-                  "gravity", "ground",
-                  "contact", "detector", "output", "object", "pin"});
+                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance",
+                  "acceleration", "gravity", "ground", "contact", "detector", "output", "object", "pin"});
     for (auto&& [k, v] : root) {
         const std::string key(k.str());
         if (key == "dt")

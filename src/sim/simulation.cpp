@@ -37,7 +37,8 @@ double estimate_dt_limit(const Scene& scene, const Model& model, const TetMesh& 
         for (Index a = 0; a < nobj; ++a)
             for (Index b = 0; b < nobj; ++b)
                 if ((a != b || scene.objects[static_cast<size_t>(a)].self_collision) &&
-                    !(scene.objects[static_cast<size_t>(a)].is_static && scene.objects[static_cast<size_t>(b)].is_static))
+                    !(scene.objects[static_cast<size_t>(a)].is_static &&
+                      scene.objects[static_cast<size_t>(b)].is_static))
                     obj_contact_k[static_cast<size_t>(a)] =
                         std::max(obj_contact_k[static_cast<size_t>(a)], contacts.pair_stiffness(a, b));
     for (Index i = 0; i < n; ++i) {
@@ -155,8 +156,9 @@ void Simulation::step()
                                       ? ", substep " + std::to_string(sub + 1) + "/" + std::to_string(s.scene.substeps)
                                       : std::string();
         throw RunFailure("simulation " + std::string(with_cause ? "blew up" : "failed") + " at step " +
-                         std::to_string(step_no) + where + " (t = " +
-                         short_number(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) + " s): " + what +
+                         std::to_string(step_no) + where +
+                         " (t = " + short_number(s.t + (sub < s.scene.substeps ? sub + 1 : s.scene.substeps) * h) +
+                         " s): " + what +
                          (with_cause ? "; likely cause: " + s.failure.likely_cause(s.scene, h, s.dt_limit, s.contacts)
                                      : std::string()));
     };
@@ -304,7 +306,8 @@ io::Fields Simulation::output_fields() const
     const SimulationImpl& s = *m_impl;
     const Index n = s.mesh().num_vertices();
     auto wanted = [&](const char* name) {
-        return std::find(s.scene.output.fields.begin(), s.scene.output.fields.end(), name) != s.scene.output.fields.end();
+        return std::find(s.scene.output.fields.begin(), s.scene.output.fields.end(), name) !=
+               s.scene.output.fields.end();
     };
     io::Fields f;
     if (wanted("velocity")) {

@@ -112,8 +112,7 @@ int solve_scalar(const LaneTerms& t, double d[3][4])
 {
     int solved = 0;
     for (int l = 0; l < 4; ++l) {
-        const double xx = t.H[0][l], yy = t.H[1][l], zz = t.H[2][l], xy = t.H[3][l], xz = t.H[4][l],
-                     yz = t.H[5][l];
+        const double xx = t.H[0][l], yy = t.H[1][l], zz = t.H[2][l], xy = t.H[3][l], xz = t.H[4][l], yz = t.H[5][l];
         if (!(xx > 0)) continue;
         const double r11 = std::sqrt(xx);
         const double l21 = xy / r11, l31 = xz / r11;
@@ -140,7 +139,7 @@ int solve_scalar(const LaneTerms& t, double d[3][4])
 /// four row loads and a 4 × 4 transpose. (Three vgatherdpd instead made the hand drop's integration 7.9-8.4 ms
 /// per step against 5.0-5.6, interleaved runs on the 2-core EPYC.)
 __attribute__((target("avx2,fma"), always_inline)) inline void load3(const double* x, const std::int32_t* ids,
-                                                                      __m256d& px, __m256d& py, __m256d& pz)
+                                                                     __m256d& px, __m256d& py, __m256d& pz)
 {
     const __m256d r0 = _mm256_load_pd(x + 4 * static_cast<std::size_t>(ids[0]));
     const __m256d r1 = _mm256_load_pd(x + 4 * static_cast<std::size_t>(ids[1]));
@@ -206,9 +205,9 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         const __m256d nx = _mm256_fmsub_pd(bay, caz, _mm256_mul_pd(baz, cay));
         const __m256d ny = _mm256_fmsub_pd(baz, cax, _mm256_mul_pd(bax, caz));
         const __m256d nz = _mm256_fmsub_pd(bax, cay, _mm256_mul_pd(bay, cax));
-        const __m256d w = _mm256_fmadd_pd(
-            _mm256_sub_pd(ax, xi), nx,
-            _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny, _mm256_mul_pd(_mm256_sub_pd(az, zi), nz)));
+        const __m256d w =
+            _mm256_fmadd_pd(_mm256_sub_pd(ax, xi), nx,
+                            _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny, _mm256_mul_pd(_mm256_sub_pd(az, zi), nz)));
         const __m256d k36 = _mm256_load_pd(t.k36);
         const __m256d excess =
             _mm256_fmadd_pd(dh, _mm256_sub_pd(w, _mm256_load_pd(t.wt)), _mm256_sub_pd(w, _mm256_load_pd(t.w0)));
@@ -284,8 +283,7 @@ __attribute__((target("avx2,fma"))) int solve_avx2(const LaneTerms& t, double d[
     const __m256d i33 = _mm256_div_pd(one, _mm256_sqrt_pd(p33));
     const __m256d z1 = _mm256_mul_pd(_mm256_load_pd(t.f[0]), i11);
     const __m256d z2 = _mm256_mul_pd(_mm256_fnmadd_pd(l21, z1, _mm256_load_pd(t.f[1])), i22);
-    const __m256d z3 =
-        _mm256_mul_pd(_mm256_fnmadd_pd(l32, z2, _mm256_fnmadd_pd(l31, z1, _mm256_load_pd(t.f[2]))), i33);
+    const __m256d z3 = _mm256_mul_pd(_mm256_fnmadd_pd(l32, z2, _mm256_fnmadd_pd(l31, z1, _mm256_load_pd(t.f[2]))), i33);
     const __m256d d2 = _mm256_mul_pd(z3, i33);
     const __m256d d1 = _mm256_mul_pd(_mm256_fnmadd_pd(l32, d2, z2), i22);
     const __m256d d0 = _mm256_mul_pd(_mm256_fnmadd_pd(l31, d2, _mm256_fnmadd_pd(l21, d1, z1)), i11);

@@ -16,7 +16,7 @@ namespace tethash::sim::detail {
 /// A spring seen from its end in each of four lanes (k = 0 pads).
 struct alignas(32) SpringLanes {
     double k[4], rest[4];
-    double length_t[4]; ///< length at the start of the substep (relative damping)
+    double length_t[4];    ///< length at the start of the substep (relative damping)
     std::int32_t other[4]; ///< the other end's vertex id
     std::int32_t unused[4];
 };
@@ -33,7 +33,7 @@ struct alignas(32) TetLanes {
 
 /// Four vertices of one colour and their entries.
 struct alignas(32) LaneGroup {
-    double damping[4];     ///< each lane's object damping time (s)
+    double damping[4];      ///< each lane's object damping time (s)
     std::int32_t vertex[4]; ///< vertex ids; a padding lane repeats lane 0 and is not written
     std::int32_t lanes;     ///< real lanes (1 … 4)
     std::int32_t spring_begin, spring_end, tet_begin, tet_end;

@@ -38,9 +38,16 @@ void StabilityPlanDeleter::operator()(StabilityPlan* p) const
 namespace {
 
 const std::vector<std::string> k_stability_columns = {
-    "point",      "repeat",   "scene",     "sweep",    "integrator",   "young",       "dt",
-    "mass_ratio", "vertices", "tets",      "steps",    "duration",     "verdict",     "status",
-    "inverted",   "inverted_fraction",     "far_self", "max_penetration",             "ms_per_step",
+    "point",       "repeat",
+    "scene",       "sweep",
+    "integrator",  "young",
+    "dt",          "mass_ratio",
+    "vertices",    "tets",
+    "steps",       "duration",
+    "verdict",     "status",
+    "inverted",    "inverted_fraction",
+    "far_self",    "max_penetration",
+    "ms_per_step",
 };
 
 /// Two copies of `mesh`, each scaled to 1 m, 0.3 m above the ground and 1.4 m apart, moving towards each other
@@ -82,16 +89,15 @@ void plan_stability_study(StudyPlan& plan)
     std::vector<sim::Integrator> integrators;
     for (const std::string& it : o.integrator.empty() ? std::vector<std::string>{"all"} : o.integrator) {
         if (it == "all")
-            integrators.insert(integrators.end(),
-                               {sim::Integrator::vbd, sim::Integrator::implicit_euler, sim::Integrator::symplectic_euler});
+            integrators.insert(integrators.end(), {sim::Integrator::vbd, sim::Integrator::implicit_euler,
+                                                   sim::Integrator::symplectic_euler});
         else
             integrators.push_back(sim::parse_integrator(it));
     }
     const auto youngs =
         parse_real_list(o.young.empty() ? std::vector<std::string>{"1e3,1e5,1e7,1e9"} : o.young, "--young", 1.0, true);
-    const auto dts = parse_real_list(o.dt.empty() ? std::vector<std::string>{"1e-3,1/240,1/60"}
-                                                  : o.dt,
-                                     "--dt", 1.0 / 240, true);
+    const auto dts =
+        parse_real_list(o.dt.empty() ? std::vector<std::string>{"1e-3,1/240,1/60"} : o.dt, "--dt", 1.0 / 240, true);
     const auto ratios = parse_real_list(o.mass_ratio.empty() ? std::vector<std::string>{"1,1e3,1e6"} : o.mass_ratio,
                                         "--mass-ratio", 1.0, true);
     if (o.duration < 0 || !std::isfinite(o.duration)) throw Error("--duration: must be > 0");
@@ -159,13 +165,12 @@ std::vector<Row> run_stability_point(StudyPlan& plan, std::int64_t index, const 
             verdict = "stopped";
         else if (!finite || inv * 100 > tets)
             verdict = "crumpled";
-        rows.push_back({std::to_string(index), std::to_string(r), sp.names[p.mesh], "stability",
-                        sim::to_string(p.integrator), fmt_double(p.young), fmt_double(p.dt), fmt_double(p.mass_ratio),
-                        std::to_string(s.mesh().num_vertices()), std::to_string(tets), std::to_string(steps),
-                        fmt_double(sp.duration), verdict, status, std::to_string(inv),
-                        inv >= 0 ? fmt_double(static_cast<double>(inv) / static_cast<double>(tets)) : "",
-                        std::to_string(far), fmt_double(s.max_penetration()),
-                        fmt_double(steps > 0 ? ms / static_cast<double>(steps) : 0.0)});
+        rows.push_back(
+            {std::to_string(index), std::to_string(r), sp.names[p.mesh], "stability", sim::to_string(p.integrator),
+             fmt_double(p.young), fmt_double(p.dt), fmt_double(p.mass_ratio), std::to_string(s.mesh().num_vertices()),
+             std::to_string(tets), std::to_string(steps), fmt_double(sp.duration), verdict, status, std::to_string(inv),
+             inv >= 0 ? fmt_double(static_cast<double>(inv) / static_cast<double>(tets)) : "", std::to_string(far),
+             fmt_double(s.max_penetration()), fmt_double(steps > 0 ? ms / static_cast<double>(steps) : 0.0)});
     }
     return rows;
 }

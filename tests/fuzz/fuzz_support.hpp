@@ -20,7 +20,8 @@ inline const std::filesystem::path& work_dir()
 {
     static const std::filesystem::path dir = [] {
         const char* tmp = std::getenv("TMPDIR");
-        std::filesystem::path base = tmp && *tmp ? tmp : (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
+        std::filesystem::path base =
+            tmp && *tmp ? tmp : (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp");
         std::filesystem::path d = base / ("tethash-fuzz-" + std::to_string(::getpid()));
         std::filesystem::create_directories(d);
         return d;

@@ -21,7 +21,7 @@ int main()
     // The installed oracle: what an embedding code tests its use of the detector against.
     const std::vector<tethash::Contact> oracle =
         tethash::brute_force_contacts(positions, topology, vertex_object, tet_object);
-    const bool same = oracle.size() == contacts.size() && oracle.size() == 1 && oracle[0].vertex == contacts[0].vertex &&
-                      oracle[0].tet == contacts[0].tet;
+    const bool same = oracle.size() == contacts.size() && oracle.size() == 1 &&
+                      oracle[0].vertex == contacts[0].vertex && oracle[0].tet == contacts[0].tet;
     return same && contacts[0].vertex == 7 && contacts[0].tet == 0 ? 0 : 1;
 }

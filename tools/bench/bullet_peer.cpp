@@ -47,7 +47,8 @@ PeerResult run_bullet(const std::vector<PeerBody>& bodies, double dt, int steps,
             x[static_cast<size_t>(i)] = btVector3(m.positions(i, 0), m.positions(i, 1), m.positions(i, 2));
         // Lumped masses: a quarter of each tet's mass to each corner (the usual choice with Bullet's tets).
         for (Index t = 0; t < m.num_tets(); ++t) {
-            const double v = std::abs(signed_volume(m.positions, {m.tets(t, 0), m.tets(t, 1), m.tets(t, 2), m.tets(t, 3)}));
+            const double v =
+                std::abs(signed_volume(m.positions, {m.tets(t, 0), m.tets(t, 1), m.tets(t, 2), m.tets(t, 3)}));
             for (int k = 0; k < 4; ++k)
                 mass[static_cast<size_t>(m.tets(t, k))] += body.density * v / 4;
         }

@@ -19,9 +19,9 @@ struct PeerBody {
 };
 
 struct PeerResult {
-    std::vector<double> ms;          ///< wall time of each step
-    std::vector<Positions> final;    ///< each body's positions at the end
-    std::string failure;             ///< non-empty when a position went non-finite
+    std::vector<double> ms;       ///< wall time of each step
+    std::vector<Positions> final; ///< each body's positions at the end
+    std::string failure;          ///< non-empty when a position went non-finite
 };
 
 /// Bullet's version as 100 × major + minor.

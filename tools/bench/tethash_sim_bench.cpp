@@ -186,7 +186,8 @@ int main(int argc, char** argv)
     app.add_option("--threads", threads, "detector and solver threads")->capture_default_str();
     app.add_option("--csv", csv, "write the rows as CSV to this file");
     app.add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
-    app.add_option("--sweep-tolerance", sweep_tolerance, "vbd early stop (fraction of the mean edge); default: scene's");
+    app.add_option("--sweep-tolerance", sweep_tolerance,
+                   "vbd early stop (fraction of the mean edge); default: scene's");
     app.add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1); default: scene's");
     app.add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size; default: scene's");
     app.add_flag("--no-peer", no_peer, "do not run the peer (Bullet soft bodies) even when built with it");
@@ -223,16 +224,17 @@ int main(int argc, char** argv)
         std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", seconds).c_str());
 #ifdef TETHASH_HAVE_BULLET
         std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
-                    bench::bullet_version() / 100, bench::bullet_version() % 100, peer_iterations, no_peer ? " (off: --no-peer)" : "");
+                    bench::bullet_version() / 100, bench::bullet_version() % 100, peer_iterations,
+                    no_peer ? " (off: --no-peer)" : "");
 #else
         std::printf("peer: Bullet not found at build time (install libbullet-dev and rebuild to compare)\n");
         no_peer = true;
 #endif
 
         std::vector<std::pair<std::string, sim::Scene>> scenes;
-        const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh",
-                                                "raptorTetra_8418.vtu", "32770_octocat.msh", "hand.mesh",
-                                                "mat100x100t40.msh", "quintupleTorus.veg"};
+        const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node",    "screw.msh",
+                                                "P1.msh",           "raptorTetra_8418.vtu", "32770_octocat.msh",
+                                                "hand.mesh",        "mat100x100t40.msh",    "quintupleTorus.veg"};
         for (const std::string& file : files) {
             const std::filesystem::path p = std::filesystem::path(meshes_dir) / file;
             if (!std::filesystem::exists(p)) continue;
@@ -308,10 +310,11 @@ int main(int argc, char** argv)
                 out << "scene,integrator,dt,vertices,tets,ms_step,ms_detect,ms_depth,ms_response,ms_integrate,"
                        "iterations,contacts,inverted,far_self,mean_z,stable,failure\n";
                 for (const Row& r : rows)
-                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{:.5g},{},\"{}\"\n",
-                                       r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth,
-                                       r.response, r.integrate, r.sweeps, r.contacts, r.inverted, r.far_self,
-                                       r.mean_z, r.stable ? 1 : 0, r.failure);
+                    out << fmt::format(
+                        "{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{:.5g},{},\"{}\"\n",
+                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth, r.response,
+                        r.integrate, r.sweeps, r.contacts, r.inverted, r.far_self, r.mean_z, r.stable ? 1 : 0,
+                        r.failure);
             }
             std::filesystem::rename(tmp, csv);
         }

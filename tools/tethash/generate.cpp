@@ -2,8 +2,8 @@
 #include "command.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/meshing/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/generate.hpp"
 
 #include <fmt/core.h>
 

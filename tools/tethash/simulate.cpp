@@ -12,10 +12,10 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <csignal>
 #include <cmath>
-#include <cstdlib>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 
@@ -52,12 +52,13 @@ int remove_previous_frames(const std::string& dir)
     std::error_code ec;
     for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
         const std::string name = entry.path().filename().string();
-        const bool frame = name.size() == 15 && name.compare(0, 6, "frame_") == 0 &&
-                           name.compare(11, 4, ".vtu") == 0 &&
-                           std::all_of(name.begin() + 6, name.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
+        const bool frame =
+            name.size() == 15 && name.compare(0, 6, "frame_") == 0 && name.compare(11, 4, ".vtu") == 0 &&
+            std::all_of(name.begin() + 6, name.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
         if ((frame || name == "scene.pvd") && entry.is_regular_file()) {
             std::error_code rm;
-            if (std::filesystem::remove(entry.path(), rm)) ++removed;
+            if (std::filesystem::remove(entry.path(), rm))
+                ++removed;
             else if (rm)
                 throw Error("--out: cannot remove '" + entry.path().string() + "' of a previous run: " + rm.message());
         }

@@ -2,9 +2,9 @@
 #include "command.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/meshing/tetrahedralize.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>

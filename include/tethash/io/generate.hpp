@@ -9,15 +9,15 @@
 
 namespace tethash::io {
 
-using meshing::GenerateParams;
-using meshing::ShapeInfo;
-using meshing::TetrahedralizeParams;
 using meshing::generate;
 using meshing::generate_shapes;
+using meshing::GenerateParams;
 using meshing::shape_catalog;
 using meshing::shape_natural_size;
+using meshing::ShapeInfo;
 using meshing::tetrahedralize;
 using meshing::tetrahedralize_sdf;
+using meshing::TetrahedralizeParams;
 using meshing::winding_numbers;
 
 } // namespace tethash::io

@@ -13,5 +13,4 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes = nullptr);
 /// Writes MeshVersionFormatted 2 with Vertices and Tetrahedra (refs: the labels, or 0).
 void write_medit(const std::string& path, const TetMesh& mesh);
 
-
 } // namespace tethash::io

@@ -15,5 +15,4 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes = nullptr);
 /// Writes NAME.node and NAME.ele (1-based; tet_label as one attribute, vertex_label as markers).
 void write_tetgen(const std::string& path, const TetMesh& mesh);
 
-
 } // namespace tethash::io

@@ -10,5 +10,4 @@ namespace tethash::io {
 /// other sections are skipped; *INCLUDE and element types other than TET are errors. No labels.
 TetMesh read_veg(const std::string& path, ReadNotes* notes = nullptr);
 
-
 } // namespace tethash::io

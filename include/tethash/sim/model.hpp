@@ -66,10 +66,10 @@ struct Energy {
 struct Model {
     Springs springs;
     VolumeTerms volumes;
-    std::vector<Index> vertex_object;      ///< n: object of each vertex
-    std::vector<double> object_mean_edge;  ///< per object: mean rest length of its unique edges (0: static)
-    std::vector<double> mass; ///< n lumped masses (static objects: their own mass, unused)
-    std::vector<char> fixed;  ///< n: 1 = pinned or static (never moves)
+    std::vector<Index> vertex_object;     ///< n: object of each vertex
+    std::vector<double> object_mean_edge; ///< per object: mean rest length of its unique edges (0: static)
+    std::vector<double> mass;             ///< n lumped masses (static objects: their own mass, unused)
+    std::vector<char> fixed;              ///< n: 1 = pinned or static (never moves)
     Eigen::Vector3d gravity{0, 0, 0};
     Ground ground;
     /// Per-vertex ground penalty stiffness and damping (n each); empty: ground.stiffness / ground.damping

@@ -88,8 +88,10 @@ struct Scene {
     /// ρ of one sweep, in [0, 1); 0 = off. Hand drop at 1/240: 6 sweeps with ρ 0.9 sag closer to the converged
     /// answer than 10 plain sweeps, at 0.6 of the cost (docs/simulator.md).
     double acceleration = 0.9;
-    double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep and overstated its friction by 36 %); 0 = always `iterations` sweeps
-    double tolerance = 1e-6; ///< CG relative residual
+    double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean
+                                ///< edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep
+                                ///< and overstated its friction by 36 %); 0 = always `iterations` sweeps
+    double tolerance = 1e-6;    ///< CG relative residual
     ContactParams contact;
     /// Detector parameters. threads defaults to 1 here (not 0 = all cores): the detection of a simulation step
     /// is short, and on a shared 2-core machine the OpenMP workers spinning between steps slowed whole steps

@@ -25,16 +25,16 @@ namespace tethash::sim {
 
 /// Timing and contact figures of one step (all its substeps). Times in milliseconds.
 struct StepStats {
-    double ms_detect = 0;      ///< Detector::detect
-    double ms_depth = 0;       ///< penetration depth and direction (Penetration::compute)
-    double ms_response = 0;    ///< contact set-up: filtering, stiffness, damping, per-vertex lists
-    double ms_integrate = 0;   ///< forces, matrix assembly, solve, update
-    std::int64_t contacts = 0; ///< contacts at the last substep (those the response uses)
+    double ms_detect = 0;           ///< Detector::detect
+    double ms_depth = 0;            ///< penetration depth and direction (Penetration::compute)
+    double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
+    double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
+    std::int64_t contacts = 0;      ///< contacts at the last substep (those the response uses)
     std::int64_t ignored_local = 0; ///< self-contacts at the last substep left to the elastic terms: the tet lies
                                     ///< within 2 mean edges of the vertex in the rest state (local inversion)
-    double max_depth = 0;      ///< largest penetration depth at the last substep (0 without contacts)
-    double mean_depth = 0;     ///< mean over contacts at the last substep
-    int solver_iterations = 0; ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
+    double max_depth = 0;           ///< largest penetration depth at the last substep (0 without contacts)
+    double mean_depth = 0;          ///< mean over contacts at the last substep
+    int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
 };
 
 class SimulationImpl;
