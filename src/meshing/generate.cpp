@@ -84,7 +84,8 @@ const std::vector<Shape>& shapes()
 {
     static const std::vector<Shape> all = [] {
         std::vector<Shape> s;
-        auto add = [&](std::string name, std::string desc, Vec3 lo, Vec3 hi, std::function<double(const Vec3&)> f) {
+        auto add = [&](std::string name, std::string desc, const Vec3& lo, const Vec3& hi,
+                       std::function<double(const Vec3&)> f) {
             s.push_back({{std::move(name), std::move(desc), hi - lo}, lo, std::move(f)});
         };
         add("box", "unit cube", Vec3::Constant(-0.5), Vec3::Constant(0.5),

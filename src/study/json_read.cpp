@@ -11,7 +11,7 @@ namespace tethash::study {
 const JsonValue* JsonValue::find(std::string_view name) const
 {
     const JsonValue* found = nullptr;
-    for (const auto& [k, v] : members)
+    for (const auto& [k, v] : members) // name, value
         if (k == name) found = &v;
     return found;
 }
@@ -79,7 +79,7 @@ class Parser {
                 if (m_pos == m_text.size() || m_text[m_pos] != '"') fail("expected a member name");
                 std::string name = string();
                 if (!eat(':')) fail("expected ':' after a member name");
-                v.members.emplace_back(std::move(name), value(depth + 1));
+                v.members.push_back(JsonMember{std::move(name), value(depth + 1)});
             } while (eat(','));
             if (!eat('}')) fail("expected ',' or '}'");
         } else if (c == '[') {

@@ -53,11 +53,12 @@ Choice search_object(double target_tets, double target_vertices)
             if (m.num_tets() == 0) continue;
             const double err = std::abs(std::log(m.num_tets() / target_tets)) +
                                0.5 * std::abs(std::log(m.num_vertices() / target_vertices));
+            const bool too_big = m.num_tets() > 3 * target_tets; // (read before m may be moved from)
             if (err < best_err) {
                 best_err = err;
                 best = Choice{shape, res, std::move(m)};
             }
-            if (best.mesh.num_tets() > 0 && m.num_tets() > 3 * target_tets) break;
+            if (best.mesh.num_tets() > 0 && too_big) break;
         }
     }
     if (best.mesh.num_tets() == 0) throw Error("teschner scenarios: io::generate produced no usable shape");

@@ -63,7 +63,7 @@ sim::ObjectSpec placed(const TetMesh& mesh, double lift)
     return o;
 }
 
-Row run(const std::string& name, sim::Scene scene, int steps)
+Row run(const std::string& name, const sim::Scene& scene, int steps)
 {
     Row r;
     r.scene = name;

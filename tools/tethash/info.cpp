@@ -146,7 +146,7 @@ void print_text(const Summary& s)
                                       : fmt::format("{:>3g}+    ", kDihedralEdges[i]);
         const double frac = s.tets ? double(s.histogram[i]) / double(s.tets) : 0.0;
         fmt::print("    {} {:>9} {}\n", range, s.histogram[i],
-                   std::string(static_cast<std::size_t>(frac * 40 + 0.5), '#'));
+                   std::string(static_cast<std::size_t>(std::lround(frac * 40)), '#'));
     }
     const auto problems = r.problems();
     if (problems.empty()) fmt::print("  problems: none\n");
