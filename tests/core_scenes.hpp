@@ -1,5 +1,5 @@
 #pragma once
-// Small scene generators for the detection tests (independent of io::generate): cube lattices split into
+// Small scene generators for the detection tests (independent of meshing::generate): cube lattices split into
 // 6 tets per cube (Kuhn), placed, deformed and combined into multi-object scenes.
 #include "tethash/detect.hpp"
 

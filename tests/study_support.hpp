@@ -1,8 +1,8 @@
 #pragma once
 // Helpers of the study tests (test_study.cpp, test_cli_study.cpp): a small scene and the deterministic part of
 // a study table.
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/study/table.hpp"
 
 #include <filesystem>
@@ -16,10 +16,10 @@ namespace tethash::test {
 /// "DIR/a.vtu+DIR/b.vtu" (one scene of two objects for --mesh).
 inline std::string two_boxes(const std::filesystem::path& dir, int resolution, const Eigen::RowVector3d& shift)
 {
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = "box";
     p.resolution = resolution;
-    TetMesh a = io::generate(p);
+    TetMesh a = meshing::generate(p);
     TetMesh b = a;
     b.positions.rowwise() += shift;
     io::write_mesh((dir / "a.vtu").string(), a);

@@ -14,7 +14,7 @@ inline meshing::SurfaceMesh sphere_surface(int resolution)
     meshing::GenerateParams p;
     p.shape = "sphere";
     p.resolution = resolution;
-    return io::boundary_surface(meshing::generate(p));
+    return meshing::boundary_surface(meshing::generate(p));
 }
 
 /// Enclosed volume by the divergence theorem (positive for outward-oriented triangles).

@@ -2,8 +2,8 @@
 #include "study_support.hpp"
 #include "support.hpp"
 
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/study/table.hpp"
 
 #include <algorithm>
@@ -168,10 +168,10 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     // 1 % inverted tets ("ok") or stops with the simulator's message ("stopped", naming the step); "crumpled"
     // (completed but garbage) must never appear.
     const auto dir = test::temp_dir();
-    io::GenerateParams p;
+    meshing::GenerateParams p;
     p.shape = "box";
     p.resolution = 3;
-    io::write_mesh((dir / "box.vtu").string(), io::generate(p));
+    io::write_mesh((dir / "box.vtu").string(), meshing::generate(p));
     const auto r = run_tethash("study stability --mesh " + quote(dir / "box.vtu") +
                                " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all --duration 0.6 "
                                "--no-plot --quiet --out " +

@@ -6,7 +6,6 @@
 
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
-#include "tethash/sim/scene.hpp"
 
 #include <gtest/gtest.h>
 

@@ -32,7 +32,7 @@ TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
     p.shape = "box";
     p.resolution = 5;
     const TetMesh m = meshing::generate(p);
-    const io::SurfaceMesh s = io::boundary_surface(m);
+    const io::SurfaceMesh s = meshing::boundary_surface(m);
     EXPECT_EQ(s.triangles.rows(), boundary_faces(m.tets).rows());
     EXPECT_LT(s.vertices.rows(), m.num_vertices()); // interior vertices dropped
     EXPECT_NEAR(enclosed_volume(s), 1.0, 1e-9);     // outward orientation, closed

@@ -1,4 +1,4 @@
-// Tests of io/generate.hpp: shapes on the BCC lattice validate, are deterministic, have the analytic
+// Tests of meshing/generate.hpp: shapes on the BCC lattice validate, are deterministic, have the analytic
 // volume, keep good tets, and reject bad parameters.
 #include "tethash/error.hpp"
 #include "tethash/mesh.hpp"

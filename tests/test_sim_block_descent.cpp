@@ -6,9 +6,10 @@
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 #include "tethash/sim/quality.hpp"
 #include "tethash/sim/simulation.hpp"
 
@@ -26,7 +27,7 @@ Scene cantilever(int resolution, double thickness, double young)
 {
     Scene s;
     ObjectSpec o;
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = resolution;
     g.size = Eigen::Vector3d(1.0, thickness, thickness);
@@ -104,7 +105,7 @@ TEST(SimBlockDescent, BitIdenticalAtOneAndTwoThreads)
         Scene s;
         for (int k = 0; k < 2; ++k) {
             ObjectSpec o;
-            io::GenerateParams g;
+            meshing::GenerateParams g;
             g.shape = k == 0 ? "box" : "sphere";
             g.resolution = 14;
             g.size = Eigen::Vector3d::Constant(0.6);
@@ -216,9 +217,9 @@ TEST(SimBlockDescent, RealMeshAndItsRegularRemeshSagTheSame)
     const auto path = test::shared_mesh("armadillo_4k.node");
     if (!path) GTEST_SKIP() << "../shared/meshes absent";
     const TetMesh real = io::read_mesh(path->string());
-    io::TetrahedralizeParams tp;
+    meshing::TetrahedralizeParams tp;
     tp.resolution = 16;
-    const TetMesh regular = io::tetrahedralize(io::boundary_surface(real), tp);
+    const TetMesh regular = meshing::tetrahedralize(meshing::boundary_surface(real), tp);
     auto sag = [](const TetMesh& mesh) {
         Scene s;
         s.objects.push_back(placed(mesh, 1.0, 0.0));

@@ -4,7 +4,7 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/sim/simulation.hpp"
 
 #include <cmath>
@@ -17,7 +17,7 @@ namespace {
 ObjectSpec box_object(double size, const Eigen::Vector3d& at, int res = 2)
 {
     ObjectSpec o;
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = res;
     g.size = Eigen::Vector3d::Constant(size);
@@ -190,9 +190,9 @@ TEST(SimContact, InvertedTetsAtStartAreRestored)
     for (Integrator integ : {Integrator::implicit_euler, Integrator::symplectic_euler}) {
         Scene s;
         ObjectSpec o = box_object(1.0, {0, 0, 0}, 3);
-        io::GenerateParams g = *o.generate;
+        meshing::GenerateParams g = *o.generate;
         o.generate.reset();
-        TetMesh m = io::generate(g);
+        TetMesh m = meshing::generate(g);
         m.rest_positions = m.positions;
         // Push one interior vertex through the opposite side of its star: its tets invert.
         Index inner = -1;
@@ -228,7 +228,7 @@ TEST(SimContact, NearlyFlatTetsAtStartStayFinite)
 {
     Scene s;
     ObjectSpec o = box_object(1.0, {0, 0, 0}, 2);
-    TetMesh m = io::generate(*o.generate);
+    TetMesh m = meshing::generate(*o.generate);
     o.generate.reset();
     // Flatten one boundary tet almost completely in the rest state: volume ~1e-6 of a normal one.
     const Index t = 0;

@@ -3,7 +3,7 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/sim/simulation.hpp"
 
 #include <Eigen/Geometry>
@@ -19,11 +19,11 @@ namespace {
 
 TetMesh box_mesh(int res = 2, double size = 1.0)
 {
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = res;
     g.size = Eigen::Vector3d::Constant(size);
-    return io::generate(g);
+    return meshing::generate(g);
 }
 
 /// One free box, no gravity, no ground, no collisions: only the elastic model acts.

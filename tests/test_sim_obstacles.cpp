@@ -3,8 +3,8 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/sim/simulation.hpp"
 
 #include <cmath>
@@ -19,7 +19,7 @@ namespace {
 ObjectSpec box_object(const Eigen::Vector3d& size, const Eigen::Vector3d& at, int res = 2)
 {
     ObjectSpec o;
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = res;
     g.size = size;
@@ -48,12 +48,12 @@ TEST(SimObstacle, BodyComesToRestOnAClosedSurfaceObstacle)
     const auto dir = temp_dir();
     // The obstacle: the boundary of a generated slab, written as OBJ, read back through assimp and
     // tetrahedralized on load.
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "box";
     g.resolution = 3;
     g.size = Eigen::Vector3d(1.2, 1.2, 0.4);
     const std::string obj = (dir / "slab.obj").string();
-    io::write_surface(obj, io::boundary_surface(io::generate(g)));
+    io::write_surface(obj, meshing::boundary_surface(meshing::generate(g)));
 
     Scene s;
     ObjectSpec slab;

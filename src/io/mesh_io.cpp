@@ -143,7 +143,7 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
     else if (e == ".node" || e == ".ele")
         write_tetgen(path, mesh);
     else if (is_surface_path(path))
-        write_surface(path, boundary_surface(mesh));
+        write_surface(path, meshing::boundary_surface(mesh));
     else
         throw Error(path + ": unknown output format '" + e + "' " + k_write_formats);
 }

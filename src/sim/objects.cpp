@@ -1,9 +1,10 @@
 #include "objects.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/meshing/tetrahedralize.hpp"
 
 #include <Eigen/Geometry>
 
@@ -23,14 +24,14 @@ TetMesh load_object(const ObjectSpec& o)
     TetMesh m;
     if (!o.mesh.empty()) {
         if (io::is_surface_path(o.mesh) && !io::is_tet_mesh_path(o.mesh)) {
-            io::TetrahedralizeParams tp;
+            meshing::TetrahedralizeParams tp;
             tp.resolution = o.surface_resolution;
-            m = io::tetrahedralize(io::read_surface(o.mesh), tp);
+            m = meshing::tetrahedralize(io::read_surface(o.mesh), tp);
         } else {
             m = io::read_mesh(o.mesh);
         }
     } else if (o.generate) {
-        m = io::generate(*o.generate);
+        m = meshing::generate(*o.generate);
     } else if (o.data) {
         m = *o.data;
     } else {

@@ -52,7 +52,7 @@ const char* to_string(LinearSolver solver)
 
 namespace {
 
-/// Largest lattice resolution of generated and tetrahedralized objects (io::generate's limit).
+/// Largest lattice resolution of generated and tetrahedralized objects (meshing::generate's limit).
 constexpr std::int64_t k_max_resolution = 1000;
 
 /// Reads one TOML table, checking every key is known and every value has the right type.
@@ -254,7 +254,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
         else if (key == "generate") {
             const toml::table& g = r.table(v, full);
             r.check_keys(g, full + ".", {"shape", "resolution", "size", "snap"});
-            io::GenerateParams gp;
+            meshing::GenerateParams gp;
             double longest = 0; // > 0 when 'size' is one number
             for (auto&& [gk, gv] : g) {
                 const std::string gkey(gk.str()), gfull = full + "." + gkey;
@@ -263,7 +263,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
                     // Checked here so the message names the line; generate() checks again.
                     std::vector<std::string> shapes;
                     try {
-                        shapes = io::generate_shapes();
+                        shapes = meshing::generate_shapes();
                     } catch (const std::exception&) {
                     }
                     if (!shapes.empty() && std::find(shapes.begin(), shapes.end(), gp.shape) == shapes.end()) {
@@ -286,7 +286,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
                 } else if (gkey == "snap")
                     gp.snap = r.boolean(gv, gfull);
             }
-            if (longest > 0) gp.scale = longest / io::shape_natural_size(gp.shape).maxCoeff();
+            if (longest > 0) gp.scale = longest / meshing::shape_natural_size(gp.shape).maxCoeff();
             o.generate = gp;
         }
     }

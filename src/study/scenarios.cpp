@@ -1,8 +1,8 @@
-// The five scenarios of Teschner et al. 2003, rebuilt with io::generate.
+// The five scenarios of Teschner et al. 2003, rebuilt with meshing::generate.
 #include "tethash/study/scenarios.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 
 #include <Eigen/Geometry>
 
@@ -40,16 +40,16 @@ struct Choice {
 /// The generated object (shape, resolution) whose tet and vertex counts are closest (in log ratio) to the targets.
 Choice search_object(double target_tets, double target_vertices)
 {
-    const auto shapes = io::generate_shapes();
+    const auto shapes = meshing::generate_shapes();
     Choice best;
     double best_err = std::numeric_limits<double>::infinity();
     for (const char* shape : {"sphere", "box", "blob"}) {
         if (std::find(shapes.begin(), shapes.end(), shape) == shapes.end()) continue;
         for (int res = 1; res <= 64; ++res) {
-            io::GenerateParams p;
+            meshing::GenerateParams p;
             p.shape = shape;
             p.resolution = res;
-            TetMesh m = io::generate(p);
+            TetMesh m = meshing::generate(p);
             if (m.num_tets() == 0) continue;
             const double err = std::abs(std::log(m.num_tets() / target_tets)) +
                                0.5 * std::abs(std::log(m.num_vertices() / target_vertices));
@@ -61,7 +61,7 @@ Choice search_object(double target_tets, double target_vertices)
             if (best.mesh.num_tets() > 0 && too_big) break;
         }
     }
-    if (best.mesh.num_tets() == 0) throw Error("teschner scenarios: io::generate produced no usable shape");
+    if (best.mesh.num_tets() == 0) throw Error("teschner scenarios: meshing::generate produced no usable shape");
     return best;
 }
 

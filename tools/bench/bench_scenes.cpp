@@ -1,7 +1,7 @@
 // The scenes of tethash_bench (bench_scenes.hpp).
 #include "bench_scenes.hpp"
 
-#include "tethash/io/generate.hpp"
+#include "tethash/meshing/generate.hpp"
 
 #include <Eigen/Geometry>
 
@@ -11,10 +11,10 @@ namespace tethash::bench {
 
 TetMesh lattice_scene(int objects, std::uint32_t seed)
 {
-    io::GenerateParams g;
+    meshing::GenerateParams g;
     g.shape = "blob";
     g.resolution = 6;
-    TetMesh obj = io::generate(g);
+    TetMesh obj = meshing::generate(g);
     obj.vertex_object.clear();
     obj.tet_object.clear();
     obj.rest_positions.resize(0, 3);

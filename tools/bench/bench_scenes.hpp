@@ -11,7 +11,7 @@
 
 namespace tethash::bench {
 
-/// `objects` copies of the scenario-5 object (io::generate "blob", resolution 6, as study/scenarios.hpp chooses
+/// `objects` copies of the scenario-5 object (meshing::generate "blob", resolution 6, as study/scenarios.hpp chooses
 /// it) on a k × k × k lattice with centre spacing 0.6 × the object size, randomly rotated: every object overlaps
 /// its lattice neighbours as in scenario 5, whatever the count.
 TetMesh lattice_scene(int objects, std::uint32_t seed);

@@ -1,5 +1,5 @@
 // tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all threads for the
-// five scenarios of Teschner et al. 2003 rebuilt with io::generate (objects overlapping heavily), plus the
+// five scenarios of Teschner et al. 2003 rebuilt with meshing::generate (objects overlapping heavily), plus the
 // meshes of ../shared/meshes; and, in the same run, a plain implementation of the 2003 algorithm
 // (baseline_2003.hpp) as the baseline. Scenes of its own: bench_scenes.hpp. `tethash_bench --help` lists options.
 //

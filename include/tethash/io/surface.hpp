@@ -15,8 +15,6 @@ bool have_assimp();
 SurfaceMesh read_surface(const std::string& path);
 /// Format from the extension (.obj .ply .stl .gltf .glb).
 void write_surface(const std::string& path, const SurfaceMesh& surface);
-/// The outward boundary of `mesh` as a surface (vertices compacted).
-SurfaceMesh boundary_surface(const TetMesh& mesh);
 /// True if `path` has a surface extension.
 bool is_surface_path(const std::string& path);
 

@@ -10,4 +10,7 @@ struct SurfaceMesh {
     Triangles triangles; ///< t × 3
 };
 
+/// The outward boundary of `mesh` as a surface (vertices compacted, kept in increasing original index).
+SurfaceMesh boundary_surface(const TetMesh& mesh);
+
 } // namespace tethash::meshing

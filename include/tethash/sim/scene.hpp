@@ -5,8 +5,8 @@
 /// Units: SI-like (length m, mass kg, time s) but nothing depends on the choice.
 
 #include "tethash/detect.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/sim/model.hpp"
 
 #include <Eigen/Core>
@@ -34,15 +34,15 @@ const char* to_string(LinearSolver solver);
 
 /// One object of the scene.
 struct ObjectSpec {
-    std::string name;                           ///< for messages; default "object K"
-    std::string mesh;                           ///< tet mesh file, or closed surface file (tetrahedralized on load)
-    std::optional<io::GenerateParams> generate; ///< built-in shape (used when `mesh` is empty)
-    std::optional<TetMesh> data;                ///< in-memory mesh (code only; used when mesh and generate are empty)
-    int surface_resolution = 16;                ///< lattice resolution when `mesh` is a surface
-    Eigen::Vector3d scale{1, 1, 1};             ///< applied first
-    Eigen::Vector3d rotate_deg{0, 0, 0};        ///< then rotations about x, y, z (degrees, in that order)
-    Eigen::Vector3d translate{0, 0, 0};         ///< then translation
-    Eigen::Vector3d velocity{0, 0, 0};          ///< initial velocity of every vertex
+    std::string name; ///< for messages; default "object K"
+    std::string mesh; ///< tet mesh file, or closed surface file (tetrahedralized on load)
+    std::optional<meshing::GenerateParams> generate; ///< built-in shape (used when `mesh` is empty)
+    std::optional<TetMesh> data;         ///< in-memory mesh (code only; used when mesh and generate are empty)
+    int surface_resolution = 16;         ///< lattice resolution when `mesh` is a surface
+    Eigen::Vector3d scale{1, 1, 1};      ///< applied first
+    Eigen::Vector3d rotate_deg{0, 0, 0}; ///< then rotations about x, y, z (degrees, in that order)
+    Eigen::Vector3d translate{0, 0, 0};  ///< then translation
+    Eigen::Vector3d velocity{0, 0, 0};   ///< initial velocity of every vertex
     Material material;
     bool self_collision = true;
     bool is_static = false; ///< never moves: an obstacle (hashed once by the detector)

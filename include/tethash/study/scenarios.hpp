@@ -1,7 +1,7 @@
 #pragma once
 /// \file study/scenarios.hpp
 /// The five test scenarios of Teschner et al. 2003 ("Optimized Spatial Hashing for Collision Detection of
-/// Deformable Objects", table 1), rebuilt with tethash's own generator (io::generate): the same numbers of
+/// Deformable Objects", table 1), rebuilt with tethash's own generator (meshing::generate): the same numbers of
 /// objects, tets and vertices (approximately: the generator's lattice decides the exact counts), objects
 /// packed so that neighbours overlap heavily and the detector finds real contacts. Deterministic.
 /// Used by `tethash study --teschner-scenarios` and by the benchmark.

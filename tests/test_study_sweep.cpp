@@ -3,7 +3,6 @@
 #include "support.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/generate.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/oracle.hpp"
 #include "tethash/study/scenarios.hpp"
