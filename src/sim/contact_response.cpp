@@ -29,6 +29,10 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
 {
     m_mesh = &mesh;
     m_model = &model;
+    // The positions the run starts from: `mesh` is the live state (its positions change every step and it keeps
+    // no separate rest positions unless its file had them), so the rest state the local-contact test measures
+    // in is copied here once.
+    m_rest = mesh.rest();
     m_params = scene.contact;
     m_mu = scene.contact.friction;
     m_object_k.assign(scene.objects.size(), 0.0);
@@ -84,7 +88,7 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
     t0 = Clock::now();
     const TetMesh& mesh = *m_mesh;
     const Model& model = *m_model;
-    const Positions& rest = mesh.rest();
+    const Positions& rest = m_rest;
     m_contacts.reserve(found.size());
     for (const Contact& c : found) {
         if (c.vertex_object == c.tet_object) {

@@ -56,6 +56,7 @@ class ContactResponse {
   private:
     const TetMesh* m_mesh = nullptr;
     const Model* m_model = nullptr;
+    Positions m_rest; // rest (start) positions, for telling local self-contacts from folds
     bool m_enabled = false;
     ContactParams m_params;
     Detector m_detector;
