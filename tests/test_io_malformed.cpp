@@ -206,6 +206,7 @@ TEST(IoMalformed, SceneIntegersAreCheckedBeforeNarrowing)
          "key 'pin[0].vertices': must be in [0, 2147483647], found 4294967296"},
         {"substeps = 2147483648\n" + object, "key 'substeps': must be in [1, 2147483647]"},
         {"iterations = -4294967295\n" + object, "key 'iterations': must be in [0, 2147483647]"},
+        {"max_substeps = -1\n" + object, "key 'max_substeps': must be in [0, 2147483647]"},
         {"[output]\nevery = 4294967296\n" + object, "key 'output.every': must be in [0, 2147483647]"},
         {"[detector]\nthreads = 4294967297\n" + object, "key 'detector.threads': must be in [0, 2147483647]"},
         {"[[object]]\ngenerate = { shape = \"box\", resolution = 4294967297 }\n",

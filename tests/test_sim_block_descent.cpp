@@ -257,40 +257,42 @@ TEST(SimBlockDescent, RealMeshAndItsRegularRemeshSagTheSame)
 TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
 {
     // The small shared meshes (the larger ones are in tethash_sim_bench) dropped 0.2 m with self-collision on:
-    // no blow-up at dt 1/240 or 1/60 and a finite state that reached the ground; at 1/240 at most 1 % inverted
-    // tets and no vertex folded through a distant part of its body. What does not hold yet is listed as open in
-    // docs/simulator.md with the benchmark's numbers: screw and P1 crumple at 1/60, and P1 (a lattice of thin
-    // struts that collapses under its weight, its struts pressed onto each other) also at 1/240 with the default
-    // 6 sweeps; the run must say so, and with 10 sweeps P1 must hold at 1/240.
+    // at dt 1/240 and 1/60 the run completes, reaches the ground, ends with at most 1 % inverted tets and (at
+    // 1/240) no vertex folded through a distant part of its body. Screw and P1 (a lattice of thin struts that
+    // collapses under its weight) need refined steps for it at 1/60 (P1 also at 1/240): without refinement
+    // (max_substeps 1) they crumple, and the run must say so.
     int ran = 0;
     for (const char* name : {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh"}) {
         const auto path = test::shared_mesh(name);
         if (!path) continue;
         const TetMesh mesh = io::read_mesh(path->string());
-        const bool p1 = std::string(name) == "P1.msh";
+        const bool hard = std::string(name) == "screw.msh" || std::string(name) == "P1.msh";
         for (double dt : {1.0 / 240, 1.0 / 60}) {
-            Scene scene = drop(mesh, dt);
-            Simulation sim(scene);
+            Simulation sim(drop(mesh, dt));
             const Positions start = sim.positions();
-            std::string failure = run_for(sim, 0.6);
-            if (!failure.empty() && (p1 || (dt > 1.0 / 200 && std::string(name) == "screw.msh"))) {
-                // Open (docs/simulator.md): these crumple; what must hold is that the run says so.
-                EXPECT_NE(failure.find("crumpled"), std::string::npos) << name << ": " << failure;
-                if (dt > 1.0 / 200) continue;
-                scene.iterations = 10;
-                Simulation again(scene);
-                failure = run_for(again, 0.6);
-                EXPECT_EQ(failure, "") << name << " dt " << dt << " with 10 sweeps";
-                EXPECT_LE(count_inverted(again.mesh(), start), mesh.num_tets() / 100) << name << " 10 sweeps";
-                // A few vertices (0.5 %) are still caught inside a strut they crossed within one step.
-                EXPECT_LE(count_far_self_penetrations(again.mesh(), start), mesh.num_vertices() / 200) << name;
-                ++ran;
-                continue;
+            const int steps = static_cast<int>(std::lround(0.6 / dt));
+            std::string failure;
+            int most_substeps = 1;
+            try {
+                for (int i = 0; i < steps; ++i) {
+                    sim.step();
+                    most_substeps = std::max(most_substeps, sim.last_stats().substeps);
+                }
+            } catch (const RunFailure& e) {
+                failure = e.what();
             }
             EXPECT_EQ(failure, "") << name << " dt " << dt;
             EXPECT_LE(count_inverted(sim.mesh(), start), mesh.num_tets() / 100) << name << " dt " << dt;
             EXPECT_TRUE(sim.positions().allFinite()) << name << " dt " << dt;
             EXPECT_LT(sim.positions().col(2).minCoeff(), 0.05) << name << " dt " << dt << ": did not land";
+            if (hard && dt > 1.0 / 200) {
+                EXPECT_GT(most_substeps, 1) << name << ": held at 1/60 without refined steps";
+                Scene coarse = drop(mesh, dt);
+                coarse.max_substeps = 1;
+                Simulation unrefined(coarse);
+                failure = run_for(unrefined, 0.6);
+                EXPECT_NE(failure.find("crumpled"), std::string::npos) << name << ": " << failure;
+            }
             if (dt > 1.0 / 200) continue;
             EXPECT_EQ(count_far_self_penetrations(sim.mesh(), start), 0) << name << " dt " << dt;
             ++ran;

@@ -29,6 +29,7 @@ TEST(SimScene, ReadsEveryKey)
 dt = 0.005
 steps = 12
 substeps = 3
+max_substeps = 12
 integrator = "vbd"
 solver = "ldlt"
 iterations = 7
@@ -74,6 +75,7 @@ box_max = [1, 1, 1]
     EXPECT_EQ(s.dt, 0.005);
     EXPECT_EQ(s.steps, 12);
     EXPECT_EQ(s.substeps, 3);
+    EXPECT_EQ(s.max_substeps, 12);
     EXPECT_EQ(s.integrator, Integrator::vbd);
     EXPECT_EQ(s.solver, LinearSolver::ldlt);
     EXPECT_EQ(s.iterations, 7);

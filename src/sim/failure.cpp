@@ -56,8 +56,7 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
         m_object_height.push_back(hi_h[o] > lo_h[o] ? hi_h[o] - lo_h[o] : 0.0);
 }
 
-std::string FailureCheck::check_inverted(const Model& model, const Scene& scene, const Positions& x, double h, double t,
-                                         double dt_limit)
+std::int64_t count_inverted_tets(const Model& model, const Positions& x)
 {
     const Index nt = static_cast<Index>(model.volumes.tets.rows());
     std::int64_t inverted = 0;
@@ -68,6 +67,13 @@ std::string FailureCheck::check_inverted(const Model& model, const Scene& scene,
             (x.row(tet(1)).transpose() - a).dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
         inverted += w > 0 ? 0 : 1;
     }
+    return inverted;
+}
+
+std::string FailureCheck::check_inverted(const Model& model, const Scene& scene, std::int64_t inverted, double h,
+                                         double t, double dt_limit)
+{
+    const std::int64_t nt = static_cast<std::int64_t>(model.volumes.tets.rows());
     if (inverted * 100 <= nt) {
         m_inverted_since = -1;
         return {};

@@ -23,12 +23,12 @@ class FailureCheck {
     std::string check_substep(const Model& model, const Positions& x, const Positions& v, double t_end) const;
     /// Empty when the internal energy after a step is below 1000 × the reference; else what is wrong.
     std::string check_energy(double internal) const;
-    /// Called after every step ending at time t. Empty unless the body crumpled: more than 1 % of the dynamic tets
-    /// inverted (signed volume ≤ 0; rest volumes are positive) for 0.1 s of simulated time without a break, or
-    /// more than 10 % at once (an impact inverts a few tets for a few steps; they recover). Else how many, and
-    /// the likely cause: a material too soft to carry its own weight, a much denser body crushing a lighter one,
-    /// or a time step too large for the material.
-    std::string check_inverted(const Model& model, const Scene& scene, const Positions& x, double h, double t,
+    /// Called after every step ending at time t with the inverted tets then (count_inverted_tets). Empty unless the
+    /// body crumpled: more than 1 % of the dynamic tets inverted (signed volume ≤ 0; rest volumes are positive) for 0.1
+    /// s of simulated time without a break, or more than 10 % at once (an impact inverts a few tets for a few steps;
+    /// they recover). Else how many, and the likely cause: a material too soft to carry its own weight, a much denser
+    /// body crushing a lighter one, or a time step too large for the material.
+    std::string check_inverted(const Model& model, const Scene& scene, std::int64_t inverted, double h, double t,
                                double dt_limit);
     /// The likely cause of a failure at substep length h, for the message.
     std::string likely_cause(const Scene& scene, double h, double dt_limit, const ContactResponse& contacts) const;
@@ -44,6 +44,9 @@ class FailureCheck {
     double m_inverted_since = -1;        ///< time at which more than 1 % of the tets became inverted (−1: not now)
     std::vector<double> m_object_height; ///< per object: extent along gravity at start (0: static or none)
 };
+
+/// Tets of the model's volume terms (the dynamic ones) whose signed volume at x is ≤ 0.
+std::int64_t count_inverted_tets(const Model& model, const Positions& x);
 
 /// Short number for messages (3 significant digits).
 std::string short_number(double v);

@@ -312,8 +312,9 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     Scene s;
     s.source = source_name;
     r.check_keys(root, "",
-                 {"dt", "steps", "substeps", "integrator", "solver", "iterations", "tolerance", "sweep_tolerance",
-                  "acceleration", "gravity", "ground", "contact", "detector", "output", "object", "pin"});
+                 {"dt", "steps", "substeps", "max_substeps", "integrator", "solver", "iterations", "tolerance",
+                  "sweep_tolerance", "acceleration", "gravity", "ground", "contact", "detector", "output", "object",
+                  "pin"});
     for (auto&& [k, v] : root) {
         const std::string key(k.str());
         if (key == "dt")
@@ -322,6 +323,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             s.steps = r.int_at_least(v, key, 0);
         else if (key == "substeps")
             s.substeps = r.int_at_least(v, key, 1);
+        else if (key == "max_substeps")
+            s.max_substeps = r.int_at_least(v, key, 0);
         else if (key == "iterations")
             s.iterations = r.int_at_least(v, key, 0);
         else if (key == "tolerance")

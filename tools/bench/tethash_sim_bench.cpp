@@ -37,11 +37,21 @@ struct Row {
     double dt = 0;
     Index vertices = 0, tets = 0;
     double ms = 0, detect = 0, depth = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
+    double ms_mean = 0;  ///< mean ms per step: the cost that counts where some steps were refined
+    double substeps = 1; ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
     double mean_z = 0; ///< mean height of the vertices at the end (how far the body sagged or sank)
     bool stable = false;
     std::string failure;
 };
+
+double mean(const std::vector<double>& v)
+{
+    double sum = 0;
+    for (double x : v)
+        sum += x;
+    return v.empty() ? 0 : sum / static_cast<double>(v.size());
+}
 
 double median(std::vector<double> v)
 {
@@ -73,7 +83,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
-    std::vector<double> ms, det, dep, resp, integ, sw, con;
+    std::vector<double> ms, det, dep, resp, integ, sw, con, sub;
     try {
         for (int i = 0; i < steps; ++i) {
             const auto t0 = std::chrono::steady_clock::now();
@@ -86,6 +96,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
             integ.push_back(st.ms_integrate);
             sw.push_back(st.solver_iterations);
             con.push_back(static_cast<double>(st.contacts));
+            sub.push_back(st.substeps);
         }
     } catch (const RunFailure& e) {
         r.failure = e.what();
@@ -97,10 +108,9 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.response = median(resp);
     r.integrate = median(integ);
     r.sweeps = median(sw);
-    double csum = 0;
-    for (double c : con)
-        csum += c;
-    r.contacts = con.empty() ? 0 : csum / static_cast<double>(con.size());
+    r.ms_mean = mean(ms);
+    r.substeps = sub.empty() ? 1 : mean(sub);
+    r.contacts = mean(con);
     r.inverted = sim::count_inverted(s.mesh(), start);
     r.far_self = sim::count_far_self_penetrations(s.mesh(), start);
     r.mean_z = s.mesh().positions.col(2).mean();
@@ -129,6 +139,7 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
         bodies.push_back({&placed_meshes[k], scene.objects[k].material.density, scene.objects[k].velocity});
     const bench::PeerResult p = bench::run_bullet(bodies, scene.dt, steps, iterations);
     r.ms = median(p.ms);
+    r.ms_mean = mean(p.ms);
     r.integrate = r.ms;
     r.sweeps = iterations;
     r.failure = p.failure;
@@ -149,10 +160,11 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
 
 void print(const Row& r)
 {
-    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %6.1f %8.1f %7lld %5lld %7.4f %10.3g  %s\n",
-                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth, r.response,
-                r.integrate, r.sweeps, r.contacts, static_cast<long long>(r.inverted),
-                static_cast<long long>(r.far_self), r.mean_z, r.stable ? r.dt / r.ms : 0.0, r.failure.c_str());
+    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %7.4f "
+                "%10.3g  %s\n",
+                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
+                r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
+                static_cast<long long>(r.far_self), r.mean_z, r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
     std::fflush(stdout);
 }
 
@@ -175,7 +187,7 @@ int main(int argc, char** argv)
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     double seconds = 0.5;
-    int threads = 1, peer_iterations = 10, iterations = 0;
+    int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0;
     double skin = -1, sweep_tolerance = -1, rho = -1;
     bool no_peer = false;
     app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
@@ -186,6 +198,9 @@ int main(int argc, char** argv)
     app.add_option("--threads", threads, "detector and solver threads")->capture_default_str();
     app.add_option("--csv", csv, "write the rows as CSV to this file");
     app.add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
+    app.add_option("--max-substeps", max_substeps,
+                   "refine a step that inverts tets or blows up into up to this many substeps; 1 = never; "
+                   "0 = the scene default");
     app.add_option("--sweep-tolerance", sweep_tolerance,
                    "vbd early stop (fraction of the mean edge); default: scene's");
     app.add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1); default: scene's");
@@ -257,9 +272,9 @@ int main(int argc, char** argv)
                 scenes.emplace_back("two armadillos at 2 m/s", two);
             }
         }
-        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %6s %8s %7s %5s %7s %10s  %s\n", "scene", "integrator",
-                    "dt", "verts", "tets", "ms/step", "detect", "depth", "resp", "integr", "iters", "contacts",
-                    "invert", "far", "mean_z", "dt/ms", "failure");
+        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %7s %10s  %s\n", "scene",
+                    "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "resp", "integr",
+                    "iters", "subst", "contacts", "invert", "far", "mean_z", "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!filter.empty() && name.find(filter) == std::string::npos) continue;
@@ -269,6 +284,7 @@ int main(int argc, char** argv)
                     scene.dt = dt;
                     scene.detect.threads = threads;
                     if (iterations > 0) scene.iterations = iterations;
+                    if (max_substeps > 0) scene.max_substeps = max_substeps;
                     if (sweep_tolerance >= 0) scene.sweep_tolerance = sweep_tolerance;
                     if (rho >= 0) scene.acceleration = rho;
                     if (skin >= 0) {
@@ -296,7 +312,7 @@ int main(int argc, char** argv)
         for (const Row& r : rows)
             if (r.stable) {
                 auto& b = best[{r.scene, r.integrator}];
-                if (r.dt > b.first) b = {r.dt, r.ms};
+                if (r.dt > b.first) b = {r.dt, r.ms_mean};
             }
         std::printf("\nlargest stable dt / ms per step (Teschner et al. 2004), over the dt run:\n");
         for (const auto& [key, v] : best)
@@ -307,14 +323,15 @@ int main(int argc, char** argv)
             {
                 std::ofstream out(tmp);
                 if (!out) throw Error("--csv: cannot write '" + tmp + "'");
-                out << "scene,integrator,dt,vertices,tets,ms_step,ms_detect,ms_depth,ms_response,ms_integrate,"
-                       "iterations,contacts,inverted,far_self,mean_z,stable,failure\n";
+                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_response,"
+                       "ms_integrate,iterations,substeps,contacts,inverted,far_self,mean_z,stable,failure\n";
                 for (const Row& r : rows)
                     out << fmt::format(
-                        "{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},{},{},{:.5g},{},\"{}\"\n",
-                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.detect, r.depth, r.response,
-                        r.integrate, r.sweeps, r.contacts, r.inverted, r.far_self, r.mean_z, r.stable ? 1 : 0,
-                        r.failure);
+                        "{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.3g},{:.4g},{},{},{:."
+                        "5g},{},\"{}\"\n",
+                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth, r.response,
+                        r.integrate, r.sweeps, r.substeps, r.contacts, r.inverted, r.far_self, r.mean_z,
+                        r.stable ? 1 : 0, r.failure);
             }
             std::filesystem::rename(tmp, csv);
         }

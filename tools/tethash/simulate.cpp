@@ -147,7 +147,7 @@ void run_simulate(const SimulateOptions& o)
 
     const bool tty = stderr_is_terminal();
     double ms_detect = 0, ms_depth = 0, ms_response = 0, ms_integrate = 0, max_depth = 0, depth_sum = 0;
-    std::int64_t contacts = 0, iterations = 0, ignored = 0;
+    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0;
     const auto start = std::chrono::steady_clock::now();
     auto last_print = start;
     const int plain_every = std::max(1, scene.steps / 10);
@@ -174,6 +174,10 @@ void run_simulate(const SimulateOptions& o)
             ms_integrate += st.ms_integrate;
             contacts += st.contacts;
             iterations += st.solver_iterations;
+            if (st.substeps > scene.substeps) {
+                ++refined;
+                refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
+            }
             max_depth = std::max(max_depth, st.max_depth);
             depth_sum += st.mean_depth * static_cast<double>(st.contacts);
             if (every > 0 && sim.step_index() % every == 0) write_frame();
@@ -219,6 +223,11 @@ void run_simulate(const SimulateOptions& o)
     if (iterations)
         std::fprintf(stdout, "solver: %.1f %s per step\n", static_cast<double>(iterations) / n,
                      scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
+    if (refined)
+        std::fprintf(stdout,
+                     "refined steps: %lld of %d taken in up to %lld substeps (tets inverted or a blow-up at "
+                     "%d; max_substeps bounds it)\n",
+                     static_cast<long long>(refined), n, static_cast<long long>(refined_substeps), scene.substeps);
     std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
                  contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
     std::fprintf(stdout,

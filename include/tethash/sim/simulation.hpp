@@ -35,6 +35,7 @@ struct StepStats {
     double max_depth = 0;           ///< largest penetration depth at the last substep (0 without contacts)
     double mean_depth = 0;          ///< mean over contacts at the last substep
     int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
+    int substeps = 1;               ///< substeps the step took (scene substeps, or more where it was refined)
 };
 
 class SimulationImpl;
