@@ -169,10 +169,10 @@ void Simulation::step()
                                      : std::string()));
     };
     // A step that leaves more than 1 % of the tets inverted, and more than it started with, is taken again in
-    // twice as many substeps, up to max_substeps (a step that blows up likewise): the time step a user picks
-    // stays the frame step, and the work grows only where the material or a contact needs it. A refined step
-    // count is kept for 0.05 s of simulated time, then halved, so a body that needs it does not pay for a failed
-    // attempt every step. (At 0.5 % instead of 1 %, transient inversions of impacts that recover by themselves
+    // twice as many substeps, up to max_substeps (a step that blows up or whose energy explodes likewise): the time
+    // step a user picks stays the frame step, and the work grows only where the material or a contact needs it. A
+    // refined step count is kept for 0.05 s of simulated time, then halved, so a body that needs it does not pay for a
+    // failed attempt every step. (At 0.5 % instead of 1 %, transient inversions of impacts that recover by themselves
     // were refined too: screw at 1/240 cost 2.3× as much and ended with more inverted tets, not fewer.)
     const int max_substeps = std::max(substeps, s.scene.max_substeps > 0                ? s.scene.max_substeps
                                                 : s.scene.integrator == Integrator::vbd ? 8 * substeps
@@ -212,6 +212,17 @@ void Simulation::step()
             }
             fail(bad);
         }
+        const Energy e = s.model.energy(x, s.v);
+        const std::string energy = s.failure.check_energy(e.internal() + s.contacts.energy());
+        if (!energy.empty()) {
+            if (substeps * 2 <= max_substeps) {
+                x = s.x_save;
+                s.v = s.v_save;
+                substeps *= 2;
+                continue;
+            }
+            fail(energy);
+        }
         s.inverted = count_inverted_tets(s.model, x);
         if (s.inverted > allowed && substeps * 2 <= max_substeps) {
             x = s.x_save;
@@ -226,9 +237,6 @@ void Simulation::step()
         s.refined_until = s.t + 0.05;
     }
     st.substeps = substeps;
-    const Energy e = s.model.energy(x, s.v);
-    const std::string bad = s.failure.check_energy(e.internal() + s.contacts.energy());
-    if (!bad.empty()) fail(bad);
     const std::string crumpled =
         s.failure.check_inverted(s.model, s.scene, s.inverted, s.scene.dt / substeps, s.t + s.scene.dt, s.dt_limit);
     if (!crumpled.empty()) fail(crumpled, false);
