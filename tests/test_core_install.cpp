@@ -22,7 +22,9 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
     ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
-    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io")); // core only
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.h"));   // the C interface
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.f90")); // its Fortran module
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io"));         // core only
 
     const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer";
     const auto cbuild = dir / "consumer";
