@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <span>
+#include <unordered_map>
 
 namespace fem {
 
@@ -52,6 +53,7 @@ void ContactModule::add(const Vec& x, Vec& f, Triplets* K, ContactReport& report
     report.force.assign(3 * static_cast<size_t>(m_objects), 0.0);
     report.pairs.clear();
     const double k = m_settings.stiffness;
+    report.stiffness = k;
     // Contacts are sorted by (node, tet); a node inside several tets of one object gets one penalty (its depth and
     // direction are per node and object).
     for (size_t c = 0; c < contacts.size(); ++c) {
@@ -65,7 +67,15 @@ void ContactModule::add(const Vec& x, Vec& f, Triplets* K, ContactReport& report
         if (ct.vertex_object == ct.tet_object) ++report.self_contacts;
         report.max_depth = std::max(report.max_depth, ct.depth);
         report.energy += 0.5 * k * ct.depth * ct.depth;
-        const Eigen::Vector3d n(ct.direction[0], ct.direction[1], ct.direction[2]);
+        // The direction of a (node, object) pair is kept from its first evaluation in the time step: the estimate
+        // turns by a few degrees where a node slides across faces, which Newton cannot converge through.
+        const std::int64_t key = static_cast<std::int64_t>(ct.vertex) * m_objects + ct.tet_object;
+        auto [frozen, fresh] =
+            m_directions.try_emplace(key, Eigen::Vector3d(ct.direction[0], ct.direction[1], ct.direction[2]));
+        (void)fresh;
+        const Eigen::Vector3d n = frozen->second;
+        for (int r = 0; r < 3; ++r)
+            report.pairs.back().direction[r] = n[r];
         // d ≈ d0 − n·δx_node + Σ bᵢ n·δx_i: gradient coefficients c (node −1, tet nodes bᵢ).
         int node[5] = {ct.vertex, 0, 0, 0, 0};
         double coef[5] = {-1, 0, 0, 0, 0};

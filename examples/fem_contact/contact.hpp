@@ -8,6 +8,8 @@
 #include <tethash/detect.hpp>
 #include <tethash/penetration.hpp>
 
+#include <unordered_map>
+
 namespace fem {
 
 struct ContactSettings {
@@ -26,6 +28,7 @@ struct ContactReport {
     bool reused = false;                 ///< the detector reused its kept candidates (skin)
     std::vector<double> force;           ///< contact force on each object (3 per object)
     std::vector<tethash::Contact> pairs; ///< the contacts used, with depth and direction
+    double stiffness = 0;                ///< the penalty k used
 };
 
 class ContactModule {
@@ -37,12 +40,15 @@ class ContactModule {
     void add(const Vec& x, Vec& f, Triplets* K, ContactReport& report);
     /// Exact distance of each contact of the report to the penetrated object's surface (for checks).
     std::vector<double> exact_depths(const Vec& x, const ContactReport& report) const;
+    /// A new time step: penalty directions are taken afresh from the next evaluation.
+    void begin_step() { m_directions.clear(); }
 
   private:
     tethash::Detector m_detector;
     tethash::Penetration m_penetration;
     ContactSettings m_settings;
     std::vector<std::int32_t> m_tets;
+    std::unordered_map<std::int64_t, Eigen::Vector3d> m_directions; ///< (node, object) → direction this step
     int m_nodes = 0, m_objects = 0;
 };
 

@@ -42,6 +42,7 @@ int Simulation::step()
     for (Eigen::Index d = 0; d < n3; ++d)
         if (free[static_cast<size_t>(d)] >= 0) m_x[d] = x_pred[d];
     const Vec f_ext = m_load + m_gravity_force;
+    m_contact.begin_step();
     const double f_scale = std::max(1.0, f_ext.lpNorm<Eigen::Infinity>());
 
     // The incremental potential Φ(x) = ½|x − x̃|²_M/h² + α/(2h)|x − xₙ|²_M + E_elastic + E_penalty − f_ext·x, whose
@@ -49,7 +50,9 @@ int Simulation::step()
     Vec f(n3), g(n3), rhs(nf);
     Triplets K, reduced;
     double ms_tethash = 0;
+    int evaluations = 0;
     auto evaluate = [&](const Vec& x) {
+        ++evaluations;
         f = f_ext;
         K.clear();
         m_elastic_energy = m_elastic.add(x, f, &K);
@@ -118,13 +121,13 @@ int Simulation::step()
                 break;
             }
         }
-        m_timings.push_back({ms_since(t0), ms_tethash, m_report.reused});
+        m_timings.push_back({ms_since(t0), ms_tethash, m_report.reused, evaluations});
         t0 = std::chrono::steady_clock::now();
         ms_tethash = 0;
-        // Stop when the step no longer moves anything, or when the line search had to cut it below 1/64: the
-        // penalty direction is an estimate that turns by a few degrees where a node slides from one face to the
-        // next, so the residual cannot drop below that jump (m_residual reports what was left).
-        if (t * step.lpNorm<Eigen::Infinity>() < m_settings.tolerance * m_elastic.smallest_edge() || t < 1.0 / 64) {
+        evaluations = 0;
+        // Stop when the step no longer moves anything (round-off), or when the line search had to cut it below
+        // 1/64 (m_residual reports what was left).
+        if (t * step.lpNorm<Eigen::Infinity>() < 1e-12 * m_elastic.smallest_edge() || t < 1.0 / 64) {
             m_converged = residual() < m_settings.tolerance * f_scale;
             ++it;
             break;

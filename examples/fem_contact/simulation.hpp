@@ -25,6 +25,7 @@ struct SimulationSettings {
 struct IterationTiming {
     double ms_total = 0, ms_tethash = 0;
     bool reused = false;
+    int evaluations = 0; ///< force evaluations (each one detection): 1 + line-search trials
 };
 
 class Simulation {
