@@ -26,6 +26,12 @@ module tethash
     real(c_double) :: direction(3)
   end type tethash_contact
 
+  type, bind(C) :: tethash_stats
+    real(c_double) :: ms_total, cell_size
+    integer(c_int64_t) :: table_size, contacts
+    integer(c_int32_t) :: reused, threads
+  end type tethash_stats
+
   interface
     function tethash_detector_create(detector) bind(C, name="tethash_detector_create") result(status)
       import :: c_ptr, c_int
@@ -128,6 +134,12 @@ module tethash
       type(c_ptr), value :: detector
       real(c_double), intent(in) :: positions(*)
       integer(c_int64_t), value :: num_vertices
+      integer(c_int) :: status
+    end function
+    function tethash_detector_stats(detector, stats) bind(C, name="tethash_detector_stats") result(status)
+      import :: c_ptr, c_int, tethash_stats
+      type(c_ptr), value :: detector
+      type(tethash_stats), intent(out) :: stats
       integer(c_int) :: status
     end function
     function tethash_last_error() bind(C, name="tethash_last_error") result(message)

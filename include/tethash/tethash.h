@@ -90,8 +90,8 @@ tethash_status tethash_detector_set_threads(tethash_detector* detector, int32_t 
 tethash_status tethash_detector_set_hash(tethash_detector* detector, tethash_hash hash);
 /** Candidate reuse between calls (a length >= 0; 0 = off): see DetectParams::skin in detect.hpp. */
 tethash_status tethash_detector_set_skin(tethash_detector* detector, double skin);
-/** Options of object `object` (>= 0): contacts within the object (self_collision != 0, the default) and static
- *  objects (is_static != 0: positions never change). Kept across set_topology calls. */
+/** Options of object `object` (0 <= object < 2^20): contacts within the object (self_collision != 0, the default) and
+ * static objects (is_static != 0: positions never change). Kept across set_topology calls. */
 tethash_status tethash_detector_set_object_options(tethash_detector* detector, int32_t object, int32_t self_collision,
                                                    int32_t is_static);
 

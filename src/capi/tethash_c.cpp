@@ -7,6 +7,7 @@
 #include "tethash/error.hpp"
 #include "tethash/penetration.hpp"
 
+#include <cassert>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -277,7 +278,9 @@ tethash_status tethash_detector_detect(tethash_detector* detector, const double*
     if (!positions && num_vertices > 0) return null_argument(where, "positions");
     return guard(where, [&] {
         detector->detected = false;
-        const Eigen::Map<const tethash::Positions> p(positions, static_cast<Eigen::Index>(num_vertices), 3);
+        const Eigen::Map<const tethash::Positions> map(positions, static_cast<Eigen::Index>(num_vertices), 3);
+        const tethash::PositionsRef p(map);
+        assert(p.data() == positions); // the caller's array, read in place
         const auto& contacts = detector->detector.detect(p, &detector->stats);
         detector->detected = true;
         if (out_count) *out_count = static_cast<int64_t>(contacts.size());

@@ -66,6 +66,10 @@ int main(void)
     check(tethash_detector_get_contacts(d, 1, vertex, tet, NULL, depth, NULL) == TETHASH_OK, "get_contacts");
     check(vertex[0] == 7 && tet[0] == 0 && near(depth[0], 0.1), "arrays agree");
 
+    tethash_stats stats;
+    check(tethash_detector_stats(d, &stats) == TETHASH_OK, "stats");
+    check(stats.contacts == 1 && stats.threads == 1 && stats.cell_size > 0, "stats of the detection");
+
     /* A wrong size is an error with a message, not a crash. */
     check(tethash_detector_detect(d, xyz, 7, &count) == TETHASH_ERROR_INVALID_ARGUMENT, "wrong size refused");
     check(strstr(tethash_last_error(), "num_vertices") != NULL, "message names num_vertices");

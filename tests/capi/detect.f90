@@ -14,6 +14,7 @@ program detect_fortran
   type(c_ptr) :: d
   integer(c_int64_t) :: count
   type(tethash_contact) :: c
+  type(tethash_stats) :: stats
   integer :: failures
 
   failures = 0
@@ -41,6 +42,9 @@ program detect_fortran
   call ok(tethash_detector_get_contacts(d, 1_c_int64_t, tet=tet), "get_contacts (tet only)")
   call ok(tethash_detector_contact(d, 0_c_int64_t, c), "contact 0")
   call expect(c%vertex == 7 .and. c%tet_object == 0 .and. c%vertex_object == 1, "contact record")
+
+  call ok(tethash_detector_stats(d, stats), "stats")
+  call expect(stats%contacts == 1 .and. stats%threads == 1 .and. stats%cell_size > 0, "stats")
 
   ! Errors come back as a status and a message.
   call expect(tethash_detector_detect(d, x, 7_c_int64_t, count) == TETHASH_ERROR_INVALID_ARGUMENT, "wrong size refused")
