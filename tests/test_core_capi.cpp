@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <limits>
+#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -157,7 +158,8 @@ TEST(CoreCapi, ParametersAndObjectOptionsPassThrough)
     ASSERT_EQ(tethash_detector_stats(h.d, &st), TETHASH_OK);
     EXPECT_EQ(st.reused, 1);
     expect_same(read_contacts(h.d), oracle, "reused");
-    EXPECT_STREQ(tethash_version(), "0.1.0");
+    EXPECT_TRUE(std::regex_match(std::string(tethash_version()), std::regex("[0-9]+\\.[0-9]+\\.[0-9]+")))
+        << tethash_version();
 }
 
 TEST(CoreCapi, PenetrationMatchesCpp)
@@ -266,13 +268,11 @@ TEST(CoreCapi, BadValuesAnswerAStatusAndAMessage)
 
     expect_error(tethash_detector_set_cell_size(h.d, TETHASH_CELL_SIZE_ABSOLUTE, -1), TETHASH_ERROR_INVALID_ARGUMENT,
                  "set_cell_size");
-    expect_error(tethash_detector_set_cell_size(h.d, static_cast<tethash_cell_size_mode>(9), 1),
-                 TETHASH_ERROR_INVALID_ARGUMENT, "unknown mode");
+    expect_error(tethash_detector_set_cell_size(h.d, 9, 1), TETHASH_ERROR_INVALID_ARGUMENT, "unknown mode");
     expect_error(tethash_detector_set_table_size(h.d, -2), TETHASH_ERROR_INVALID_ARGUMENT, "set_table_size");
     expect_error(tethash_detector_set_threads(h.d, -1), TETHASH_ERROR_INVALID_ARGUMENT, "set_threads");
     expect_error(tethash_detector_set_threads(h.d, 1 << 30), TETHASH_ERROR_INVALID_ARGUMENT, "set_threads");
-    expect_error(tethash_detector_set_hash(h.d, static_cast<tethash_hash>(5)), TETHASH_ERROR_INVALID_ARGUMENT,
-                 "unknown hash");
+    expect_error(tethash_detector_set_hash(h.d, 5), TETHASH_ERROR_INVALID_ARGUMENT, "unknown hash");
     expect_error(tethash_detector_set_skin(h.d, std::numeric_limits<double>::infinity()),
                  TETHASH_ERROR_INVALID_ARGUMENT, "skin");
     expect_error(tethash_detector_set_object_options(h.d, -1, 1, 0), TETHASH_ERROR_INVALID_ARGUMENT, "object");

@@ -82,12 +82,15 @@ tethash_status tethash_detector_create(tethash_detector** out_detector);
 void tethash_detector_destroy(tethash_detector* detector);
 
 /* ---- parameters: each may be set at any time; validated when set ---- */
-tethash_status tethash_detector_set_cell_size(tethash_detector* detector, tethash_cell_size_mode mode, double value);
+/** `mode`: a tethash_cell_size_mode. Enumerations are passed as int32_t (an out-of-range value is an error, and
+ *  the size is the same for every compiler and for Fortran). */
+tethash_status tethash_detector_set_cell_size(tethash_detector* detector, int32_t mode, double value);
 /** Number of buckets, >= 1; 0 = automatic. */
 tethash_status tethash_detector_set_table_size(tethash_detector* detector, int64_t buckets);
 /** 0 = every hardware thread (the default), 1 = serial, up to the machine's limit. */
 tethash_status tethash_detector_set_threads(tethash_detector* detector, int32_t threads);
-tethash_status tethash_detector_set_hash(tethash_detector* detector, tethash_hash hash);
+/** `hash`: a tethash_hash. */
+tethash_status tethash_detector_set_hash(tethash_detector* detector, int32_t hash);
 /** Candidate reuse between calls (a length >= 0; 0 = off): see DetectParams::skin in detect.hpp. */
 tethash_status tethash_detector_set_skin(tethash_detector* detector, double skin);
 /** Options of object `object` (0 <= object < 2^20): contacts within the object (self_collision != 0, the default) and

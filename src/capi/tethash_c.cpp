@@ -16,7 +16,7 @@
 #include <vector>
 
 #ifndef TETHASH_VERSION_STRING
-#define TETHASH_VERSION_STRING "unknown"
+#error "TETHASH_VERSION_STRING (the project version) is defined by CMakeLists.txt"
 #endif
 
 struct tethash_detector {
@@ -143,13 +143,13 @@ void tethash_detector_destroy(tethash_detector* detector)
     delete detector;
 }
 
-tethash_status tethash_detector_set_cell_size(tethash_detector* detector, tethash_cell_size_mode mode, double value)
+tethash_status tethash_detector_set_cell_size(tethash_detector* detector, int32_t mode, double value)
 {
     const char* where = "tethash_detector_set_cell_size";
+    if (mode != TETHASH_CELL_SIZE_AUTO && mode != TETHASH_CELL_SIZE_ABSOLUTE && mode != TETHASH_CELL_SIZE_FACTOR)
+        return invalid(where, "unknown mode " + std::to_string(mode));
     if (mode != TETHASH_CELL_SIZE_AUTO && !(std::isfinite(value) && value > 0))
         return invalid(where, "value must be finite and > 0, got " + std::to_string(value));
-    if (mode != TETHASH_CELL_SIZE_AUTO && mode != TETHASH_CELL_SIZE_ABSOLUTE && mode != TETHASH_CELL_SIZE_FACTOR)
-        return invalid(where, "unknown mode " + std::to_string(static_cast<int>(mode)));
     return set_param(detector, where, [&](tethash::DetectParams& p) {
         using M = tethash::DetectParams::CellSizeMode;
         p.cell_size_mode = mode == TETHASH_CELL_SIZE_AUTO       ? M::auto_mean_edge
@@ -176,11 +176,11 @@ tethash_status tethash_detector_set_threads(tethash_detector* detector, int32_t 
     });
 }
 
-tethash_status tethash_detector_set_hash(tethash_detector* detector, tethash_hash hash)
+tethash_status tethash_detector_set_hash(tethash_detector* detector, int32_t hash)
 {
     const char* where = "tethash_detector_set_hash";
     if (hash != TETHASH_HASH_COLUMN && hash != TETHASH_HASH_TESCHNER)
-        return invalid(where, "unknown hash " + std::to_string(static_cast<int>(hash)));
+        return invalid(where, "unknown hash " + std::to_string(hash));
     return set_param(detector, where, [&](tethash::DetectParams& p) {
         p.hash = hash == TETHASH_HASH_COLUMN ? tethash::HashFunction::column : tethash::HashFunction::teschner;
     });
