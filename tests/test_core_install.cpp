@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 using namespace tethash::test;
 
 namespace {
@@ -22,7 +24,9 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
     ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
-    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io")); // core only
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.h"));   // the C interface
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.f90")); // its Fortran module
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io"));         // core only
 
     const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer";
     const auto cbuild = dir / "consumer";
@@ -36,4 +40,36 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     const auto run = run_shell(sq(cbuild / "consumer"));
     EXPECT_EQ(run.status, 0) << run.out << run.err;
     EXPECT_NE(run.out.find("contact vertex 7 tet 0"), std::string::npos) << run.out;
+}
+
+TEST(CoreInstall, CConsumerBuildsAndRuns)
+{
+    if (run_shell("command -v cc").status != 0) GTEST_SKIP() << "no C compiler (cc)";
+    const auto dir = temp_dir();
+    const std::filesystem::path build = std::filesystem::path(TETHASH_TEST_TMP).parent_path().parent_path();
+    const auto prefix = dir / "prefix";
+    const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
+    ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
+    const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer_c";
+    const auto cbuild = dir / "consumer";
+    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) + " -DCMAKE_BUILD_TYPE=Release" +
+                                " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+    ASSERT_EQ(conf.status, 0) << conf.out << conf.err;
+    const auto bld = run_shell("cmake --build " + sq(cbuild) + " -j2");
+    ASSERT_EQ(bld.status, 0) << bld.out << bld.err;
+    const auto run = run_shell(sq(cbuild / "detect_c"));
+    EXPECT_EQ(run.status, 0) << run.out << run.err;
+    EXPECT_NE(run.out.find("contact vertex 7 tet 0"), std::string::npos) << run.out;
+
+    // A project without CXX is told why find_package(tethash) fails.
+    const auto c_only = dir / "c_only";
+    std::filesystem::create_directories(c_only);
+    {
+        std::ofstream cm(c_only / "CMakeLists.txt");
+        cm << "cmake_minimum_required(VERSION 3.25)\nproject(c_only LANGUAGES C)\nfind_package(tethash REQUIRED)\n";
+    }
+    const auto bad =
+        run_shell("cmake -S " + sq(c_only) + " -B " + sq(c_only / "build") + " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE((bad.out + bad.err).find("enable CXX"), std::string::npos) << bad.out << bad.err;
 }

@@ -1,0 +1,173 @@
+! Fortran interface of the tethash detector: module `tethash`, bind(C) interfaces to include/tethash/tethash.h.
+! Compile this file with your code (a .mod file is specific to a compiler) and link tethash::core.
+!
+! Layout: real(c_double) :: x(3, n) and integer(c_int32_t) :: tets(4, m) are the C API's row-major n x 3 and
+! m x 4 arrays. Indices are 0-based (subtract 1 from Fortran's 1-based vertex numbers). Every function returns
+! a status, TETHASH_OK = 0; tethash_error_message() gives the message of the last failure on this thread.
+module tethash
+  use, intrinsic :: iso_c_binding
+  implicit none
+  private :: c_strlen
+
+  integer(c_int), parameter :: TETHASH_OK = 0
+  integer(c_int), parameter :: TETHASH_ERROR_NULL_ARGUMENT = 1
+  integer(c_int), parameter :: TETHASH_ERROR_INVALID_ARGUMENT = 2
+  integer(c_int), parameter :: TETHASH_ERROR_STATE = 3
+  integer(c_int), parameter :: TETHASH_ERROR_OUT_OF_MEMORY = 4
+  integer(c_int), parameter :: TETHASH_ERROR_INTERNAL = 5
+  integer(c_int), parameter :: TETHASH_CELL_SIZE_AUTO = 0, TETHASH_CELL_SIZE_ABSOLUTE = 1, &
+                               TETHASH_CELL_SIZE_FACTOR = 2
+  integer(c_int), parameter :: TETHASH_HASH_COLUMN = 0, TETHASH_HASH_TESCHNER = 1
+
+  type, bind(C) :: tethash_contact
+    integer(c_int32_t) :: vertex, tet, vertex_object, tet_object
+    real(c_double) :: bary(4)
+    real(c_double) :: depth
+    real(c_double) :: direction(3)
+  end type tethash_contact
+
+  type, bind(C) :: tethash_stats
+    real(c_double) :: ms_total, cell_size
+    integer(c_int64_t) :: table_size, contacts
+    integer(c_int32_t) :: reused, threads
+  end type tethash_stats
+
+  interface
+    function tethash_detector_create(detector) bind(C, name="tethash_detector_create") result(status)
+      import :: c_ptr, c_int
+      type(c_ptr), intent(out) :: detector
+      integer(c_int) :: status
+    end function
+    subroutine tethash_detector_destroy(detector) bind(C, name="tethash_detector_destroy")
+      import :: c_ptr
+      type(c_ptr), value :: detector
+    end subroutine
+    function tethash_detector_set_cell_size(detector, mode, value) bind(C, name="tethash_detector_set_cell_size") &
+        result(status)
+      import :: c_ptr, c_int, c_double
+      type(c_ptr), value :: detector
+      integer(c_int), value :: mode
+      real(c_double), value :: value
+      integer(c_int) :: status
+    end function
+    function tethash_detector_set_table_size(detector, buckets) bind(C, name="tethash_detector_set_table_size") &
+        result(status)
+      import :: c_ptr, c_int, c_int64_t
+      type(c_ptr), value :: detector
+      integer(c_int64_t), value :: buckets
+      integer(c_int) :: status
+    end function
+    function tethash_detector_set_threads(detector, threads) bind(C, name="tethash_detector_set_threads") &
+        result(status)
+      import :: c_ptr, c_int, c_int32_t
+      type(c_ptr), value :: detector
+      integer(c_int32_t), value :: threads
+      integer(c_int) :: status
+    end function
+    function tethash_detector_set_hash(detector, hash) bind(C, name="tethash_detector_set_hash") result(status)
+      import :: c_ptr, c_int
+      type(c_ptr), value :: detector
+      integer(c_int), value :: hash
+      integer(c_int) :: status
+    end function
+    function tethash_detector_set_skin(detector, skin) bind(C, name="tethash_detector_set_skin") result(status)
+      import :: c_ptr, c_int, c_double
+      type(c_ptr), value :: detector
+      real(c_double), value :: skin
+      integer(c_int) :: status
+    end function
+    function tethash_detector_set_object_options(detector, object, self_collision, is_static) &
+        bind(C, name="tethash_detector_set_object_options") result(status)
+      import :: c_ptr, c_int, c_int32_t
+      type(c_ptr), value :: detector
+      integer(c_int32_t), value :: object, self_collision, is_static
+      integer(c_int) :: status
+    end function
+    ! vertex_object / tet_object: c_loc of an integer(c_int32_t) array, or c_null_ptr (all objects 0).
+    function tethash_detector_set_topology(detector, tets, num_tets, num_vertices, vertex_object, tet_object) &
+        bind(C, name="tethash_detector_set_topology") result(status)
+      import :: c_ptr, c_int, c_int32_t, c_int64_t
+      type(c_ptr), value :: detector
+      integer(c_int32_t), intent(in) :: tets(*)
+      integer(c_int64_t), value :: num_tets, num_vertices
+      type(c_ptr), value :: vertex_object, tet_object
+      integer(c_int) :: status
+    end function
+    function tethash_detector_detect(detector, positions, num_vertices, count) bind(C, name="tethash_detector_detect") &
+        result(status)
+      import :: c_ptr, c_int, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      real(c_double), intent(in) :: positions(*)
+      integer(c_int64_t), value :: num_vertices
+      integer(c_int64_t), intent(out) :: count
+      integer(c_int) :: status
+    end function
+    function tethash_detector_contact_count(detector, count) bind(C, name="tethash_detector_contact_count") &
+        result(status)
+      import :: c_ptr, c_int, c_int64_t
+      type(c_ptr), value :: detector
+      integer(c_int64_t), intent(out) :: count
+      integer(c_int) :: status
+    end function
+    ! i is 0-based.
+    function tethash_detector_contact(detector, i, contact) bind(C, name="tethash_detector_contact") result(status)
+      import :: c_ptr, c_int, c_int64_t, tethash_contact
+      type(c_ptr), value :: detector
+      integer(c_int64_t), value :: i
+      type(tethash_contact), intent(out) :: contact
+      integer(c_int) :: status
+    end function
+    ! Absent optional arrays are not filled: vertex(capacity), tet(capacity), bary(4, capacity), depth(capacity),
+    ! direction(3, capacity).
+    function tethash_detector_get_contacts(detector, capacity, vertex, tet, bary, depth, direction) &
+        bind(C, name="tethash_detector_get_contacts") result(status)
+      import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      integer(c_int64_t), value :: capacity
+      integer(c_int32_t), intent(out), optional :: vertex(*), tet(*)
+      real(c_double), intent(out), optional :: bary(*), depth(*), direction(*)
+      integer(c_int) :: status
+    end function
+    function tethash_detector_compute_penetration(detector, positions, num_vertices) &
+        bind(C, name="tethash_detector_compute_penetration") result(status)
+      import :: c_ptr, c_int, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      real(c_double), intent(in) :: positions(*)
+      integer(c_int64_t), value :: num_vertices
+      integer(c_int) :: status
+    end function
+    function tethash_detector_stats(detector, stats) bind(C, name="tethash_detector_stats") result(status)
+      import :: c_ptr, c_int, tethash_stats
+      type(c_ptr), value :: detector
+      type(tethash_stats), intent(out) :: stats
+      integer(c_int) :: status
+    end function
+    function tethash_last_error() bind(C, name="tethash_last_error") result(message)
+      import :: c_ptr
+      type(c_ptr) :: message
+    end function
+    function c_strlen(s) bind(C, name="strlen") result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: s
+      integer(c_size_t) :: n
+    end function
+  end interface
+
+contains
+
+  ! The message of the last failing call on this thread, as a Fortran string.
+  function tethash_error_message() result(message)
+    character(len=:), allocatable :: message
+    type(c_ptr) :: p
+    character(kind=c_char), pointer :: chars(:)
+    integer :: n, k
+    p = tethash_last_error()
+    n = int(c_strlen(p))
+    call c_f_pointer(p, chars, [n])
+    allocate (character(len=n) :: message)
+    do k = 1, n
+      message(k:k) = chars(k)
+    end do
+  end function tethash_error_message
+
+end module tethash

@@ -1,0 +1,381 @@
+// The C interface (include/tethash/tethash.h) over Detector and Penetration: every entry point checks its
+// pointers and sizes, runs the C++ call inside guard(), which maps exceptions to a status and a thread-local
+// message, so nothing is thrown across the boundary.
+#include "tethash/tethash.h"
+
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/penetration.hpp"
+
+#include <cassert>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+
+#ifndef TETHASH_VERSION_STRING
+#error "TETHASH_VERSION_STRING (the project version) is defined by CMakeLists.txt"
+#endif
+
+struct tethash_detector {
+    tethash::Detector detector;
+    tethash::Penetration penetration;
+    bool penetration_ready = false; ///< penetration's topology is the detector's
+    bool has_topology = false;
+    // The topology as given, kept so that object options set later apply (set_topology is re-run).
+    std::vector<tethash::Index> tets, vertex_object, tet_object;
+    tethash::Index num_vertices = 0;
+    std::vector<tethash::ObjectOptions> objects;
+    tethash::DetectStats stats;
+    bool detected = false; ///< contacts() belong to the current topology
+};
+
+namespace {
+
+thread_local std::string last_error;
+
+tethash_status fail(tethash_status status, const std::string& message)
+{
+    // Assigning may itself throw bad_alloc; the status is still returned.
+    try {
+        last_error = message;
+    } catch (...) {
+    }
+    return status;
+}
+
+/// Runs `body` (returning a status), turning every exception into a status and a message prefixed by `where`.
+template <class F> tethash_status guard(const char* where, F&& body) noexcept
+{
+    try {
+        return body();
+    } catch (const tethash::Error& e) {
+        return fail(TETHASH_ERROR_INVALID_ARGUMENT, std::string(where) + ": " + e.what());
+    } catch (const std::bad_alloc&) {
+        return fail(TETHASH_ERROR_OUT_OF_MEMORY, std::string(where) + ": out of memory");
+    } catch (const std::exception& e) {
+        return fail(TETHASH_ERROR_INTERNAL, std::string(where) + ": " + e.what());
+    } catch (...) {
+        return fail(TETHASH_ERROR_INTERNAL, std::string(where) + ": unknown error");
+    }
+}
+
+tethash_status null_argument(const char* where, const char* name)
+{
+    return fail(TETHASH_ERROR_NULL_ARGUMENT, std::string(where) + ": " + name + " is NULL");
+}
+
+tethash_status invalid(const char* where, const std::string& what)
+{
+    return fail(TETHASH_ERROR_INVALID_ARGUMENT, std::string(where) + ": " + what);
+}
+
+constexpr std::int64_t max_index = std::numeric_limits<tethash::Index>::max();
+
+/// Re-applies the stored topology with the current object options.
+void apply_topology(tethash_detector& d)
+{
+    const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+    d.detected = false;
+    d.penetration_ready = false;
+    d.has_topology = false;
+    d.detector.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object, d.objects);
+    d.has_topology = true;
+}
+
+tethash_contact to_c(const tethash::Contact& c)
+{
+    tethash_contact o;
+    o.vertex = c.vertex;
+    o.tet = c.tet;
+    o.vertex_object = c.vertex_object;
+    o.tet_object = c.tet_object;
+    for (int k = 0; k < 4; ++k)
+        o.bary[k] = c.bary[k];
+    o.depth = c.depth;
+    for (int k = 0; k < 3; ++k)
+        o.direction[k] = c.direction[k];
+    return o;
+}
+
+/// Sets one parameter through set_params (validated there); restores nothing on failure (set_params validates
+/// before it changes anything).
+template <class F> tethash_status set_param(tethash_detector* d, const char* where, F&& change)
+{
+    if (!d) return null_argument(where, "detector");
+    return guard(where, [&] {
+        tethash::DetectParams p = d->detector.params();
+        change(p);
+        d->detector.set_params(p);
+        return TETHASH_OK;
+    });
+}
+
+} // namespace
+
+extern "C" {
+
+const char* tethash_last_error(void)
+{
+    return last_error.c_str();
+}
+
+const char* tethash_version(void)
+{
+    return TETHASH_VERSION_STRING;
+}
+
+tethash_status tethash_detector_create(tethash_detector** out_detector)
+{
+    const char* where = "tethash_detector_create";
+    if (!out_detector) return null_argument(where, "out_detector");
+    *out_detector = nullptr;
+    return guard(where, [&] {
+        *out_detector = new tethash_detector();
+        return TETHASH_OK;
+    });
+}
+
+void tethash_detector_destroy(tethash_detector* detector)
+{
+    delete detector;
+}
+
+tethash_status tethash_detector_set_cell_size(tethash_detector* detector, int32_t mode, double value)
+{
+    const char* where = "tethash_detector_set_cell_size";
+    if (mode != TETHASH_CELL_SIZE_AUTO && mode != TETHASH_CELL_SIZE_ABSOLUTE && mode != TETHASH_CELL_SIZE_FACTOR)
+        return invalid(where, "unknown mode " + std::to_string(mode));
+    if (mode != TETHASH_CELL_SIZE_AUTO && !(std::isfinite(value) && value > 0))
+        return invalid(where, "value must be finite and > 0, got " + std::to_string(value));
+    return set_param(detector, where, [&](tethash::DetectParams& p) {
+        using M = tethash::DetectParams::CellSizeMode;
+        p.cell_size_mode = mode == TETHASH_CELL_SIZE_AUTO       ? M::auto_mean_edge
+                           : mode == TETHASH_CELL_SIZE_ABSOLUTE ? M::absolute
+                                                                : M::factor_of_mean_edge;
+        if (mode != TETHASH_CELL_SIZE_AUTO) p.cell_size = value;
+    });
+}
+
+tethash_status tethash_detector_set_table_size(tethash_detector* detector, int64_t buckets)
+{
+    const char* where = "tethash_detector_set_table_size";
+    if (buckets < 0) return invalid(where, "buckets must be ≥ 0 (0 = automatic), got " + std::to_string(buckets));
+    return set_param(detector, where, [&](tethash::DetectParams& p) { p.table_size = buckets; });
+}
+
+tethash_status tethash_detector_set_threads(tethash_detector* detector, int32_t threads)
+{
+    const char* where = "tethash_detector_set_threads";
+    if (!detector) return null_argument(where, "detector");
+    return guard(where, [&] {
+        const int checked = tethash::check_threads(threads, "threads");
+        return set_param(detector, where, [&](tethash::DetectParams& p) { p.threads = checked; });
+    });
+}
+
+tethash_status tethash_detector_set_hash(tethash_detector* detector, int32_t hash)
+{
+    const char* where = "tethash_detector_set_hash";
+    if (hash != TETHASH_HASH_COLUMN && hash != TETHASH_HASH_TESCHNER)
+        return invalid(where, "unknown hash " + std::to_string(hash));
+    return set_param(detector, where, [&](tethash::DetectParams& p) {
+        p.hash = hash == TETHASH_HASH_COLUMN ? tethash::HashFunction::column : tethash::HashFunction::teschner;
+    });
+}
+
+tethash_status tethash_detector_set_skin(tethash_detector* detector, double skin)
+{
+    const char* where = "tethash_detector_set_skin";
+    if (!(std::isfinite(skin) && skin >= 0))
+        return invalid(where, "skin must be finite and ≥ 0, got " + std::to_string(skin));
+    return set_param(detector, where, [&](tethash::DetectParams& p) {
+        p.skin_mode = tethash::DetectParams::SkinMode::absolute;
+        p.skin = skin;
+    });
+}
+
+tethash_status tethash_detector_set_object_options(tethash_detector* detector, int32_t object, int32_t self_collision,
+                                                   int32_t is_static)
+{
+    const char* where = "tethash_detector_set_object_options";
+    if (!detector) return null_argument(where, "detector");
+    if (object < 0 || object >= (1 << 20))
+        return invalid(where, "object must be in [0, 1048576), got " + std::to_string(object));
+    return guard(where, [&] {
+        auto& objects = detector->objects;
+        const std::vector<tethash::ObjectOptions> before = objects;
+        if (static_cast<std::size_t>(object) >= objects.size()) objects.resize(static_cast<std::size_t>(object) + 1);
+        objects[static_cast<std::size_t>(object)].self_collision = self_collision != 0;
+        objects[static_cast<std::size_t>(object)].is_static = is_static != 0;
+        if (detector->has_topology) {
+            try {
+                apply_topology(*detector);
+            } catch (...) {
+                objects = before;
+                apply_topology(*detector);
+                throw;
+            }
+        }
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_set_topology(tethash_detector* detector, const int32_t* tets, int64_t num_tets,
+                                             int64_t num_vertices, const int32_t* vertex_object,
+                                             const int32_t* tet_object)
+{
+    const char* where = "tethash_detector_set_topology";
+    if (!detector) return null_argument(where, "detector");
+    if (num_tets < 0 || num_tets > max_index)
+        return invalid(where,
+                       "num_tets must be in [0, " + std::to_string(max_index) + "], got " + std::to_string(num_tets));
+    if (num_vertices < 0 || num_vertices > max_index)
+        return invalid(where, "num_vertices must be in [0, " + std::to_string(max_index) + "], got " +
+                                  std::to_string(num_vertices));
+    if (!tets && num_tets > 0) return null_argument(where, "tets");
+    return guard(where, [&] {
+        tethash_detector& d = *detector;
+        const auto m = static_cast<std::size_t>(num_tets), n = static_cast<std::size_t>(num_vertices);
+        std::vector<tethash::Index> t;
+        if (tets) t.assign(tets, tets + 4 * m);
+        std::vector<tethash::Index> vo, to;
+        if (vertex_object) vo.assign(vertex_object, vertex_object + n);
+        if (tet_object) to.assign(tet_object, tet_object + m);
+        // The detector validates indices and object ids; on failure the previous arrays are restored and the
+        // detector is left without a topology (detect then answers TETHASH_ERROR_STATE).
+        d.tets.swap(t);
+        d.vertex_object.swap(vo);
+        d.tet_object.swap(to);
+        const tethash::Index old_n = d.num_vertices;
+        d.num_vertices = static_cast<tethash::Index>(num_vertices);
+        try {
+            apply_topology(d);
+        } catch (...) {
+            d.tets.swap(t);
+            d.vertex_object.swap(vo);
+            d.tet_object.swap(to);
+            d.num_vertices = old_n;
+            d.has_topology = false;
+            throw;
+        }
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_detect(tethash_detector* detector, const double* positions, int64_t num_vertices,
+                                       int64_t* out_count)
+{
+    const char* where = "tethash_detector_detect";
+    if (out_count) *out_count = 0;
+    if (!detector) return null_argument(where, "detector");
+    if (!detector->has_topology) return fail(TETHASH_ERROR_STATE, std::string(where) + ": no topology set");
+    if (num_vertices != detector->num_vertices)
+        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
+                                  std::to_string(detector->num_vertices));
+    if (!positions && num_vertices > 0) return null_argument(where, "positions");
+    return guard(where, [&] {
+        detector->detected = false;
+        const Eigen::Map<const tethash::Positions> map(positions, static_cast<Eigen::Index>(num_vertices), 3);
+        const tethash::PositionsRef p(map);
+        assert(p.data() == positions); // the caller's array, read in place
+        const auto& contacts = detector->detector.detect(p, &detector->stats);
+        detector->detected = true;
+        if (out_count) *out_count = static_cast<int64_t>(contacts.size());
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_contact_count(const tethash_detector* detector, int64_t* out_count)
+{
+    const char* where = "tethash_detector_contact_count";
+    if (!detector) return null_argument(where, "detector");
+    if (!out_count) return null_argument(where, "out_count");
+    auto& d = const_cast<tethash_detector&>(*detector);
+    *out_count = d.detected ? static_cast<int64_t>(d.detector.contacts().size()) : 0;
+    return TETHASH_OK;
+}
+
+tethash_status tethash_detector_contact(const tethash_detector* detector, int64_t i, tethash_contact* out_contact)
+{
+    const char* where = "tethash_detector_contact";
+    if (!detector) return null_argument(where, "detector");
+    if (!out_contact) return null_argument(where, "out_contact");
+    auto& d = const_cast<tethash_detector&>(*detector);
+    const int64_t count = d.detected ? static_cast<int64_t>(d.detector.contacts().size()) : 0;
+    if (i < 0 || i >= count)
+        return invalid(where, "contact " + std::to_string(i) + " out of range [0, " + std::to_string(count) + ")");
+    *out_contact = to_c(d.detector.contacts()[static_cast<std::size_t>(i)]);
+    return TETHASH_OK;
+}
+
+tethash_status tethash_detector_get_contacts(const tethash_detector* detector, int64_t capacity, int32_t* vertex,
+                                             int32_t* tet, double* bary, double* depth, double* direction)
+{
+    const char* where = "tethash_detector_get_contacts";
+    if (!detector) return null_argument(where, "detector");
+    auto& d = const_cast<tethash_detector&>(*detector);
+    const std::size_t count = d.detected ? d.detector.contacts().size() : 0;
+    if (capacity < 0 || static_cast<std::size_t>(capacity) < count)
+        return invalid(where, "capacity " + std::to_string(capacity) + " is less than the " + std::to_string(count) +
+                                  " contacts");
+    const std::vector<tethash::Contact>& cs = d.detector.contacts();
+    for (std::size_t i = 0; i < count; ++i) {
+        const tethash::Contact& c = cs[i];
+        if (vertex) vertex[i] = c.vertex;
+        if (tet) tet[i] = c.tet;
+        if (bary)
+            for (std::size_t k = 0; k < 4; ++k)
+                bary[4 * i + k] = c.bary[k];
+        if (depth) depth[i] = c.depth;
+        if (direction)
+            for (std::size_t k = 0; k < 3; ++k)
+                direction[3 * i + k] = c.direction[k];
+    }
+    return TETHASH_OK;
+}
+
+tethash_status tethash_detector_compute_penetration(tethash_detector* detector, const double* positions,
+                                                    int64_t num_vertices)
+{
+    const char* where = "tethash_detector_compute_penetration";
+    if (!detector) return null_argument(where, "detector");
+    if (!detector->detected) return fail(TETHASH_ERROR_STATE, std::string(where) + ": no detection to complete");
+    if (num_vertices != detector->num_vertices)
+        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
+                                  std::to_string(detector->num_vertices));
+    if (!positions && num_vertices > 0) return null_argument(where, "positions");
+    return guard(where, [&] {
+        tethash_detector& d = *detector;
+        if (!d.penetration_ready) {
+            const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+            d.penetration.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object);
+            d.penetration_ready = true;
+        }
+        const Eigen::Map<const tethash::Positions> p(positions, static_cast<Eigen::Index>(num_vertices), 3);
+        for (Eigen::Index v = 0; v < p.rows(); ++v)
+            if (!p.row(v).allFinite())
+                return invalid(where, "position of vertex " + std::to_string(v) + " is not finite");
+        d.penetration.compute(p, d.detector.contacts());
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_stats(const tethash_detector* detector, tethash_stats* out_stats)
+{
+    const char* where = "tethash_detector_stats";
+    if (!detector) return null_argument(where, "detector");
+    if (!out_stats) return null_argument(where, "out_stats");
+    const tethash::DetectStats& s = detector->stats;
+    out_stats->ms_total = s.ms_total;
+    out_stats->cell_size = s.cell_size;
+    out_stats->table_size = s.table_size;
+    out_stats->contacts = s.contacts;
+    out_stats->reused = s.reused;
+    out_stats->threads = s.threads;
+    return TETHASH_OK;
+}
+
+} // extern "C"

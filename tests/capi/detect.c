@@ -1,0 +1,86 @@
+/* A C program using the detector through tethash.h, checked against a result worked out by hand:
+ *   tet 0 (object 0): the unit corner tet (0,0,0) (1,0,0) (0,1,0) (0,0,1);
+ *   tet 1 (object 1): base (0,0,-1) (1,0,-1) (0,1,-1) below it, apex vertex 7 at (0.2, 0.2, 0.1).
+ * Vertex 7 lies in tet 0 with barycentric coordinates (0.5, 0.2, 0.2, 0.1); nothing else touches. Every edge from
+ * vertex 7 leaves tet 0 through its face z = 0 (outward normal -z), 0.1 below the vertex, so the penetration depth
+ * is 0.1 and the direction (0, 0, -1). Moving vertex 7 to z = -0.1 in the caller's array (no new registration)
+ * leaves no contact. Exit status 0 when everything holds, 1 otherwise. */
+#include <tethash/tethash.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static int failures = 0;
+
+static void check(int ok, const char* what)
+{
+    if (!ok) {
+        fprintf(stderr, "FAILED: %s\n", what);
+        ++failures;
+    }
+}
+
+static int near(double a, double b)
+{
+    return fabs(a - b) <= 1e-12;
+}
+
+int main(void)
+{
+    double xyz[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 1, 0, -1, 0, 1, -1, 0.2, 0.2, 0.1};
+    const int32_t tets[2 * 4] = {0, 1, 2, 3, 4, 5, 6, 7};
+    const int32_t vertex_object[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+    const int32_t tet_object[2] = {0, 1};
+
+    tethash_detector* d = NULL;
+    if (tethash_detector_create(&d) != TETHASH_OK) {
+        fprintf(stderr, "create: %s\n", tethash_last_error());
+        return 1;
+    }
+    check(tethash_detector_set_threads(d, 1) == TETHASH_OK, "set_threads");
+    if (tethash_detector_set_topology(d, tets, 2, 8, vertex_object, tet_object) != TETHASH_OK) {
+        fprintf(stderr, "set_topology: %s\n", tethash_last_error());
+        tethash_detector_destroy(d);
+        return 1;
+    }
+
+    int64_t count = -1;
+    check(tethash_detector_detect(d, xyz, 8, &count) == TETHASH_OK, "detect");
+    check(count == 1, "one contact");
+    check(tethash_detector_compute_penetration(d, xyz, 8) == TETHASH_OK, "compute_penetration");
+    tethash_contact c;
+    memset(&c, 0, sizeof c);
+    check(tethash_detector_contact(d, 0, &c) == TETHASH_OK, "contact 0");
+    printf("contact vertex %d tet %d bary %.3f %.3f %.3f %.3f depth %.6f direction %.3f %.3f %.3f\n", c.vertex, c.tet,
+           c.bary[0], c.bary[1], c.bary[2], c.bary[3], c.depth, c.direction[0], c.direction[1], c.direction[2]);
+    check(c.vertex == 7 && c.tet == 0, "vertex 7 in tet 0");
+    check(c.vertex_object == 1 && c.tet_object == 0, "objects 1 in 0");
+    check(near(c.bary[0], 0.5) && near(c.bary[1], 0.2) && near(c.bary[2], 0.2) && near(c.bary[3], 0.1), "bary");
+    check(near(c.depth, 0.1), "depth 0.1");
+    check(near(c.direction[0], 0) && near(c.direction[1], 0) && near(c.direction[2], -1), "direction -z");
+
+    /* The arrays form. */
+    int32_t vertex[1] = {-1}, tet[1] = {-1};
+    double depth[1] = {0};
+    check(tethash_detector_get_contacts(d, 1, vertex, tet, NULL, depth, NULL) == TETHASH_OK, "get_contacts");
+    check(vertex[0] == 7 && tet[0] == 0 && near(depth[0], 0.1), "arrays agree");
+
+    tethash_stats stats;
+    check(tethash_detector_stats(d, &stats) == TETHASH_OK, "stats");
+    check(stats.contacts == 1 && stats.threads == 1 && stats.cell_size > 0, "stats of the detection");
+
+    /* A wrong size is an error with a message, not a crash. */
+    check(tethash_detector_detect(d, xyz, 7, &count) == TETHASH_ERROR_INVALID_ARGUMENT, "wrong size refused");
+    check(strstr(tethash_last_error(), "num_vertices") != NULL, "message names num_vertices");
+    printf("expected error: %s\n", tethash_last_error());
+
+    /* The caller moves its own array; the next detection reads it in place. */
+    xyz[7 * 3 + 2] = -0.1;
+    check(tethash_detector_detect(d, xyz, 8, &count) == TETHASH_OK, "detect after the move");
+    check(count == 0, "no contact after the move");
+
+    tethash_detector_destroy(d);
+    printf("%s (tethash %s)\n", failures ? "FAILED" : "ok", tethash_version());
+    return failures ? 1 : 0;
+}

@@ -1,0 +1,293 @@
+// The C interface (tethash.h): the same contacts as the C++ Detector and the oracle on several scenes, the same
+// penetration as Penetration, parameters and object options passed through, and every error path answered by a
+// status and a message naming the function (never a crash).
+#include "core_scenes.hpp"
+
+#include "tethash/oracle.hpp"
+#include "tethash/penetration.hpp"
+#include "tethash/tethash.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace tethash;
+
+namespace {
+
+/// Owns a C detector for the length of a test.
+struct Handle {
+    tethash_detector* d = nullptr;
+    Handle() { EXPECT_EQ(tethash_detector_create(&d), TETHASH_OK); }
+    ~Handle() { tethash_detector_destroy(d); }
+    Handle(const Handle&) = delete;
+    Handle& operator=(const Handle&) = delete;
+};
+
+void set_topology(tethash_detector* d, const test::Scene& s)
+{
+    ASSERT_EQ(tethash_detector_set_topology(d, s.tets.data(), s.tets.rows(), s.positions.rows(), s.vertex_object.data(),
+                                            s.tet_object.data()),
+              TETHASH_OK)
+        << tethash_last_error();
+}
+
+/// The contacts of the C detector's last detection, read through both accessors (checked to agree).
+std::vector<tethash_contact> read_contacts(const tethash_detector* d)
+{
+    int64_t count = -1;
+    EXPECT_EQ(tethash_detector_contact_count(d, &count), TETHASH_OK);
+    std::vector<tethash_contact> out(static_cast<size_t>(count));
+    for (int64_t i = 0; i < count; ++i)
+        EXPECT_EQ(tethash_detector_contact(d, i, &out[static_cast<size_t>(i)]), TETHASH_OK);
+    std::vector<int32_t> vertex(out.size()), tet(out.size());
+    std::vector<double> bary(4 * out.size()), depth(out.size()), direction(3 * out.size());
+    EXPECT_EQ(
+        tethash_detector_get_contacts(d, count, vertex.data(), tet.data(), bary.data(), depth.data(), direction.data()),
+        TETHASH_OK);
+    for (size_t i = 0; i < out.size(); ++i) {
+        EXPECT_EQ(vertex[i], out[i].vertex);
+        EXPECT_EQ(tet[i], out[i].tet);
+        for (size_t k = 0; k < 4; ++k)
+            EXPECT_EQ(bary[4 * i + k], out[i].bary[k]);
+        if (std::isnan(out[i].depth))
+            EXPECT_TRUE(std::isnan(depth[i]));
+        else
+            EXPECT_EQ(depth[i], out[i].depth);
+        for (size_t k = 0; k < 3; ++k)
+            EXPECT_EQ(direction[3 * i + k], out[i].direction[k]);
+    }
+    return out;
+}
+
+void expect_same(const std::vector<tethash_contact>& c, const std::vector<Contact>& cpp, const char* what)
+{
+    ASSERT_EQ(c.size(), cpp.size()) << what;
+    for (size_t i = 0; i < c.size(); ++i) {
+        EXPECT_EQ(c[i].vertex, cpp[i].vertex) << what << " contact " << i;
+        EXPECT_EQ(c[i].tet, cpp[i].tet) << what << " contact " << i;
+        EXPECT_EQ(c[i].vertex_object, cpp[i].vertex_object) << what << " contact " << i;
+        EXPECT_EQ(c[i].tet_object, cpp[i].tet_object) << what << " contact " << i;
+        for (int k = 0; k < 4; ++k)
+            EXPECT_NEAR(c[i].bary[k], cpp[i].bary[k], 1e-12) << what << " contact " << i;
+    }
+}
+
+std::vector<test::Scene> scenes()
+{
+    std::vector<test::Scene> out;
+    out.push_back(test::random_scene(7, 3, 2, 0.1));
+    out.push_back(test::random_scene(11, 4, 3, 0.2));
+    out.push_back(test::lattice_pair(2, 0.25, Eigen::Vector3d(0.125, 0.125, 0.125), Eigen::Vector3d::Zero()));
+    return out;
+}
+
+void expect_error(tethash_status got, tethash_status want, const std::string& function)
+{
+    EXPECT_EQ(got, want) << tethash_last_error();
+    const std::string msg = tethash_last_error();
+    EXPECT_NE(msg.find(function), std::string::npos) << msg;
+}
+
+} // namespace
+
+TEST(CoreCapi, SameContactsAsDetectorAndOracle)
+{
+    int scene_no = 0;
+    for (const test::Scene& s : scenes()) {
+        const std::string what = "scene " + std::to_string(scene_no++);
+        Handle h;
+        set_topology(h.d, s);
+        int64_t count = -1;
+        ASSERT_EQ(tethash_detector_detect(h.d, s.positions.data(), s.positions.rows(), &count), TETHASH_OK)
+            << tethash_last_error();
+        const std::vector<tethash_contact> c = read_contacts(h.d);
+        EXPECT_EQ(count, static_cast<int64_t>(c.size()));
+        EXPECT_GT(c.size(), 0u) << what;
+
+        Detector det;
+        det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+        expect_same(c, det.detect(s.positions), what.c_str());
+        expect_same(c, brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object), what.c_str());
+        for (const tethash_contact& x : c)
+            EXPECT_TRUE(std::isnan(x.depth));
+    }
+}
+
+TEST(CoreCapi, ParametersAndObjectOptionsPassThrough)
+{
+    const test::Scene s = test::random_scene(5, 3, 3, 0.15);
+    std::vector<ObjectOptions> objects(3);
+    objects[1].self_collision = false;
+    objects[2].is_static = true;
+    const auto oracle = brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, objects);
+
+    Handle h;
+    // Options before and after the topology: both apply.
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 1, 0, 0), TETHASH_OK);
+    set_topology(h.d, s);
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 2, 1, 1), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_cell_size(h.d, TETHASH_CELL_SIZE_FACTOR, 1.5), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_table_size(h.d, 1009), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_hash(h.d, TETHASH_HASH_TESCHNER), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_threads(h.d, 1), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_skin(h.d, 0.01), TETHASH_OK);
+    int64_t count = 0;
+    ASSERT_EQ(tethash_detector_detect(h.d, s.positions.data(), s.positions.rows(), &count), TETHASH_OK)
+        << tethash_last_error();
+    expect_same(read_contacts(h.d), oracle, "options");
+
+    tethash_stats st{};
+    ASSERT_EQ(tethash_detector_stats(h.d, &st), TETHASH_OK);
+    EXPECT_EQ(st.table_size, 1009);
+    EXPECT_EQ(st.threads, 1);
+    EXPECT_EQ(st.contacts, count);
+    Detector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, objects);
+    DetectStats cs;
+    det.detect(s.positions, &cs);
+    EXPECT_NEAR(st.cell_size, 1.5 * cs.cell_size, 1e-12 * cs.cell_size);
+
+    // Same positions again: the skin's candidates are reused, same contacts.
+    ASSERT_EQ(tethash_detector_detect(h.d, s.positions.data(), s.positions.rows(), &count), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_stats(h.d, &st), TETHASH_OK);
+    EXPECT_EQ(st.reused, 1);
+    expect_same(read_contacts(h.d), oracle, "reused");
+    EXPECT_TRUE(std::regex_match(std::string(tethash_version()), std::regex("[0-9]+\\.[0-9]+\\.[0-9]+")))
+        << tethash_version();
+}
+
+TEST(CoreCapi, PenetrationMatchesCpp)
+{
+    const test::Scene s = test::random_scene(3, 2, 3, 0.05);
+    Handle h;
+    set_topology(h.d, s);
+    int64_t count = 0;
+    ASSERT_EQ(tethash_detector_detect(h.d, s.positions.data(), s.positions.rows(), &count), TETHASH_OK);
+    ASSERT_GT(count, 0);
+    ASSERT_EQ(tethash_detector_compute_penetration(h.d, s.positions.data(), s.positions.rows()), TETHASH_OK)
+        << tethash_last_error();
+    const auto c = read_contacts(h.d);
+
+    Detector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    std::vector<Contact> cpp = det.detect(s.positions);
+    Penetration pen;
+    pen.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    pen.compute(s.positions, cpp);
+    ASSERT_EQ(c.size(), cpp.size());
+    for (size_t i = 0; i < c.size(); ++i) {
+        EXPECT_GE(c[i].depth, 0);
+        EXPECT_DOUBLE_EQ(c[i].depth, cpp[i].depth) << i;
+        for (int k = 0; k < 3; ++k)
+            EXPECT_DOUBLE_EQ(c[i].direction[k], cpp[i].direction[k]) << i;
+        EXPECT_NEAR(std::hypot(c[i].direction[0], c[i].direction[1], c[i].direction[2]), 1.0, 1e-9);
+    }
+}
+
+TEST(CoreCapi, NullPointersAnswerAStatus)
+{
+    expect_error(tethash_detector_create(nullptr), TETHASH_ERROR_NULL_ARGUMENT, "tethash_detector_create");
+    tethash_detector_destroy(nullptr); // accepted
+    const double xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const int32_t tet[4] = {0, 1, 2, 3};
+    int64_t count = 0;
+    expect_error(tethash_detector_detect(nullptr, xyz, 4, &count), TETHASH_ERROR_NULL_ARGUMENT,
+                 "tethash_detector_detect");
+    expect_error(tethash_detector_set_topology(nullptr, tet, 1, 4, nullptr, nullptr), TETHASH_ERROR_NULL_ARGUMENT,
+                 "tethash_detector_set_topology");
+    expect_error(tethash_detector_set_threads(nullptr, 1), TETHASH_ERROR_NULL_ARGUMENT, "set_threads");
+    expect_error(tethash_detector_set_skin(nullptr, 0), TETHASH_ERROR_NULL_ARGUMENT, "set_skin");
+    expect_error(tethash_detector_stats(nullptr, nullptr), TETHASH_ERROR_NULL_ARGUMENT, "tethash_detector_stats");
+
+    Handle h;
+    expect_error(tethash_detector_set_topology(h.d, nullptr, 1, 4, nullptr, nullptr), TETHASH_ERROR_NULL_ARGUMENT,
+                 "tets is NULL");
+    ASSERT_EQ(tethash_detector_set_topology(h.d, tet, 1, 4, nullptr, nullptr), TETHASH_OK);
+    expect_error(tethash_detector_detect(h.d, nullptr, 4, &count), TETHASH_ERROR_NULL_ARGUMENT, "positions is NULL");
+    expect_error(tethash_detector_contact_count(h.d, nullptr), TETHASH_ERROR_NULL_ARGUMENT, "out_count");
+    expect_error(tethash_detector_contact(h.d, 0, nullptr), TETHASH_ERROR_NULL_ARGUMENT, "out_contact");
+    expect_error(tethash_detector_stats(h.d, nullptr), TETHASH_ERROR_NULL_ARGUMENT, "out_stats");
+    // NULL outputs of get_contacts are skipped, not an error.
+    ASSERT_EQ(tethash_detector_detect(h.d, xyz, 4, nullptr), TETHASH_OK);
+    EXPECT_EQ(tethash_detector_get_contacts(h.d, 0, nullptr, nullptr, nullptr, nullptr, nullptr), TETHASH_OK);
+}
+
+TEST(CoreCapi, BadValuesAnswerAStatusAndAMessage)
+{
+    const double xyz[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.1, 0.1, 0.1};
+    const int32_t good[8] = {0, 1, 2, 3, 1, 2, 3, 4};
+    const int32_t bad[8] = {0, 1, 2, 3, 1, 2, 3, 5};
+    Handle h;
+    int64_t count = 7;
+    expect_error(tethash_detector_detect(h.d, xyz, 5, &count), TETHASH_ERROR_STATE, "no topology");
+    EXPECT_EQ(count, 0);
+    expect_error(tethash_detector_compute_penetration(h.d, xyz, 5), TETHASH_ERROR_STATE, "no detection");
+    expect_error(tethash_detector_set_topology(h.d, bad, 2, 5, nullptr, nullptr), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "tethash_detector_set_topology");
+    EXPECT_NE(std::string(tethash_last_error()).find("range"), std::string::npos) << tethash_last_error();
+    expect_error(tethash_detector_detect(h.d, xyz, 5, &count), TETHASH_ERROR_STATE, "no topology");
+    expect_error(tethash_detector_set_topology(h.d, good, -1, 5, nullptr, nullptr), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "num_tets");
+    expect_error(tethash_detector_set_topology(h.d, good, 2, -5, nullptr, nullptr), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "num_vertices");
+    const int32_t bad_objects[5] = {0, 0, 0, 0, -3};
+    expect_error(tethash_detector_set_topology(h.d, good, 2, 5, bad_objects, nullptr), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "tethash_detector_set_topology");
+
+    ASSERT_EQ(tethash_detector_set_topology(h.d, good, 2, 5, nullptr, nullptr), TETHASH_OK) << tethash_last_error();
+    expect_error(tethash_detector_detect(h.d, xyz, 4, &count), TETHASH_ERROR_INVALID_ARGUMENT, "topology has 5");
+    double nan_xyz[15];
+    std::copy(xyz, xyz + 15, nan_xyz);
+    nan_xyz[7] = std::numeric_limits<double>::quiet_NaN();
+    expect_error(tethash_detector_detect(h.d, nan_xyz, 5, &count), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "tethash_detector_detect");
+    int64_t n = -1;
+    EXPECT_EQ(tethash_detector_contact_count(h.d, &n), TETHASH_OK);
+    EXPECT_EQ(n, 0); // a failed detection leaves no contacts to read
+
+    ASSERT_EQ(tethash_detector_detect(h.d, xyz, 5, &count), TETHASH_OK) << tethash_last_error();
+    ASSERT_EQ(count, 1); // vertex 4 inside tet 0 (tet 1 holds it as its own vertex)
+    tethash_contact c{};
+    ASSERT_EQ(tethash_detector_contact(h.d, 0, &c), TETHASH_OK);
+    EXPECT_EQ(c.vertex, 4);
+    EXPECT_EQ(c.tet, 0);
+    EXPECT_NEAR(c.bary[0], 0.7, 1e-12);
+    expect_error(tethash_detector_contact(h.d, 1, &c), TETHASH_ERROR_INVALID_ARGUMENT, "out of range");
+    expect_error(tethash_detector_contact(h.d, -1, &c), TETHASH_ERROR_INVALID_ARGUMENT, "out of range");
+    int32_t v[1];
+    expect_error(tethash_detector_get_contacts(h.d, 0, v, nullptr, nullptr, nullptr, nullptr),
+                 TETHASH_ERROR_INVALID_ARGUMENT, "capacity");
+    expect_error(tethash_detector_compute_penetration(h.d, xyz, 3), TETHASH_ERROR_INVALID_ARGUMENT, "num_vertices");
+    expect_error(tethash_detector_compute_penetration(h.d, nan_xyz, 5), TETHASH_ERROR_INVALID_ARGUMENT, "not finite");
+
+    expect_error(tethash_detector_set_cell_size(h.d, TETHASH_CELL_SIZE_ABSOLUTE, -1), TETHASH_ERROR_INVALID_ARGUMENT,
+                 "set_cell_size");
+    expect_error(tethash_detector_set_cell_size(h.d, 9, 1), TETHASH_ERROR_INVALID_ARGUMENT, "unknown mode");
+    expect_error(tethash_detector_set_table_size(h.d, -2), TETHASH_ERROR_INVALID_ARGUMENT, "set_table_size");
+    expect_error(tethash_detector_set_threads(h.d, -1), TETHASH_ERROR_INVALID_ARGUMENT, "set_threads");
+    expect_error(tethash_detector_set_threads(h.d, 1 << 30), TETHASH_ERROR_INVALID_ARGUMENT, "set_threads");
+    expect_error(tethash_detector_set_hash(h.d, 5), TETHASH_ERROR_INVALID_ARGUMENT, "unknown hash");
+    expect_error(tethash_detector_set_skin(h.d, std::numeric_limits<double>::infinity()),
+                 TETHASH_ERROR_INVALID_ARGUMENT, "skin");
+    expect_error(tethash_detector_set_object_options(h.d, -1, 1, 0), TETHASH_ERROR_INVALID_ARGUMENT, "object");
+
+    // After all these failures the detector still works as before.
+    ASSERT_EQ(tethash_detector_detect(h.d, xyz, 5, &count), TETHASH_OK) << tethash_last_error();
+    EXPECT_EQ(count, 1);
+}
+
+TEST(CoreCapi, LastErrorIsPerThread)
+{
+    expect_error(tethash_detector_create(nullptr), TETHASH_ERROR_NULL_ARGUMENT, "tethash_detector_create");
+    std::string other;
+    std::thread t([&] { other = tethash_last_error(); });
+    t.join();
+    EXPECT_EQ(other, "");
+    EXPECT_NE(std::string(tethash_last_error()).find("create"), std::string::npos);
+}
