@@ -504,7 +504,10 @@ py::dict run_study(const std::string& sweep, const py::dict& kw)
         py::gil_scoped_release release;
         res = tethash::study::run_study(*plan, hooks);
     }
-    if (res.interrupted || stop.load()) throw py::error_already_set(); // KeyboardInterrupt: rows so far kept
+    if (res.interrupted || stop.load()) { // Ctrl-C: the rows measured so far stay in the CSV
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
+        throw py::error_already_set();
+    }
     py::dict d;
     d["points_done"] = res.points_done;
     d["points_planned"] = res.points_planned;

@@ -41,13 +41,13 @@ struct UnionResult {
 };
 
 /// Runs every part at `positions` with subdomains built at `built_at`, the ghost layer `width` wide.
-UnionResult run_parts(const Scene& s, const Partition& p, double width, ContactOwner owner,
-                      const Positions& built_at, const Positions& positions)
+UnionResult run_parts(const Scene& s, const Partition& p, double width, ContactOwner owner, const Positions& built_at,
+                      const Positions& positions)
 {
     UnionResult r;
     for (int part = 0; part < static_cast<int>(p.regions.size()); ++part) {
-        const Subdomain sub = make_subdomain(built_at, s.tets, p.vertex_part, p.tet_part, part, p.regions[part],
-                                             width, owner, s.vertex_object, s.tet_object);
+        const Subdomain sub = make_subdomain(built_at, s.tets, p.vertex_part, p.tet_part, part, p.regions[part], width,
+                                             owner, s.vertex_object, s.tet_object);
         for (auto o : sub.vertex_owned)
             r.ghost_vertices += o ? 0 : 1;
         for (auto o : sub.tet_owned)
@@ -140,8 +140,7 @@ TEST(CoreSubdomain, WithoutGhostLayerContactsAreLost)
             const UnionResult half = run_parts(s, p, 0.0, ContactOwner::tet, s.positions, s.positions);
             EXPECT_LE(half.contacts.size(), want.size());
             lost += static_cast<std::int64_t>(want.size() - half.contacts.size());
-            EXPECT_EQ(run_parts(s, p, width, ContactOwner::tet, s.positions, s.positions).contacts.size(),
-                      want.size());
+            EXPECT_EQ(run_parts(s, p, width, ContactOwner::tet, s.positions, s.positions).contacts.size(), want.size());
         }
     }
     EXPECT_GT(lost, 0);

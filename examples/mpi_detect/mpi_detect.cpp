@@ -125,7 +125,8 @@ int run(int rank, int size, int argc, char** argv)
         } else if (a == "--steps" && i + 1 < argc) {
             steps = std::atoi(argv[++i]);
         } else {
-            if (rank == 0) std::fprintf(stderr, "mpi_detect: unknown argument '%s' (--mesh FILE, --steps N)\n", argv[i]);
+            if (rank == 0)
+                std::fprintf(stderr, "mpi_detect: unknown argument '%s' (--mesh FILE, --steps N)\n", argv[i]);
             return 2;
         }
     }
@@ -198,7 +199,9 @@ int run(int rank, int size, int argc, char** argv)
     const std::vector<int> tet_corners = scatter(own_tet_corners, rank, size);
     const std::vector<int> tet_object = scatter(own_tet_object, rank, size);
     const std::size_t owned = vertex_ids.size();
-    const auto rest_of = [&](std::size_t i) { return Eigen::RowVector3d(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]); };
+    const auto rest_of = [&](std::size_t i) {
+        return Eigen::RowVector3d(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+    };
 
     // ---- 2. ghost lists: owned vertices within the ghost width of another rank's region, sent once with ids
     // and objects; positions travel along the same lists every step.
@@ -303,8 +306,7 @@ int run(int rank, int size, int argc, char** argv)
             total += counts[r];
         }
         std::vector<int> all(static_cast<std::size_t>(rank == 0 ? total : 0));
-        MPI_Gatherv(flat.data(), count, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, 0,
-                    MPI_COMM_WORLD);
+        MPI_Gatherv(flat.data(), count, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, 0, MPI_COMM_WORLD);
         double ms_max = 0;
         MPI_Reduce(&ms, &ms_max, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
         int ghosts = static_cast<int>(ghost_ids.size()), ghosts_max = 0;

@@ -68,11 +68,11 @@ Positions tet_centroids(const PositionsRef& positions, const TetsRef& tets);
 /// A subdomain's local mesh: global ids of its vertices and tets (ascending), which of them it owns, and its tets
 /// in local vertex numbering.
 struct Subdomain {
-    std::vector<Index> vertices;             ///< global ids of the local vertices, ascending
-    std::vector<Index> tets;                 ///< global ids of the local tets, ascending
-    std::vector<std::uint8_t> vertex_owned;  ///< per local vertex: 1 owned, 0 ghost
-    std::vector<std::uint8_t> tet_owned;     ///< per local tet: 1 owned, 0 ghost
-    Tets local_tets;                         ///< local tets, local vertex ids
+    std::vector<Index> vertices;                  ///< global ids of the local vertices, ascending
+    std::vector<Index> tets;                      ///< global ids of the local tets, ascending
+    std::vector<std::uint8_t> vertex_owned;       ///< per local vertex: 1 owned, 0 ghost
+    std::vector<std::uint8_t> tet_owned;          ///< per local tet: 1 owned, 0 ghost
+    Tets local_tets;                              ///< local tets, local vertex ids
     std::vector<Index> vertex_object, tet_object; ///< object ids of the local vertices and tets (empty: all 0)
     /// The local positions (|vertices| × 3) gathered from a global array.
     Positions gather(const PositionsRef& global_positions) const;
@@ -100,8 +100,7 @@ void owned_contacts(std::span<const Contact> local, std::span<const std::uint8_t
 
 /// Detects on the local positions (the detector's topology is sub.local_tets) and keeps the owned contacts in
 /// `out` (global ids, sorted). Returns `out`.
-const std::vector<Contact>& detect_owned(Detector& detector, const PositionsRef& local_positions,
-                                         const Subdomain& sub, ContactOwner owner, std::vector<Contact>& out,
-                                         DetectStats* stats = nullptr);
+const std::vector<Contact>& detect_owned(Detector& detector, const PositionsRef& local_positions, const Subdomain& sub,
+                                         ContactOwner owner, std::vector<Contact>& out, DetectStats* stats = nullptr);
 
 } // namespace tethash

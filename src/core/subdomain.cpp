@@ -67,8 +67,8 @@ void bisect(const PositionsRef& points, std::vector<Index>& ids, std::size_t fir
         }
         (hi - lo).maxCoeff(&axis);
         // The point at the proportional rank along the axis; points on the cut go right (lo <= x < hi).
-        const std::size_t k = first + (last - first) * static_cast<std::size_t>(left_parts) /
-                                          static_cast<std::size_t>(parts);
+        const std::size_t k =
+            first + (last - first) * static_cast<std::size_t>(left_parts) / static_cast<std::size_t>(parts);
         const auto coord = [&](Index i) { return points(i, axis); };
         std::nth_element(ids.begin() + static_cast<std::ptrdiff_t>(first), ids.begin() + static_cast<std::ptrdiff_t>(k),
                          ids.begin() + static_cast<std::ptrdiff_t>(last),
@@ -79,9 +79,9 @@ void bisect(const PositionsRef& points, std::vector<Index>& ids, std::size_t fir
         const double a = region.lo[axis], b = region.hi[axis];
         cut = std::isfinite(a) && std::isfinite(b) ? 0.5 * (a + b) : std::isfinite(a) ? a : std::isfinite(b) ? b : 0;
     }
-    const auto mid = std::partition(ids.begin() + static_cast<std::ptrdiff_t>(first),
-                                    ids.begin() + static_cast<std::ptrdiff_t>(last),
-                                    [&](Index i) { return points(i, axis) < cut; });
+    const auto mid =
+        std::partition(ids.begin() + static_cast<std::ptrdiff_t>(first),
+                       ids.begin() + static_cast<std::ptrdiff_t>(last), [&](Index i) { return points(i, axis) < cut; });
     const auto split = static_cast<std::size_t>(mid - ids.begin());
     Region left = region, right = region;
     left.hi[axis] = cut;
@@ -111,8 +111,8 @@ int region_of(const std::vector<Region>& regions, const Eigen::Vector3d& p)
 {
     for (std::size_t r = 0; r < regions.size(); ++r)
         if (regions[r].contains(p)) return static_cast<int>(r);
-    throw Error("region_of: no region holds the point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) +
-                ", " + std::to_string(p.z()) + ")");
+    throw Error("region_of: no region holds the point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                std::to_string(p.z()) + ")");
 }
 
 Positions tet_centroids(const PositionsRef& positions, const TetsRef& tets)
@@ -182,8 +182,7 @@ Subdomain make_subdomain(const PositionsRef& positions, const TetsRef& tets, std
     s.local_tets.resize(static_cast<Eigen::Index>(s.tets.size()), 4);
     for (std::size_t i = 0; i < s.tets.size(); ++i)
         for (int k = 0; k < 4; ++k)
-            s.local_tets(static_cast<Eigen::Index>(i), k) =
-                local_id[static_cast<std::size_t>(tets(s.tets[i], k))];
+            s.local_tets(static_cast<Eigen::Index>(i), k) = local_id[static_cast<std::size_t>(tets(s.tets[i], k))];
     return s;
 }
 
@@ -215,9 +214,8 @@ void owned_contacts(std::span<const Contact> local, std::span<const std::uint8_t
     if (!std::is_sorted(out.begin(), out.end(), less)) std::sort(out.begin(), out.end(), less);
 }
 
-const std::vector<Contact>& detect_owned(Detector& detector, const PositionsRef& local_positions,
-                                         const Subdomain& sub, ContactOwner owner, std::vector<Contact>& out,
-                                         DetectStats* stats)
+const std::vector<Contact>& detect_owned(Detector& detector, const PositionsRef& local_positions, const Subdomain& sub,
+                                         ContactOwner owner, std::vector<Contact>& out, DetectStats* stats)
 {
     const std::vector<Contact>& local = detector.detect(local_positions, stats);
     owned_contacts(local, sub.vertex_owned, sub.tet_owned, sub.vertices, sub.tets, owner, out);
