@@ -1,0 +1,356 @@
+// Per-rank collision detection over MPI, the way a domain-decomposed FEM code would run it:
+//  1. rank 0 holds the mesh (read from a file, or two generated bodies in contact), partitions the tets by
+//     recursive coordinate bisection of their centroids (vertices by the region holding them), and sends each
+//     rank what it owns;
+//  2. every rank sends its neighbours the owned vertices within the ghost width (largest tet extent + skin) of
+//     their regions, once; each step only the positions of those vertices travel;
+//  3. every rank detects on its local mesh and keeps the contacts whose tet it owns (tethash::detect_owned);
+//  4. rank 0 gathers the contacts and checks that their union is the serial detection, each contact once.
+// Exit status 0 when every step agrees, 1 when one does not, 2 on bad input.
+//
+//   mpirun -np 4 build/examples/mpi_detect/mpi_detect [--mesh FILE] [--steps N]
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/generate.hpp"
+#include "tethash/subdomain.hpp"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using tethash::Index;
+
+template <typename T> MPI_Datatype mpi_type();
+template <> MPI_Datatype mpi_type<int>()
+{
+    return MPI_INT;
+}
+template <> MPI_Datatype mpi_type<double>()
+{
+    return MPI_DOUBLE;
+}
+
+/// Rank 0 gives rank r `per_rank[r]` (other ranks pass an empty vector of vectors).
+template <typename T> std::vector<T> scatter(const std::vector<std::vector<T>>& per_rank, int rank, int size)
+{
+    std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
+    std::vector<T> flat;
+    if (rank == 0)
+        for (int r = 0; r < size; ++r) {
+            counts[r] = static_cast<int>(per_rank[r].size());
+            displs[r] = static_cast<int>(flat.size());
+            flat.insert(flat.end(), per_rank[r].begin(), per_rank[r].end());
+        }
+    int mine = 0;
+    MPI_Scatter(counts.data(), 1, MPI_INT, &mine, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    std::vector<T> out(static_cast<std::size_t>(mine));
+    MPI_Scatterv(flat.data(), counts.data(), displs.data(), mpi_type<T>(), out.data(), mine, mpi_type<T>(), 0,
+                 MPI_COMM_WORLD);
+    return out;
+}
+
+/// Every rank sends send[q] to rank q; returns what it received, concatenated in rank order.
+template <typename T> std::vector<T> all_to_all(const std::vector<std::vector<T>>& send, int size)
+{
+    std::vector<int> scount(static_cast<std::size_t>(size)), sdispl(static_cast<std::size_t>(size)),
+        rcount(static_cast<std::size_t>(size)), rdispl(static_cast<std::size_t>(size));
+    std::vector<T> flat;
+    for (int q = 0; q < size; ++q) {
+        scount[q] = static_cast<int>(send[q].size());
+        sdispl[q] = static_cast<int>(flat.size());
+        flat.insert(flat.end(), send[q].begin(), send[q].end());
+    }
+    MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    int total = 0;
+    for (int q = 0; q < size; ++q) {
+        rdispl[q] = total;
+        total += rcount[q];
+    }
+    std::vector<T> out(static_cast<std::size_t>(total));
+    MPI_Alltoallv(flat.data(), scount.data(), sdispl.data(), mpi_type<T>(), out.data(), rcount.data(), rdispl.data(),
+                  mpi_type<T>(), MPI_COMM_WORLD);
+    return out;
+}
+
+/// The default scene: a box and a sphere overlapping (objects 0 and 1).
+tethash::TetMesh default_mesh()
+{
+    tethash::meshing::GenerateParams box;
+    box.shape = "box";
+    box.resolution = 7;
+    tethash::meshing::GenerateParams ball;
+    ball.shape = "sphere";
+    ball.resolution = 9;
+    tethash::TetMesh mesh = tethash::meshing::generate(box);
+    tethash::TetMesh sphere = tethash::meshing::generate(ball);
+    for (Eigen::Index v = 0; v < sphere.positions.rows(); ++v)
+        sphere.positions.row(v) += Eigen::RowVector3d(0.55, 0.13, 0.07);
+    mesh.ensure_object_ids();
+    mesh.append(sphere);
+    return mesh;
+}
+
+/// Positions at `step`: object 1 moves towards object 0 by `speed` per step along -x.
+Eigen::RowVector3d position_at(const Eigen::RowVector3d& rest, Index object, int step, double speed)
+{
+    return object == 1 ? Eigen::RowVector3d(rest + Eigen::RowVector3d(-speed * step, 0, 0)) : rest;
+}
+
+std::vector<std::pair<Index, Index>> pairs_of(const std::vector<tethash::Contact>& contacts)
+{
+    std::vector<std::pair<Index, Index>> p;
+    p.reserve(contacts.size());
+    for (const auto& c : contacts)
+        p.emplace_back(c.vertex, c.tet);
+    return p;
+}
+
+int run(int rank, int size, int argc, char** argv)
+{
+    std::string mesh_path;
+    int steps = 3;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--mesh" && i + 1 < argc) {
+            mesh_path = argv[++i];
+        } else if (a == "--steps" && i + 1 < argc) {
+            steps = std::atoi(argv[++i]);
+        } else {
+            if (rank == 0)
+                std::fprintf(stderr, "mpi_detect: unknown argument '%s' (--mesh FILE, --steps N)\n", argv[i]);
+            return 2;
+        }
+    }
+    if (steps < 1) {
+        if (rank == 0) std::fprintf(stderr, "mpi_detect: --steps must be >= 1\n");
+        return 2;
+    }
+
+    // ---- 1. rank 0: the mesh, the partition, what each rank owns.
+    tethash::TetMesh mesh;
+    std::vector<std::vector<int>> own_vertex_ids(static_cast<std::size_t>(size)),
+        own_vertex_object(static_cast<std::size_t>(size)), own_tet_ids(static_cast<std::size_t>(size)),
+        own_tet_corners(static_cast<std::size_t>(size)), own_tet_object(static_cast<std::size_t>(size));
+    std::vector<std::vector<double>> own_positions(static_cast<std::size_t>(size));
+    std::vector<double> setup(6 * static_cast<std::size_t>(size) + 2, 0.0); // regions, width, speed
+    int ok = 1;
+    if (rank == 0) {
+        try {
+            mesh = mesh_path.empty() ? default_mesh() : tethash::io::read_tet_mesh(mesh_path);
+            mesh.ensure_object_ids();
+            const tethash::Positions centroids = tethash::tet_centroids(mesh.positions, mesh.tets);
+            const auto regions = tethash::bisect_regions(centroids, size);
+            const double skin = 0.3 * tethash::mean_edge_length(mesh.positions, mesh.tets);
+            const double width = tethash::ghost_width(mesh.positions, mesh.tets, skin);
+            for (Index v = 0; v < mesh.num_vertices(); ++v) {
+                const int r = tethash::region_of(regions, mesh.positions.row(v).transpose());
+                own_vertex_ids[r].push_back(v);
+                own_vertex_object[r].push_back(mesh.vertex_object[v]);
+                for (int a = 0; a < 3; ++a)
+                    own_positions[r].push_back(mesh.positions(v, a));
+            }
+            for (Index t = 0; t < mesh.num_tets(); ++t) {
+                const int r = tethash::region_of(regions, centroids.row(t).transpose());
+                own_tet_ids[r].push_back(t);
+                own_tet_object[r].push_back(mesh.tet_object[t]);
+                for (int k = 0; k < 4; ++k)
+                    own_tet_corners[r].push_back(mesh.tets(t, k));
+            }
+            for (int r = 0; r < size; ++r)
+                for (int a = 0; a < 3; ++a) {
+                    setup[6 * r + a] = regions[r].lo[a];
+                    setup[6 * r + 3 + a] = regions[r].hi[a];
+                }
+            setup[6 * size] = width;
+            // Motion below skin / 2 over the whole run: the ghost lists stay valid without a new exchange.
+            setup[6 * size + 1] = 0.45 * skin / steps;
+            std::printf("mpi_detect: %d ranks, %d vertices, %d tets, ghost width %.4g (largest tet extent %.4g + "
+                        "skin %.4g)\n",
+                        size, mesh.num_vertices(), mesh.num_tets(), width, width - skin, skin);
+        } catch (const tethash::Error& e) {
+            std::fprintf(stderr, "mpi_detect: %s\n", e.what());
+            ok = 0;
+        }
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!ok) return 2;
+    MPI_Bcast(setup.data(), static_cast<int>(setup.size()), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    std::vector<tethash::Region> regions(static_cast<std::size_t>(size));
+    for (int r = 0; r < size; ++r)
+        for (int a = 0; a < 3; ++a) {
+            regions[r].lo[a] = setup[6 * r + a];
+            regions[r].hi[a] = setup[6 * r + 3 + a];
+        }
+    const double width = setup[6 * size], speed = setup[6 * size + 1];
+
+    const std::vector<int> vertex_ids = scatter(own_vertex_ids, rank, size);
+    const std::vector<int> vertex_object = scatter(own_vertex_object, rank, size);
+    const std::vector<double> rest = scatter(own_positions, rank, size);
+    const std::vector<int> tet_ids = scatter(own_tet_ids, rank, size);
+    const std::vector<int> tet_corners = scatter(own_tet_corners, rank, size);
+    const std::vector<int> tet_object = scatter(own_tet_object, rank, size);
+    const std::size_t owned = vertex_ids.size();
+    const auto rest_of = [&](std::size_t i) {
+        return Eigen::RowVector3d(rest[3 * i], rest[3 * i + 1], rest[3 * i + 2]);
+    };
+
+    // ---- 2. ghost lists: owned vertices within the ghost width of another rank's region, sent once with ids
+    // and objects; positions travel along the same lists every step.
+    std::vector<std::vector<int>> send_list(static_cast<std::size_t>(size)), send_ids(static_cast<std::size_t>(size)),
+        send_objects(static_cast<std::size_t>(size));
+    for (int q = 0; q < size; ++q) {
+        if (q == rank) continue;
+        for (std::size_t i = 0; i < owned; ++i)
+            if (regions[q].distance(rest_of(i).transpose()) <= width) {
+                send_list[q].push_back(static_cast<int>(i));
+                send_ids[q].push_back(vertex_ids[i]);
+                send_objects[q].push_back(vertex_object[i]);
+            }
+    }
+    const std::vector<int> ghost_ids = all_to_all(send_ids, size);
+    const std::vector<int> ghost_objects = all_to_all(send_objects, size);
+
+    // The local mesh: owned and ghost vertices in ascending global order, owned tets in local numbering.
+    tethash::Subdomain sub;
+    std::vector<std::pair<int, int>> order; // (global id, source: i >= 0 owned index, -1 - g ghost index g)
+    for (std::size_t i = 0; i < owned; ++i)
+        order.emplace_back(vertex_ids[i], static_cast<int>(i));
+    for (std::size_t g = 0; g < ghost_ids.size(); ++g)
+        order.emplace_back(ghost_ids[g], -1 - static_cast<int>(g));
+    std::sort(order.begin(), order.end());
+    for (const auto& [id, source] : order) {
+        sub.vertices.push_back(id);
+        sub.vertex_owned.push_back(source >= 0 ? 1 : 0);
+        sub.vertex_object.push_back(source >= 0 ? vertex_object[source] : ghost_objects[-1 - source]);
+    }
+    sub.tets.assign(tet_ids.begin(), tet_ids.end());
+    sub.tet_owned.assign(tet_ids.size(), 1);
+    sub.tet_object.assign(tet_object.begin(), tet_object.end());
+    sub.local_tets.resize(static_cast<Eigen::Index>(tet_ids.size()), 4);
+    int missing = 0;
+    for (std::size_t t = 0; t < tet_ids.size(); ++t)
+        for (int k = 0; k < 4; ++k) {
+            const int g = tet_corners[4 * t + k];
+            const auto it = std::lower_bound(sub.vertices.begin(), sub.vertices.end(), g);
+            if (it == sub.vertices.end() || *it != g) {
+                ++missing; // a corner outside the ghost layer: the width rule would be wrong
+                sub.local_tets(static_cast<Eigen::Index>(t), k) = 0;
+            } else {
+                sub.local_tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(it - sub.vertices.begin());
+            }
+        }
+    int missing_all = 0;
+    MPI_Allreduce(&missing, &missing_all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+    if (missing_all > 0) {
+        if (rank == 0) std::fprintf(stderr, "mpi_detect: %d tet corners outside the ghost layers\n", missing_all);
+        return 1;
+    }
+
+    // One thread per rank: ranks are the parallelism here (more would oversubscribe the cores the ranks share).
+    tethash::DetectParams params;
+    params.threads = 1;
+    tethash::Detector det(params);
+    det.set_topology(sub.local_tets, static_cast<Index>(sub.vertices.size()), sub.vertex_object, sub.tet_object);
+    tethash::Positions local(static_cast<Eigen::Index>(sub.vertices.size()), 3);
+    std::vector<tethash::Contact> mine;
+    tethash::Detector serial;
+    if (rank == 0) serial.set_topology(mesh);
+    int failures = 0;
+
+    for (int step = 0; step < steps; ++step) {
+        // ---- owned positions of this step, ghosts from their owners.
+        std::vector<double> owned_now(3 * owned);
+        for (std::size_t i = 0; i < owned; ++i) {
+            const Eigen::RowVector3d p = position_at(rest_of(i), vertex_object[i], step, speed);
+            for (int a = 0; a < 3; ++a)
+                owned_now[3 * i + a] = p[a];
+        }
+        std::vector<std::vector<double>> send_pos(static_cast<std::size_t>(size));
+        for (int q = 0; q < size; ++q)
+            for (int i : send_list[q])
+                send_pos[q].insert(send_pos[q].end(), owned_now.begin() + 3 * i, owned_now.begin() + 3 * i + 3);
+        const std::vector<double> ghost_pos = all_to_all(send_pos, size);
+        for (std::size_t l = 0; l < order.size(); ++l) {
+            const int source = order[l].second;
+            const double* p = source >= 0 ? &owned_now[3 * static_cast<std::size_t>(source)]
+                                          : &ghost_pos[3 * static_cast<std::size_t>(-1 - source)];
+            local.row(static_cast<Eigen::Index>(l)) << p[0], p[1], p[2];
+        }
+
+        // ---- 3. detection on the local mesh, the contacts of owned tets.
+        const auto start = std::chrono::steady_clock::now();
+        tethash::detect_owned(det, local, sub, tethash::ContactOwner::tet, mine);
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+        // ---- 4. gather on rank 0 and compare with the serial detection.
+        std::vector<int> flat;
+        for (const auto& c : mine) {
+            flat.push_back(c.vertex);
+            flat.push_back(c.tet);
+        }
+        const int count = static_cast<int>(flat.size());
+        std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
+        MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+        int total = 0;
+        for (int r = 0; r < size; ++r) {
+            displs[r] = total;
+            total += counts[r];
+        }
+        std::vector<int> all(static_cast<std::size_t>(rank == 0 ? total : 0));
+        MPI_Gatherv(flat.data(), count, MPI_INT, all.data(), counts.data(), displs.data(), MPI_INT, 0, MPI_COMM_WORLD);
+        double ms_max = 0;
+        MPI_Reduce(&ms, &ms_max, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+        int ghosts = static_cast<int>(ghost_ids.size()), ghosts_max = 0;
+        MPI_Reduce(&ghosts, &ghosts_max, 1, MPI_INT, MPI_MAX, 0, MPI_COMM_WORLD);
+        if (rank == 0) {
+            std::vector<std::pair<Index, Index>> got;
+            for (std::size_t i = 0; i + 1 < all.size(); i += 2)
+                got.emplace_back(all[i], all[i + 1]);
+            std::sort(got.begin(), got.end());
+            const auto dup = std::adjacent_find(got.begin(), got.end()) != got.end();
+            tethash::Positions now = mesh.positions;
+            for (Index v = 0; v < mesh.num_vertices(); ++v)
+                now.row(v) = position_at(mesh.positions.row(v), mesh.vertex_object[v], step, speed);
+            const auto want = pairs_of(serial.detect(now));
+            const bool same = got == want;
+            std::printf("step %d: %zu contacts from the ranks (per rank:", step, got.size());
+            for (int r = 0; r < size; ++r)
+                std::printf(" %d", counts[r] / 2);
+            std::printf("), serial %zu, %s; most ghosts on a rank %d, slowest rank %.2f ms\n", want.size(),
+                        same ? "equal" : (dup ? "DIFFERENT (a contact reported twice)" : "DIFFERENT"), ghosts_max,
+                        ms_max);
+            if (!same || want.empty()) ++failures;
+        }
+    }
+    MPI_Bcast(&failures, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (rank == 0) std::printf("mpi_detect: %s\n", failures ? "FAILED" : "the union over ranks equals the serial run");
+    return failures ? 1 : 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    MPI_Init(&argc, &argv);
+    int rank = 0, size = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    int status = 2;
+    try {
+        status = run(rank, size, argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mpi_detect (rank %d): %s\n", rank, e.what());
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+    MPI_Finalize();
+    return status;
+}
