@@ -17,19 +17,10 @@
 #include <string>
 
 using namespace tethash;
+using tethash::test::identical;
 using tethash::test::Scene;
 
 namespace {
-
-bool identical(const std::vector<Contact>& a, const std::vector<Contact>& b)
-{
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (a[i].vertex != b[i].vertex || a[i].tet != b[i].tet ||
-            std::memcmp(a[i].bary, b[i].bary, sizeof a[i].bary) != 0)
-            return false;
-    return true;
-}
 
 /// Runs the detector without statistics (the lean scan kernel) and with them (every entry classified):
 /// both must give the same contacts bit for bit; returns them.

@@ -121,6 +121,16 @@ TetMesh read_reference(const std::filesystem::path& dir)
     return m;
 }
 
+/// `m` with fields `f` in each format and encoding we write (ours.vtu, ours_binary.vtk, ours_ascii.vtk), and
+/// its reference text for the Python checks.
+void write_ours_and_reference(const std::filesystem::path& dir, const TetMesh& m, const io::Fields& f)
+{
+    io::write_vtu((dir / "ours.vtu").string(), m, f);
+    io::write_vtk((dir / "ours_binary.vtk").string(), m, f, true);
+    io::write_vtk((dir / "ours_ascii.vtk").string(), m, f, false);
+    write_reference(dir, m);
+}
+
 } // namespace
 
 // ---- our writers → our readers ------------------------------------------------------------
@@ -443,11 +453,8 @@ TEST(IoVtk, MeshioReadsEveryFileWeWrite)
     const auto dir = temp_dir();
     const TetMesh m = grid_mesh();
     const io::Fields f = sample_fields(m);
-    io::write_vtu((dir / "ours.vtu").string(), m, f);
-    io::write_vtk((dir / "ours_binary.vtk").string(), m, f, true);
-    io::write_vtk((dir / "ours_ascii.vtk").string(), m, f, false);
+    write_ours_and_reference(dir, m, f);
     io::write_pvd((dir / "series.pvd").string(), {{0.0, "ours.vtu"}, {0.5, "ours.vtu"}});
-    write_reference(dir, m);
     {
         std::ofstream v(dir / "ref_velocity.txt"), s(dir / "ref_stress.txt"), o(dir / "ref_objects.txt");
         v.precision(17);
@@ -557,10 +564,7 @@ TEST(IoVtk, VtkLibraryReadsOursAndWeReadVtkLibraryFiles)
     const auto dir = temp_dir();
     const TetMesh m = grid_mesh();
     const io::Fields f = sample_fields(m);
-    io::write_vtu((dir / "ours.vtu").string(), m, f);
-    io::write_vtk((dir / "ours_binary.vtk").string(), m, f, true);
-    io::write_vtk((dir / "ours_ascii.vtk").string(), m, f, false);
-    write_reference(dir, m);
+    write_ours_and_reference(dir, m, f);
     write_text(dir / "check_with_vtk.py", kVtkScript);
     const RunResult r = run_shell(py + " " + quote(dir / "check_with_vtk.py") + " " + quote(dir));
     ASSERT_EQ(r.status, 0) << r.out << r.err;

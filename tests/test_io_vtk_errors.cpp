@@ -94,6 +94,21 @@ struct Case {
     std::vector<std::string> parts; ///< after the file name
 };
 
+/// Writes each case to dir/NAME`ext` and expects `read` to fail on it with the case's message (its first part
+/// prefixed with the path).
+void expect_cases(const std::filesystem::path& dir, const std::vector<Case>& cases, const std::string& ext,
+                  const std::function<void(const std::string&)>& read)
+{
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        const auto path = dir / (std::string(c.name) + ext);
+        write_text(path, c.text);
+        std::vector<std::string> parts = c.parts;
+        parts.front() = path.string() + parts.front();
+        expect_error([&] { read(path.string()); }, parts);
+    }
+}
+
 } // namespace
 
 TEST(IoVtkErrors, TemplatesAreValid)
@@ -150,14 +165,7 @@ TEST(IoVtkErrors, LegacyAscii)
                   "CELLS 2 4\nOFFSETS vtktypeint64\n0 5\nCONNECTIVITY vtktypeint64\n0 1 2 3\n"),
          {":12: offset 1 is 5, expected a value from 0 to 4"}},
     };
-    for (const Case& c : cases) {
-        SCOPED_TRACE(c.name);
-        const auto path = dir / (std::string(c.name) + ".vtk");
-        write_text(path, c.text);
-        std::vector<std::string> parts = c.parts;
-        parts.front() = path.string() + parts.front();
-        expect_error([&] { io::read_vtk(path.string()); }, parts);
-    }
+    expect_cases(dir, cases, ".vtk", [](const std::string& path) { (void)io::read_vtk(path); });
 }
 
 TEST(IoVtkErrors, LegacyBinaryNamesByteOffsets)
@@ -261,14 +269,7 @@ TEST(IoVtkErrors, VtuAscii)
                   "format=\"binary\">\n          FAAAAAAAAAABAAAAAgAAAAMAAAA="),
          {":14: expected the block header of DataArray 'connectivity'", "to give 16 bytes, found 20"}},
     };
-    for (const Case& c : cases) {
-        SCOPED_TRACE(c.name);
-        const auto path = dir / (std::string(c.name) + ".vtu");
-        write_text(path, c.text);
-        std::vector<std::string> parts = c.parts;
-        parts.front() = path.string() + parts.front();
-        expect_error([&] { io::read_vtu(path.string()); }, parts);
-    }
+    expect_cases(dir, cases, ".vtu", [](const std::string& path) { (void)io::read_vtu(path); });
     // The base64 form of the template's connectivity, as a check of the strings above.
     write_text(dir / "b64.vtu", replaced(kVtu, "format=\"ascii\">\n          0 1 2 3",
                                          "format=\"binary\">\n          EAAAAA==AAAAAAEAAAACAAAAAwAAAA=="));

@@ -51,6 +51,14 @@ Scene free_box(Integrator integ, double dt, double damping = 0.0, double perturb
     return s;
 }
 
+/// free_box with a time step `factor` times its explicit stability limit.
+Scene free_box_past_limit(Integrator integ, double factor)
+{
+    Scene s = free_box(integ, 1.0);
+    s.dt = factor * Simulation(s).explicit_dt_limit();
+    return s;
+}
+
 } // namespace
 
 TEST(SimModel, MassesSumToDensityTimesVolume)
@@ -251,9 +259,7 @@ TEST(SimIntegrators, SymplecticEulerEnergyOscillatesBounded)
 TEST(SimIntegrators, ImplicitEulerEnergyNonIncreasing)
 {
     for (LinearSolver solver : {LinearSolver::cg, LinearSolver::ldlt}) {
-        Scene s = free_box(Integrator::implicit_euler, 1.0);
-        Simulation probe(s);
-        s.dt = 20 * probe.explicit_dt_limit(); // far above the explicit limit
+        Scene s = free_box_past_limit(Integrator::implicit_euler, 20); // far above the explicit limit
         s.solver = solver;
         s.tolerance = 1e-10;
         Simulation sim(s);
@@ -271,9 +277,7 @@ TEST(SimIntegrators, ImplicitEulerEnergyNonIncreasing)
 
 TEST(SimIntegrators, LocalGlobalEnergyBoundedAtLargeSteps)
 {
-    Scene s = free_box(Integrator::vbd, 1.0);
-    Simulation probe(s);
-    s.dt = 20 * probe.explicit_dt_limit();
+    Scene s = free_box_past_limit(Integrator::vbd, 20);
     s.iterations = 10;
     Simulation sim(s);
     const double e0 = sim.energy().total();
@@ -286,9 +290,7 @@ TEST(SimIntegrators, LocalGlobalEnergyBoundedAtLargeSteps)
 
 TEST(SimIntegrators, ExplicitAboveLimitWarnsThenStopsWithoutNaN)
 {
-    Scene s = free_box(Integrator::symplectic_euler, 1.0);
-    Simulation probe(s);
-    s.dt = 5 * probe.explicit_dt_limit();
+    Scene s = free_box_past_limit(Integrator::symplectic_euler, 5);
     Simulation sim(s);
     ASSERT_FALSE(sim.warnings().empty());
     EXPECT_NE(sim.warnings()[0].find("stability limit"), std::string::npos) << sim.warnings()[0];
@@ -307,9 +309,7 @@ TEST(SimIntegrators, ExplicitAboveLimitWarnsThenStopsWithoutNaN)
 
 TEST(SimIntegrators, SubstepsBringExplicitUnderTheLimit)
 {
-    Scene s = free_box(Integrator::symplectic_euler, 1.0);
-    Simulation probe(s);
-    s.dt = 3 * probe.explicit_dt_limit();
+    Scene s = free_box_past_limit(Integrator::symplectic_euler, 3);
     s.substeps = 6;
     Simulation sim(s);
     EXPECT_TRUE(sim.warnings().empty());
