@@ -1,4 +1,4 @@
-// Gmsh .msh 2.2 and 4.1 (ASCII and binary): reader and 4.1 writer.
+// Gmsh .msh 2.2 and 4.1 (ASCII and binary) reader.
 //
 // Reading keeps the 4-node tets (element type 4) in file order and all nodes in file order; other
 // element types are skipped with a count in ReadNotes. Labels: 4.1 -> the first physical tag of the
@@ -6,6 +6,7 @@
 // tag of the element, or the second (elementary) tag where the physical tag is 0 or absent.
 #include "tethash/io/gmsh.hpp"
 
+#include "gmsh_element_types.hpp"
 #include "number.hpp"
 #include "tethash/error.hpp"
 #include "text_reader.hpp"
@@ -22,112 +23,9 @@ namespace tethash::io {
 
 namespace {
 
+using detail::gmsh_element_name;
+using detail::gmsh_nodes_per_element;
 using detail::TextReader;
-
-/// Nodes per element of a Gmsh element type, 0 if the type is unknown here.
-int nodes_per_element(std::int64_t type)
-{
-    switch (type) {
-    case 1:
-        return 2; // 2-node line
-    case 2:
-        return 3; // 3-node triangle
-    case 3:
-        return 4; // 4-node quadrangle
-    case 4:
-        return 4; // 4-node tetrahedron
-    case 5:
-        return 8; // 8-node hexahedron
-    case 6:
-        return 6; // 6-node prism
-    case 7:
-        return 5; // 5-node pyramid
-    case 8:
-        return 3; // 3-node line
-    case 9:
-        return 6; // 6-node triangle
-    case 10:
-        return 9; // 9-node quadrangle
-    case 11:
-        return 10; // 10-node tetrahedron
-    case 12:
-        return 27; // 27-node hexahedron
-    case 13:
-        return 18; // 18-node prism
-    case 14:
-        return 14; // 14-node pyramid
-    case 15:
-        return 1; // 1-node point
-    case 16:
-        return 8; // 8-node quadrangle
-    case 17:
-        return 20; // 20-node hexahedron
-    case 18:
-        return 15; // 15-node prism
-    case 19:
-        return 13; // 13-node pyramid
-    case 20:
-        return 9; // 9-node incomplete triangle
-    case 21:
-        return 10; // 10-node triangle
-    case 22:
-        return 12; // 12-node incomplete triangle
-    case 23:
-        return 15; // 15-node triangle
-    case 24:
-        return 15; // 15-node incomplete triangle
-    case 25:
-        return 21; // 21-node triangle
-    case 26:
-        return 4; // 4-node line
-    case 27:
-        return 5; // 5-node line
-    case 28:
-        return 6; // 6-node line
-    case 29:
-        return 20; // 20-node tetrahedron
-    case 30:
-        return 35; // 35-node tetrahedron
-    case 31:
-        return 56; // 56-node tetrahedron
-    case 92:
-        return 64; // 64-node hexahedron
-    case 93:
-        return 125; // 125-node hexahedron
-    default:
-        return 0;
-    }
-}
-
-std::string element_type_name(std::int64_t type)
-{
-    switch (type) {
-    case 1:
-        return "2-node line";
-    case 2:
-        return "3-node triangle";
-    case 3:
-        return "4-node quadrangle";
-    case 5:
-        return "8-node hexahedron";
-    case 6:
-        return "6-node prism";
-    case 7:
-        return "5-node pyramid";
-    case 8:
-        return "3-node line";
-    case 9:
-        return "6-node triangle";
-    case 11:
-        return "10-node tetrahedron";
-    case 15:
-        return "point";
-    default: {
-        const int n = nodes_per_element(type);
-        return n ? std::to_string(n) + "-node element" : "unknown element";
-    }
-    }
-}
 
 /// Node tag -> 0-based index, dense when the tags are compact, hashed otherwise.
 class NodeMap {
@@ -472,7 +370,7 @@ class MshReader {
                 if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
                 m_r.fail_message(msg);
             }
-            const int nn = nodes_per_element(type);
+            const int nn = gmsh_nodes_per_element(type);
             if (is_tet(type)) {
                 check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn),
                            "tets");
@@ -561,7 +459,7 @@ class MshReader {
             if (k == 0) physical = t;
             if (k == 1) elementary = t;
         }
-        const int nn = nodes_per_element(type);
+        const int nn = gmsh_nodes_per_element(type);
         if (is_tet(type)) {
             for (int k = 0; k < nn; ++k) { // a 10-node tet lists its corners first
                 const std::size_t at = m_r.offset();
@@ -588,7 +486,7 @@ class MshReader {
                 const std::int64_t type = m_r.next_int("the type of element " + std::to_string(etag));
                 const std::int64_t ntags =
                     m_r.next_int_in("the number of tags of element " + std::to_string(etag), 0, 1000);
-                if (nodes_per_element(type) == 0) {
+                if (gmsh_nodes_per_element(type) == 0) {
                     m_r.skip_rest_of_line(); // unknown type: an ASCII element is one line
                     skip_elements(type, 1);
                     continue;
@@ -602,7 +500,7 @@ class MshReader {
                 const std::int64_t type = read_int("an element type");
                 const std::int64_t count = read_int("the number of elements that follow");
                 const std::int64_t ntags = read_int("the number of tags");
-                const int nn = nodes_per_element(type);
+                const int nn = gmsh_nodes_per_element(type);
                 if (nn == 0)
                     m_r.fail_at_byte(at, "element type " + std::to_string(type) +
                                              " is unknown, so its elements cannot be skipped in a binary file");
@@ -659,9 +557,9 @@ class MshReader {
             for (const auto& [type, count] : m_skipped) {
                 m_notes->skipped_cells += count;
                 m_notes->messages.push_back("skipped " + std::to_string(count) + " elements of type " +
-                                            std::to_string(type) + " (" + element_type_name(type) + ")");
+                                            std::to_string(type) + " (" + gmsh_element_name(type) + ")");
                 m_notes->skipped.push_back(
-                    {count, "type " + std::to_string(type) + " (" + element_type_name(type) + ")", type == 11});
+                    {count, "type " + std::to_string(type) + " (" + gmsh_element_name(type) + ")", type == 11});
             }
         }
         return mesh;
@@ -684,186 +582,12 @@ class MshReader {
     std::map<std::int64_t, std::int64_t> m_skipped;
 };
 
-// ---- writing -------------------------------------------------------------------------------------
-
-/// Appends a value in the file's binary layout (native byte order) or as text followed by `sep`.
-struct MshOut {
-    bool binary;
-    std::string s;
-    void size(std::uint64_t v, char sep = ' ')
-    {
-        if (binary)
-            raw(v);
-        else {
-            detail::append_int(s, static_cast<std::int64_t>(v));
-            s += sep;
-        }
-    }
-    void integer(std::int32_t v, char sep = ' ')
-    {
-        if (binary)
-            raw(v);
-        else {
-            detail::append_int(s, v);
-            s += sep;
-        }
-    }
-    void real(double v, char sep = ' ')
-    {
-        if (binary)
-            raw(v);
-        else {
-            detail::append_double(s, v);
-            s += sep;
-        }
-    }
-    template <class T> void raw(T v)
-    {
-        char b[sizeof(T)];
-        std::memcpy(b, &v, sizeof(T));
-        s.append(b, sizeof(T));
-    }
-    /// In binary, ends a binary run with the newline Gmsh puts before $End lines.
-    void end_binary()
-    {
-        if (binary) s += '\n';
-    }
-};
-
 } // namespace
 
 TetMesh read_msh(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
     MshReader reader(path, notes, options);
     return reader.read();
-}
-
-void write_msh(const std::string& path, const TetMesh& mesh, bool binary)
-{
-    mesh.check_consistency("mesh to write to " + path);
-    const Index n = mesh.num_vertices(), m = mesh.num_tets();
-    const bool has_labels = static_cast<Index>(mesh.tet_label.size()) == m && m > 0;
-    const bool has_objects = static_cast<Index>(mesh.tet_object.size()) == m && m > 0;
-
-    // One volume entity per (object, label) pair, numbered 1.. in order of first appearance.
-    std::map<std::pair<Index, Index>, Index> entity_of_key;
-    std::vector<std::pair<Index, Index>> keys;
-    std::vector<Index> tet_entity(static_cast<std::size_t>(m));
-    for (Index t = 0; t < m; ++t) {
-        const std::pair<Index, Index> key{has_objects ? mesh.tet_object[static_cast<std::size_t>(t)] : 0,
-                                          has_labels ? mesh.tet_label[static_cast<std::size_t>(t)] : 0};
-        auto [it, fresh] = entity_of_key.emplace(key, static_cast<Index>(keys.size()) + 1);
-        if (fresh) keys.push_back(key);
-        tet_entity[static_cast<std::size_t>(t)] = it->second;
-    }
-    if (keys.empty()) keys.push_back({0, 0}); // a mesh with no tets still needs an entity for its nodes
-    const auto num_entities = static_cast<Index>(keys.size());
-
-    // Nodes belong to the entity of the first tet that uses them (entity 1 if unused).
-    std::vector<Index> node_entity(static_cast<std::size_t>(n), 0);
-    for (Index t = 0; t < m; ++t)
-        for (int k = 0; k < 4; ++k) {
-            Index& e = node_entity[static_cast<std::size_t>(mesh.tets(t, k))];
-            if (e == 0) e = tet_entity[static_cast<std::size_t>(t)];
-        }
-    for (Index& e : node_entity)
-        if (e == 0) e = 1;
-
-    // Bounding box per entity.
-    std::vector<std::array<double, 6>> box(static_cast<std::size_t>(num_entities), {0, 0, 0, 0, 0, 0});
-    std::vector<bool> box_set(static_cast<std::size_t>(num_entities), false);
-    for (Index v = 0; v < n; ++v) {
-        const auto e = static_cast<std::size_t>(node_entity[static_cast<std::size_t>(v)] - 1);
-        for (int a = 0; a < 3; ++a) {
-            const double x = mesh.positions(v, a);
-            if (!box_set[e] || x < box[e][static_cast<std::size_t>(a)]) box[e][static_cast<std::size_t>(a)] = x;
-            if (!box_set[e] || x > box[e][static_cast<std::size_t>(a) + 3]) box[e][static_cast<std::size_t>(a) + 3] = x;
-        }
-        box_set[e] = true;
-    }
-
-    // Runs of consecutive nodes / tets with the same entity become blocks (file order = index order).
-    auto runs = [](const std::vector<Index>& entity) {
-        std::vector<std::pair<std::size_t, std::size_t>> r; // [begin, end)
-        for (std::size_t i = 0; i < entity.size();) {
-            std::size_t j = i;
-            while (j < entity.size() && entity[j] == entity[i])
-                ++j;
-            r.push_back({i, j});
-            i = j;
-        }
-        return r;
-    };
-    const auto node_runs = runs(node_entity);
-    const auto tet_runs = runs(tet_entity);
-
-    MshOut o{binary, {}};
-    o.s.reserve(static_cast<std::size_t>(n) * (binary ? 32 : 64) + static_cast<std::size_t>(m) * (binary ? 40 : 48) +
-                1024);
-    o.s += "$MeshFormat\n4.1 ";
-    o.s += binary ? "1 8\n" : "0 8\n";
-    if (binary) {
-        o.raw(std::int32_t{1});
-        o.s += '\n';
-    }
-    o.s += "$EndMeshFormat\n$Entities\n";
-    o.size(0);
-    o.size(0);
-    o.size(0);
-    o.size(static_cast<std::uint64_t>(num_entities), '\n');
-    for (Index e = 0; e < num_entities; ++e) {
-        o.integer(e + 1);
-        for (int k = 0; k < 6; ++k)
-            o.real(box[static_cast<std::size_t>(e)][static_cast<std::size_t>(k)]);
-        if (has_labels) {
-            o.size(1);
-            o.integer(keys[static_cast<std::size_t>(e)].second);
-        } else {
-            o.size(0);
-        }
-        o.size(0, '\n'); // no bounding surfaces
-    }
-    o.end_binary();
-    o.s += "$EndEntities\n$Nodes\n";
-    o.size(node_runs.size());
-    o.size(static_cast<std::uint64_t>(n));
-    o.size(n ? 1 : 0);
-    o.size(static_cast<std::uint64_t>(n), '\n');
-    for (const auto& [b, e] : node_runs) {
-        o.integer(3);
-        o.integer(node_entity[b]);
-        o.integer(0);
-        o.size(e - b, '\n');
-        for (std::size_t v = b; v < e; ++v)
-            o.size(v + 1, '\n');
-        for (std::size_t v = b; v < e; ++v) {
-            const auto vi = static_cast<Index>(v);
-            o.real(mesh.positions(vi, 0));
-            o.real(mesh.positions(vi, 1));
-            o.real(mesh.positions(vi, 2), '\n');
-        }
-    }
-    o.end_binary();
-    o.s += "$EndNodes\n$Elements\n";
-    o.size(tet_runs.size());
-    o.size(static_cast<std::uint64_t>(m));
-    o.size(m ? 1 : 0);
-    o.size(static_cast<std::uint64_t>(m), '\n');
-    for (const auto& [b, e] : tet_runs) {
-        o.integer(3);
-        o.integer(tet_entity[b]);
-        o.integer(4);
-        o.size(e - b, '\n');
-        for (std::size_t t = b; t < e; ++t) {
-            const auto ti = static_cast<Index>(t);
-            o.size(t + 1);
-            for (int k = 0; k < 4; ++k)
-                o.size(static_cast<std::uint64_t>(mesh.tets(ti, k)) + 1, k == 3 ? '\n' : ' ');
-        }
-    }
-    o.end_binary();
-    o.s += "$EndElements\n";
-    write_text_file(path, o.s);
 }
 
 } // namespace tethash::io
