@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -85,6 +86,14 @@ inline RunResult run_tethash(const std::string& args)
     cmd.push_back(' ');
     cmd.append(args);
     return run_shell(cmd);
+}
+
+/// Expects `r` to be a refusal of bad input: exit status 2 and a message on stderr containing each of `parts`.
+inline void expect_refused(const RunResult& r, std::initializer_list<std::string> parts)
+{
+    EXPECT_EQ(r.status, 2) << r.err;
+    for (const std::string& part : parts)
+        EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
 }
 
 /// A Python interpreter that imports every module in `modules` (space separated), or nullopt.

@@ -214,6 +214,19 @@ class MshReader {
         return *v;
     }
 
+    /// Fails unless the blocks of section $`section` held the `total` `items` its header announced (at the
+    /// byte offset in a binary file, else at the line of the token that follows).
+    void check_blocks_total(std::int64_t seen, std::int64_t total, std::int64_t blocks, const std::string& items,
+                            const std::string& section)
+    {
+        if (seen == total) return;
+        const std::string msg = "expected " + std::to_string(total) + " " + items + " (the $" + section +
+                                " header), found " + std::to_string(seen) + " in its " + std::to_string(blocks) +
+                                " blocks";
+        if (binary()) m_r.fail_at_byte(m_r.offset(), msg);
+        m_r.next("$End" + section);
+        m_r.fail_message(msg);
+    }
     void expect_end(std::string_view marker)
     {
         const std::string_view tok = m_r.peek();
@@ -321,13 +334,7 @@ class MshReader {
             }
             seen += count;
         }
-        if (seen != total) {
-            const std::string msg = "expected " + std::to_string(total) + " nodes (the $Nodes header), found " +
-                                    std::to_string(seen) + " in its " + std::to_string(blocks) + " blocks";
-            if (binary()) m_r.fail_at_byte(m_r.offset(), msg);
-            m_r.next("$EndNodes");
-            m_r.fail_message(msg);
-        }
+        check_blocks_total(seen, total, blocks, "nodes", "Nodes");
         expect_end("$EndNodes");
         finish_nodes();
     }
@@ -411,13 +418,7 @@ class MshReader {
             }
             seen += count;
         }
-        if (seen != total) {
-            const std::string msg = "expected " + std::to_string(total) + " elements (the $Elements header), found " +
-                                    std::to_string(seen) + " in its " + std::to_string(blocks) + " blocks";
-            if (binary()) m_r.fail_at_byte(m_r.offset(), msg);
-            m_r.next("$EndElements");
-            m_r.fail_message(msg);
-        }
+        check_blocks_total(seen, total, blocks, "elements", "Elements");
         expect_end("$EndElements");
     }
 
