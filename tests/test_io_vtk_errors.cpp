@@ -24,19 +24,6 @@ std::string replaced(std::string s, const std::string& from, const std::string& 
     return s;
 }
 
-/// Runs `read` on a file and expects an Error whose message contains each of `parts`.
-void expect_error(const std::function<void()>& read, const std::vector<std::string>& parts)
-{
-    try {
-        read();
-        ADD_FAILURE() << "expected an Error containing '" << parts.front() << "'";
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        for (const std::string& p : parts)
-            EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
-    }
-}
-
 // Line numbers below are 1-based lines of these templates.
 const std::string kVtk = "# vtk DataFile Version 3.0\n" // 1
                          "four points\n"                // 2
