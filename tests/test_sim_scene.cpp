@@ -194,12 +194,7 @@ TEST(SimScene, ShippedScenesAndDefaultParse)
 
 TEST(SimScene, MissingFileIsAnError)
 {
-    try {
-        load_scene("/nonexistent/scene.toml");
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.toml"), std::string::npos);
-    }
+    expect_error([&] { load_scene("/nonexistent/scene.toml"); }, {"/nonexistent/scene.toml"});
 }
 
 TEST(SimScene, DirectoryIsNamedAsSuch)
