@@ -27,18 +27,25 @@ TetMesh box_mesh(int res = 2, double size = 1.0)
     return meshing::generate(g);
 }
 
+/// `x` with every coordinate moved by a uniform random amount in [−amplitude, amplitude] (a fixed `seed`).
+Positions perturbed(Positions x, unsigned seed, double amplitude)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-amplitude, amplitude);
+    for (Index i = 0; i < x.rows(); ++i)
+        for (int c = 0; c < 3; ++c)
+            x(i, c) += u(rng);
+    return x;
+}
+
 /// One free box, no gravity, no ground, no collisions: only the elastic model acts.
 Scene free_box(Integrator integ, double dt, double damping = 0.0, double perturb = 0.05)
 {
     Scene s;
     ObjectSpec o;
     TetMesh m = box_mesh(2);
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<double> u(-perturb, perturb);
     m.rest_positions = m.positions;
-    for (Index i = 0; i < m.num_vertices(); ++i)
-        for (int c = 0; c < 3; ++c)
-            m.positions(i, c) += u(rng);
+    m.positions = perturbed(m.positions, 7, perturb);
     o.data = m;
     o.self_collision = false;
     o.material.young = 1e4;
@@ -137,12 +144,7 @@ TEST(SimModel, ForcesAreMinusEnergyGradient)
     Material mat;
     mat.volume_stiffness = 3.0;
     Model model = Model::build(m, {mat}, {0});
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<double> u(-0.1, 0.1);
-    Positions x = m.positions;
-    for (Index i = 0; i < x.rows(); ++i)
-        for (int c = 0; c < 3; ++c)
-            x(i, c) += u(rng);
+    const Positions x = perturbed(m.positions, 3, 0.1);
     const Positions v = Positions::Zero(x.rows(), 3);
     Positions f = Positions::Zero(x.rows(), 3);
     model.add_forces(x, v, f);
@@ -176,12 +178,7 @@ TEST(SimModel, MatrixFreeOperatorEqualsAssembledMatrix)
     model.ground.height = -0.45;
     model.ground.stiffness = 1e3;
     model.ground.damping = 5;
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> u(-0.08, 0.08);
-    Positions x = m.positions;
-    for (Index i = 0; i < x.rows(); ++i)
-        for (int c = 0; c < 3; ++c)
-            x(i, c) += u(rng);
+    const Positions x = perturbed(m.positions, 5, 0.08);
     std::vector<Eigen::Triplet<double>> t;
     model.add_matrix_triplets(x, 0.7, 0.3, t);
     const Index N = 3 * x.rows();
