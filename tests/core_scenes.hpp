@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <sstream>
 #include <string>
@@ -20,6 +21,17 @@ struct Scene {
     std::vector<Index> vertex_object, tet_object;
     std::vector<ObjectOptions> objects;
 };
+
+/// The same contacts bit for bit: vertex, tet, both objects and the barycentric coordinates.
+inline bool identical(const std::vector<Contact>& a, const std::vector<Contact>& b)
+{
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a[i].vertex != b[i].vertex || a[i].tet != b[i].tet || a[i].vertex_object != b[i].vertex_object ||
+            a[i].tet_object != b[i].tet_object || std::memcmp(a[i].bary, b[i].bary, sizeof a[i].bary) != 0)
+            return false;
+    return true;
+}
 
 /// One object as the text of a Medit .mesh file (1-based indices).
 inline std::string medit_text(const Scene& s)

@@ -10,6 +10,7 @@
 #include <functional>
 #include <initializer_list>
 #include <string>
+#include <utility>
 
 namespace tethash::test {
 
@@ -25,7 +26,6 @@ inline std::string q(const std::filesystem::path& p)
     return quote(p);
 }
 
-/// 1-based number of the first line of `text` that contains `needle` (0 if none).
 /// Writes `good` with its first `from` replaced by `to` (a failure if there is none) to `path`.
 inline std::filesystem::path write_edited(const std::filesystem::path& path, std::string good, const std::string& from,
                                           const std::string& to)
@@ -37,6 +37,14 @@ inline std::filesystem::path write_edited(const std::filesystem::path& path, std
     return path;
 }
 
+/// `edited(dir, from, to, name)`: writes `good` with its first `from` replaced by `to` to dir/name, returns the path.
+inline auto editor(std::string good)
+{
+    return [good = std::move(good)](const std::filesystem::path& dir, const std::string& from, const std::string& to,
+                                    const std::string& name) { return write_edited(dir / name, good, from, to); };
+}
+
+/// 1-based number of the first line of `text` that contains `needle` (0 if none).
 inline int line_of(const std::string& text, const std::string& needle)
 {
     const std::size_t at = text.find(needle);
@@ -47,28 +55,10 @@ inline int line_of(const std::string& text, const std::string& needle)
     return line;
 }
 
-/// Runs `fn`, expects a tethash::Error whose message contains every string in `parts`; returns the message.
-inline std::string expect_error(const std::function<void()>& fn, std::initializer_list<std::string> parts)
-{
-    try {
-        fn();
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        for (const std::string& p : parts)
-            EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
-        return msg;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "expected tethash::Error, got another exception: " << e.what();
-        return e.what();
-    }
-    ADD_FAILURE() << "expected tethash::Error, nothing was thrown";
-    return {};
-}
-
 /// Expects reading `path` (by extension) to fail with a message containing `parts`.
 inline std::string expect_read_error(const std::filesystem::path& path, std::initializer_list<std::string> parts)
 {
-    return expect_error([&] { (void)io::read_mesh(path.string()); }, parts);
+    return expect_error([&] { (void)io::read_mesh(path.string()); }, std::vector<std::string>(parts));
 }
 
 /// "PATH:LINE:" as messages start.
@@ -225,6 +215,42 @@ for f in sys.argv[2:]:
 )PY";
 }
 
+/// Writes `ref` to dir/ref.txt, then runs `body` with meshio imported, the reference read as `pts`, `tets`,
+/// `labels` and the output path in sys.argv[2] (`out`, under `dir`).
+inline RunResult meshio_writes(const std::string& py, const std::filesystem::path& dir, const TetMesh& ref,
+                               const std::string& body, const std::string& out)
+{
+    write_reference(dir / "ref.txt", ref);
+    const std::string script = std::string(python_read_reference()) +
+                               "import meshio\npts, tets, labels = read_reference(sys.argv[1])\n" + body;
+    return run_python(py, dir, script, q(dir / "ref.txt") + " " + q(dir / out));
+}
+
+/// meshio reads each of `files` (under `dir`) and finds the mesh of dir/ref.txt with labels `label_key`.
+inline void expect_meshio_reads(const std::string& py, const std::filesystem::path& dir, const std::string& label_key,
+                                std::initializer_list<std::string> files)
+{
+    std::string args = q(dir / "ref.txt");
+    for (const std::string& f : files) {
+        args.push_back(' '); // appended, not " " + q(...): g++ 12 warns falsely on that concatenation
+        args.append(q(dir / f));
+    }
+    const RunResult r = run_python(py, dir, python_check_with_meshio(label_key), args);
+    EXPECT_EQ(r.status, 0) << r.out << r.err;
+    for (const std::string& f : files)
+        EXPECT_NE(r.out.find("OK " + (dir / f).string()), std::string::npos) << r.out << r.err;
+}
+
+/// `m` has the given counts, is valid and has no inverted tet (what every shared real mesh must be).
+inline void expect_valid_with_counts(const TetMesh& m, Index vertices, Index tets)
+{
+    EXPECT_EQ(m.num_vertices(), vertices);
+    EXPECT_EQ(m.num_tets(), tets);
+    const ValidationReport rep = validate(m);
+    EXPECT_TRUE(rep.ok());
+    EXPECT_EQ(rep.inverted_tets, 0);
+}
+
 /// The mesh every tests/data/*/two_tets* file holds: 5 vertices, 2 tets, in this order.
 inline TetMesh two_tets()
 {
@@ -234,6 +260,26 @@ inline TetMesh two_tets()
     m.tets.resize(2, 4);
     m.tets << 0, 1, 2, 3, 1, 2, 3, 4;
     return m;
+}
+
+/// Reads tests/data/`rel` (by extension) and expects the mesh of two_tets(); returns it for the format's own checks.
+inline TetMesh read_two_tets_file(const std::string& rel, io::ReadNotes* notes = nullptr)
+{
+    TetMesh m = io::read_mesh(data_file(rel).string(), notes);
+    expect_same_geometry(m, two_tets(), rel);
+    return m;
+}
+
+/// Writes `m` to dir/`written` (by extension), reads dir/`read_back` and expects the same geometry and tet
+/// labels; returns what was read.
+inline TetMesh round_trip(const TetMesh& m, const std::filesystem::path& dir, const std::string& written,
+                          const std::string& read_back, const std::string& what)
+{
+    io::write_mesh((dir / written).string(), m);
+    TetMesh r = io::read_mesh((dir / read_back).string());
+    expect_same_geometry(r, m, what);
+    EXPECT_EQ(r.tet_label, m.tet_label) << what;
+    return r;
 }
 
 } // namespace tethash::test

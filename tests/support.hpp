@@ -1,6 +1,8 @@
 #pragma once
-// Helpers shared by the tests: running the tethash program, temporary folders, finding a Python
-// interpreter that imports given modules, the shared real meshes.
+// Helpers shared by the tests: running the tethash program, temporary folders, expected errors and refusals,
+// finding a Python interpreter that imports given modules, the shared real meshes.
+#include "tethash/error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -8,10 +10,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <initializer_list>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 namespace tethash::test {
 
@@ -85,6 +90,32 @@ inline RunResult run_tethash(const std::string& args)
     cmd.push_back(' ');
     cmd.append(args);
     return run_shell(cmd);
+}
+
+/// Runs `fn` and expects a tethash::Error whose message contains each of `parts`; returns the message.
+inline std::string expect_error(const std::function<void()>& fn, const std::vector<std::string>& parts)
+{
+    try {
+        fn();
+    } catch (const Error& e) {
+        const std::string msg = e.what();
+        for (const std::string& part : parts)
+            EXPECT_NE(msg.find(part), std::string::npos) << "'" << part << "' not in: " << msg;
+        return msg;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "expected tethash::Error, got another exception: " << e.what();
+        return e.what();
+    }
+    ADD_FAILURE() << "expected tethash::Error, nothing was thrown";
+    return {};
+}
+
+/// Expects `r` to be a refusal of bad input: exit status 2 and a message on stderr containing each of `parts`.
+inline void expect_refused(const RunResult& r, std::initializer_list<std::string> parts)
+{
+    EXPECT_EQ(r.status, 2) << r.err;
+    for (const std::string& part : parts)
+        EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
 }
 
 /// A Python interpreter that imports every module in `modules` (space separated), or nullopt.

@@ -22,15 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Shell-quoted path (own helper: GCC 12 warns falsely on "'" + string inlined from support.hpp's quote()).
-std::string sq(const fs::path& p)
-{
-    std::string s(1, '\'');
-    s.append(p.string());
-    s.push_back('\'');
-    return s;
-}
-
 const fs::path kBox = fs::path(TETHASH_SOURCE_DIR) / "meshes" / "box.vtu";
 
 /// Lines of `text` (a trailing newline does not start another line).
@@ -70,12 +61,12 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
 {
     const auto dir = temp_dir();
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {"generate box -o " + sq(dir / "g.vtu") + " --resolution abc", "--resolution"},
-        {"generate box -o " + sq(dir / "g.vtu") + " --size 1 2", "--size"},
-        {"tetrahedralize x.obj -o " + sq(dir / "t.vtu") + " -r abc", "--resolution"},
-        {"study cell-size --mesh " + sq(kBox) + " --repeat abc", "--repeat"},
-        {"info --no-such-option " + sq(kBox), "--no-such-option"},
-        {"convert " + sq(kBox), "OUT"},
+        {"generate box -o " + quote(dir / "g.vtu") + " --resolution abc", "--resolution"},
+        {"generate box -o " + quote(dir / "g.vtu") + " --size 1 2", "--size"},
+        {"tetrahedralize x.obj -o " + quote(dir / "t.vtu") + " -r abc", "--resolution"},
+        {"study cell-size --mesh " + quote(kBox) + " --repeat abc", "--repeat"},
+        {"info --no-such-option " + quote(kBox), "--no-such-option"},
+        {"convert " + quote(kBox), "OUT"},
         {"no-such-command", "no-such-command"},
     };
     for (const auto& [args, fragment] : cases) {
@@ -83,21 +74,22 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
         expect_one_line_error(r, args, {fragment, "--help"});
         EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
     }
-    expect_one_line_error(run_tethash("detect " + sq(kBox) + " --threads abc"), "--threads abc", {"--threads", "abc"});
+    expect_one_line_error(run_tethash("detect " + quote(kBox) + " --threads abc"), "--threads abc",
+                          {"--threads", "abc"});
     // Options that contradict each other.
     const std::vector<std::pair<std::string, std::string>> conflicts = {
-        {"generate box -o " + sq(dir / "g.vtu") + " --size 1 1 1 --scale 2", "--scale"},
-        {"generate box --list -o " + sq(dir / "g.vtu"), "--list"},
-        {"study cell-size --mesh " + sq(kBox) + " --scene x.toml --out " + sq(dir / "s"), "--scene"},
-        {"study integrator --mesh " + sq(kBox) + " --out " + sq(dir / "s"), "--mesh"},
-        {"study hash --mesh " + sq(kBox) + " --from 1 --to 2 --points 2 --out " + sq(dir / "s"), "--from"},
+        {"generate box -o " + quote(dir / "g.vtu") + " --size 1 1 1 --scale 2", "--scale"},
+        {"generate box --list -o " + quote(dir / "g.vtu"), "--list"},
+        {"study cell-size --mesh " + quote(kBox) + " --scene x.toml --out " + quote(dir / "s"), "--scene"},
+        {"study integrator --mesh " + quote(kBox) + " --out " + quote(dir / "s"), "--mesh"},
+        {"study hash --mesh " + quote(kBox) + " --from 1 --to 2 --points 2 --out " + quote(dir / "s"), "--from"},
     };
     for (const auto& [args, fragment] : conflicts) {
         expect_one_line_error(run_tethash(args), args, {fragment});
         EXPECT_FALSE(fs::exists(dir / "g.vtu")) << args;
         EXPECT_FALSE(fs::exists(dir / "s")) << args;
     }
-    const std::string too_fine = "generate box -o " + sq(dir / "g.vtu") + " --resolution 5000";
+    const std::string too_fine = "generate box -o " + quote(dir / "g.vtu") + " --resolution 5000";
     expect_one_line_error(run_tethash(too_fine), too_fine, {"--resolution 5000", "at most 1000"});
     // Help still goes to standard output with status 0, names the program (not its path) and shows defaults.
     const RunResult help = run_tethash("detect --help");
@@ -118,24 +110,25 @@ TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)
         std::vector<std::string> fragments;
     };
     const std::vector<Case> cases = {
-        {"info " + sq(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
-        {"info " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
-        {"detect " + sq(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
-        {"detect " + sq(dir / "folder.vtu"), {"folder.vtu", "directory"}},
-        {"convert " + sq(dir / "folder.vtu") + " " + sq(dir / "o.vtu"), {"folder.vtu", "directory"}},
-        {"study cell-size --no-plot --out " + sq(dir / "s") + " --mesh " + sq(dir / "folder.vtu"),
+        {"info " + quote(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
+        {"info " + quote(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"detect " + quote(dir / "missing.vtu"), {"missing.vtu", "no such file"}},
+        {"detect " + quote(dir / "folder.vtu"), {"folder.vtu", "directory"}},
+        {"convert " + quote(dir / "folder.vtu") + " " + quote(dir / "o.vtu"), {"folder.vtu", "directory"}},
+        {"study cell-size --no-plot --out " + quote(dir / "s") + " --mesh " + quote(dir / "folder.vtu"),
          {"folder.vtu", "directory"}},
-        {"study integrator --no-plot --out " + sq(dir / "s") + " --scene " + sq(dir / "folder.vtu"),
+        {"study integrator --no-plot --out " + quote(dir / "s") + " --scene " + quote(dir / "folder.vtu"),
          {"--scene", "directory"}},
-        {"tetrahedralize " + sq(dir / "missing.obj") + " -o " + sq(dir / "t.vtu"), {"missing.obj", "no such file"}},
-        {"tetrahedralize " + sq(kBox) + " -o " + sq(dir / "t.vtu"), {"box.vtu", "tet mesh", "surface"}},
-        {"info " + sq(dir / "empty.vtu"), {"empty.vtu", "end of file"}},
-        {"info " + sq(dir / "empty.vtk"), {"empty.vtk"}},
-        {"info " + sq(dir / "empty.msh"), {"empty.msh", "end of file"}},
-        {"info " + sq(dir / "empty.mesh"), {"empty.mesh", "end of file"}},
-        {"info " + sq(dir / "empty.veg"), {"empty.veg"}},
-        {"info " + sq(dir / "empty.node"), {"empty"}},
-        {"info " + sq(dir / "mesh.xyz"), {"mesh.xyz"}},
+        {"tetrahedralize " + quote(dir / "missing.obj") + " -o " + quote(dir / "t.vtu"),
+         {"missing.obj", "no such file"}},
+        {"tetrahedralize " + quote(kBox) + " -o " + quote(dir / "t.vtu"), {"box.vtu", "tet mesh", "surface"}},
+        {"info " + quote(dir / "empty.vtu"), {"empty.vtu", "end of file"}},
+        {"info " + quote(dir / "empty.vtk"), {"empty.vtk"}},
+        {"info " + quote(dir / "empty.msh"), {"empty.msh", "end of file"}},
+        {"info " + quote(dir / "empty.mesh"), {"empty.mesh", "end of file"}},
+        {"info " + quote(dir / "empty.veg"), {"empty.veg"}},
+        {"info " + quote(dir / "empty.node"), {"empty"}},
+        {"info " + quote(dir / "mesh.xyz"), {"mesh.xyz"}},
     };
     for (const Case& c : cases)
         expect_one_line_error(run_tethash(c.args), c.args, c.fragments);
@@ -147,7 +140,7 @@ TEST(CliBadInput, UnreadableFileNamesIt)
     const auto dir = temp_dir();
     fs::copy_file(kBox, dir / "locked.vtu");
     fs::permissions(dir / "locked.vtu", fs::perms::none);
-    expect_one_line_error(run_tethash("info " + sq(dir / "locked.vtu")), "info locked.vtu",
+    expect_one_line_error(run_tethash("info " + quote(dir / "locked.vtu")), "info locked.vtu",
                           {"locked.vtu", "cannot open"});
 }
 
@@ -161,25 +154,25 @@ TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
     };
     std::vector<Case> cases;
     const std::vector<std::pair<std::string, std::string>> commands = {
-        {"convert " + sq(kBox) + " ", ""},
+        {"convert " + quote(kBox) + " ", ""},
         {"generate box -r 2 -o ", ""},
-        {"detect " + sq(kBox) + " --contacts ", "--contacts"},
-        {"detect " + sq(kBox) + " --stats ", "--stats"},
+        {"detect " + quote(kBox) + " --contacts ", "--contacts"},
+        {"detect " + quote(kBox) + " --stats ", "--stats"},
     };
     for (const auto& [prefix, option] : commands) {
-        cases.push_back({prefix + sq(dir / "missing" / "out.vtu"), {"out.vtu", "folder", "does not exist"}});
-        cases.push_back({prefix + sq(dir / "folder"), {"folder", "is a directory"}});
-        cases.push_back({prefix + sq("/proc/out.vtu"), {"/proc", "cannot create"}});
+        cases.push_back({prefix + quote(dir / "missing" / "out.vtu"), {"out.vtu", "folder", "does not exist"}});
+        cases.push_back({prefix + quote(dir / "folder"), {"folder", "is a directory"}});
+        cases.push_back({prefix + quote("/proc/out.vtu"), {"/proc", "cannot create"}});
         if (!option.empty())
             for (auto& c : std::vector<Case*>{&cases[cases.size() - 3], &cases[cases.size() - 2], &cases.back()})
                 c->fragments.push_back(option);
     }
-    cases.push_back({"convert " + sq(kBox) + " " + sq(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
-    cases.push_back({"generate box -o " + sq(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
-    cases.push_back({"generate box -o " + sq(dir / "folder"), {"folder", "is a directory"}});
+    cases.push_back({"convert " + quote(kBox) + " " + quote(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
+    cases.push_back({"generate box -o " + quote(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
+    cases.push_back({"generate box -o " + quote(dir / "folder"), {"folder", "is a directory"}});
     if (tethash::io::have_assimp())
-        cases.push_back({"tetrahedralize " + sq(fs::path(TETHASH_SOURCE_DIR) / "meshes" / "surfaces" / "blob.obj") +
-                             " -o " + sq(dir / "missing" / "t.vtu"),
+        cases.push_back({"tetrahedralize " + quote(fs::path(TETHASH_SOURCE_DIR) / "meshes" / "surfaces" / "blob.obj") +
+                             " -o " + quote(dir / "missing" / "t.vtu"),
                          {"t.vtu", "does not exist"}});
     for (const Case& c : cases) {
         const RunResult r = run_tethash(c.args);
@@ -204,8 +197,8 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
         if (name == "out.node") write_text(dir / "out.ele", good);
         if (name == "out.gltf") write_text(dir / "out.bin", good);
         // dash counts ulimit -f in 512-byte blocks: 4 KiB, far less than any of these files.
-        const RunResult r =
-            run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " convert " + sq(kBox) + " " + sq(out));
+        const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + quote(TETHASH_EXE) + " convert " + quote(kBox) +
+                                      " " + quote(out));
         expect_one_line_error(r, name, {name});
         EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << "the message names the temporary: " << r.err;
         EXPECT_EQ(read_text(out), good) << name;
@@ -216,15 +209,17 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
     }
     // The same for detect's outputs (the contacts of two overlapping boxes fill more than 4 KiB).
     write_text(dir / "c.csv", good);
-    ASSERT_EQ(run_tethash("generate box -r 6 -o " + sq(dir / "b.vtu")).status, 0);
-    const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + sq(TETHASH_EXE) + " detect " + sq(dir / "b.vtu") +
-                                  " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"));
+    ASSERT_EQ(run_tethash("generate box -r 6 -o " + quote(dir / "b.vtu")).status, 0);
+    const RunResult r =
+        run_shell("trap '' XFSZ; ulimit -f 8; " + quote(TETHASH_EXE) + " detect " + quote(dir / "b.vtu") + " " +
+                  quote(dir / "b.vtu") + " --contacts " + quote(dir / "c.csv"));
     expect_one_line_error(r, "detect --contacts", {"c.csv"});
     EXPECT_EQ(read_text(dir / "c.csv"), good);
     EXPECT_TRUE(temporaries(dir).empty());
     fs::remove(dir / "c.csv");
     // Without the limit the same command writes the file: the failure above was the write.
-    ASSERT_EQ(run_tethash("detect " + sq(dir / "b.vtu") + " " + sq(dir / "b.vtu") + " --contacts " + sq(dir / "c.csv"))
+    ASSERT_EQ(run_tethash("detect " + quote(dir / "b.vtu") + " " + quote(dir / "b.vtu") + " --contacts " +
+                          quote(dir / "c.csv"))
                   .status,
               0);
     EXPECT_GT(fs::file_size(dir / "c.csv"), 4096u);
@@ -234,12 +229,12 @@ TEST(CliBadInput, StudyRejectsBadCountsAndOutputFolders)
 {
     const auto dir = temp_dir();
     write_text(dir / "file", "not a folder\n");
-    const std::string base = "study cell-size --no-plot --quiet --cell-size 1 --mesh " + sq(kBox);
+    const std::string base = "study cell-size --no-plot --quiet --cell-size 1 --mesh " + quote(kBox);
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {base + " --repeat -2 --out " + sq(dir / "s"), "--repeat"},
-        {base + " --warmup -1 --out " + sq(dir / "s"), "--warmup"},
-        {base + " --out " + sq(dir / "file"), "not a folder"},
-        {base + " --out " + sq(dir / "file" / "sub"), "--out"},
+        {base + " --repeat -2 --out " + quote(dir / "s"), "--repeat"},
+        {base + " --warmup -1 --out " + quote(dir / "s"), "--warmup"},
+        {base + " --out " + quote(dir / "file"), "not a folder"},
+        {base + " --out " + quote(dir / "file" / "sub"), "--out"},
         {base + " --out /proc/tethash_study", "--out"},
     };
     for (const auto& [args, fragment] : cases) {
@@ -255,11 +250,11 @@ TEST(CliBadInput, PlotScriptRejectsWhatIsNotAStudyInOneLine)
 {
     TETHASH_SKIP_WITHOUT_PYTHON(py, "matplotlib");
     const auto dir = temp_dir();
-    const std::string script = sq(fs::path(TETHASH_SOURCE_DIR) / "tools" / "plot_study.py");
+    const std::string script = quote(fs::path(TETHASH_SOURCE_DIR) / "tools" / "plot_study.py");
     fs::create_directories(dir / "other");
     write_text(dir / "other" / "study.csv", "a,b\n1,2\n");
-    const std::vector<std::pair<std::string, std::string>> cases = {{sq(dir / "none"), "no such file"},
-                                                                    {sq(dir / "other"), "not a tethash study"}};
+    const std::vector<std::pair<std::string, std::string>> cases = {{quote(dir / "none"), "no such file"},
+                                                                    {quote(dir / "other"), "not a tethash study"}};
     for (const auto& [arg, fragment] : cases) {
         const RunResult r = run_shell(py + " " + script + " " + arg);
         EXPECT_EQ(r.status, 2) << arg << "\n" << r.err;
@@ -276,8 +271,8 @@ TEST(CliBadInput, InterruptedWriteLeavesNoTemporary)
     const auto dir = temp_dir();
     write_text(dir / "a.vtu", "good\n");
     // The shell writes its pid and becomes tethash (exec): that pid is the one to interrupt.
-    const std::string cmd = "echo $$ > " + sq(dir / "pid") + "; exec " + sq(TETHASH_EXE) + " generate box -r 40 -o " +
-                            sq(dir / "a.vtu") + " >/dev/null 2>&1";
+    const std::string cmd = "echo $$ > " + quote(dir / "pid") + "; exec " + quote(TETHASH_EXE) +
+                            " generate box -r 40 -o " + quote(dir / "a.vtu") + " >/dev/null 2>&1";
     std::atomic<bool> done{false};
     std::thread run([&] {
         (void)std::system(cmd.c_str());

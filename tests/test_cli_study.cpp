@@ -106,8 +106,7 @@ TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
     // The same shard twice is an error.
     const auto twice = run_tethash("study merge " + quote(dir / "s0") + " " + quote(dir / "s0") + " --no-plot --out " +
                                    quote(dir / "twice"));
-    EXPECT_EQ(twice.status, 2);
-    EXPECT_NE(twice.err.find("appears twice"), std::string::npos) << twice.err;
+    expect_refused(twice, {"appears twice"});
 }
 
 TEST(CliStudy, PlotScriptWritesFiguresWhenMatplotlibIsPresent)

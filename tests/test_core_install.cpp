@@ -8,20 +8,13 @@
 
 using namespace tethash::test;
 
-namespace {
-std::string sq(const std::filesystem::path& p)
-{
-    return tethash::test::quote(p);
-}
-} // namespace
-
 TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
 {
     const auto dir = temp_dir();
     const std::filesystem::path build = std::filesystem::path(TETHASH_TEST_TMP).parent_path().parent_path();
     ASSERT_TRUE(std::filesystem::exists(build / "CMakeCache.txt")) << build;
     const auto prefix = dir / "prefix";
-    const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
+    const auto inst = run_shell("cmake --install " + quote(build) + " --prefix " + quote(prefix));
     ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.h"));   // the C interface
@@ -30,14 +23,14 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
 
     const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer";
     const auto cbuild = dir / "consumer";
-    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) +
+    const auto conf = run_shell("cmake -S " + quote(src) + " -B " + quote(cbuild) +
                                 " -DCMAKE_BUILD_TYPE=Release"
                                 " -DCMAKE_PREFIX_PATH=" +
-                                sq(prefix));
+                                quote(prefix));
     ASSERT_EQ(conf.status, 0) << conf.out << conf.err;
-    const auto bld = run_shell("cmake --build " + sq(cbuild) + " -j2");
+    const auto bld = run_shell("cmake --build " + quote(cbuild) + " -j2");
     ASSERT_EQ(bld.status, 0) << bld.out << bld.err;
-    const auto run = run_shell(sq(cbuild / "consumer"));
+    const auto run = run_shell(quote(cbuild / "consumer"));
     EXPECT_EQ(run.status, 0) << run.out << run.err;
     EXPECT_NE(run.out.find("contact vertex 7 tet 0"), std::string::npos) << run.out;
 }

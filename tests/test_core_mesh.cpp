@@ -1,4 +1,5 @@
 // The mesh model: validation, reorientation, derived data (edges, boundary, adjacency, statistics, quality).
+#include "support.hpp"
 #include "tethash/error.hpp"
 #include "tethash/geometry.hpp"
 #include "tethash/mesh.hpp"
@@ -10,6 +11,7 @@
 #include <set>
 
 using namespace tethash;
+using tethash::test::expect_error;
 
 namespace {
 
@@ -196,15 +198,7 @@ TEST(Mesh, ConsistencyCheckNamesTheTet)
 {
     TetMesh m = kuhn_cube();
     m.tets(3, 2) = 42;
-    try {
-        m.check_consistency("cube.msh");
-        FAIL() << "expected an error";
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        EXPECT_NE(msg.find("cube.msh"), std::string::npos) << msg;
-        EXPECT_NE(msg.find("tet 3"), std::string::npos) << msg;
-        EXPECT_NE(msg.find("42"), std::string::npos) << msg;
-    }
+    expect_error([&] { m.check_consistency("cube.msh"); }, {"cube.msh", "tet 3", "42"});
 }
 
 // ---- split_objects_by_label -------------------------------------------------------------
@@ -253,17 +247,12 @@ TEST(MeshLabels, SharedVertexIsAnErrorNamingItOrJoinsTheLabels)
 {
     TetMesh m = kuhn_cube();
     m.tet_label = {1, 1, 1, 2, 2, 2}; // tets 0-2 and 3-5 share vertices 0, 6 and one more each side
-    try {
-        TetMesh copy = m;
-        split_objects_by_label(copy, SharedLabelVertices::error, "cube.msh");
-        FAIL() << "no error for a vertex shared by two labels";
-    } catch (const Error& e) {
-        const std::string msg = e.what();
-        EXPECT_NE(msg.find("cube.msh"), std::string::npos) << msg;
-        EXPECT_NE(msg.find("vertex "), std::string::npos) << msg;
-        EXPECT_NE(msg.find("label 1"), std::string::npos) << msg;
-        EXPECT_NE(msg.find("label 2"), std::string::npos) << msg;
-    }
+    expect_error(
+        [&] {
+            TetMesh copy = m;
+            split_objects_by_label(copy, SharedLabelVertices::error, "cube.msh");
+        },
+        {"cube.msh", "vertex ", "label 1", "label 2"});
     const LabelSplit s = split_objects_by_label(m, SharedLabelVertices::join);
     ASSERT_EQ(s.object_labels.size(), 1u);
     EXPECT_EQ(s.object_labels[0], (std::vector<Index>{1, 2}));

@@ -13,11 +13,6 @@ using namespace tethash::predicates;
 
 namespace {
 
-std::string sq(const std::filesystem::path& p)
-{
-    return tethash::test::quote(p);
-}
-
 /// Exact sign of det[b−a, c−a, d−a] for integer coordinates (|difference| < 2^40).
 __extension__ typedef __int128 i128;
 
@@ -117,7 +112,8 @@ TEST(CorePredicates, ArbitraryDoublesMatchPythonFractions)
         "    u=[b[i]-a[i] for i in range(3)]; w=[c[i]-a[i] for i in range(3)]; z=[d[i]-a[i] for i in range(3)]\n"
         "    det=u[0]*(w[1]*z[2]-w[2]*z[1])-u[1]*(w[0]*z[2]-w[2]*z[0])+u[2]*(w[0]*z[1]-w[1]*z[0])\n"
         "    print((det>0)-(det<0))\n");
-    const auto r = tethash::test::run_shell(py + " " + sq(dir / "ref.py") + " " + sq(dir / "cases.txt"));
+    const auto r = tethash::test::run_shell(py + " " + tethash::test::quote(dir / "ref.py") + " " +
+                                            tethash::test::quote(dir / "cases.txt"));
     ASSERT_EQ(r.status, 0) << r.err;
     std::istringstream in(r.out);
     int nonzero = 0;

@@ -39,19 +39,10 @@ void operator delete(void* p, std::size_t) noexcept
 }
 
 using namespace tethash;
+using tethash::test::identical;
 using tethash::test::Scene;
 
 namespace {
-
-bool identical(const std::vector<Contact>& a, const std::vector<Contact>& b)
-{
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (a[i].vertex != b[i].vertex || a[i].tet != b[i].tet || a[i].vertex_object != b[i].vertex_object ||
-            a[i].tet_object != b[i].tet_object || std::memcmp(a[i].bary, b[i].bary, sizeof a[i].bary) != 0)
-            return false;
-    return true;
-}
 
 /// Same (vertex, tet) sequence as the oracle, barycentric coordinates equal up to rounding with the same exact zeros.
 ::testing::AssertionResult same_as_oracle(const std::vector<Contact>& got, const std::vector<Contact>& want)

@@ -10,6 +10,7 @@
 #include <string>
 
 using namespace tethash;
+using tethash::test::expect_error;
 namespace fs = std::filesystem;
 using tethash::test::temp_dir;
 
@@ -37,12 +38,7 @@ TEST(IoFile, WritesAndReadsBackBytes)
 TEST(IoFile, ReadErrorsNameThePath)
 {
     const auto dir = temp_dir();
-    try {
-        io::read_file(dir.string());
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
-    }
+    expect_error([&] { io::read_file(dir.string()); }, {"is a directory"});
     const std::string missing = (dir / "missing.txt").string();
     try {
         io::read_file(missing);

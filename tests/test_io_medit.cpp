@@ -12,19 +12,14 @@ namespace {
 const char* k_good = "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n1 1 1 0\n"
                      "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\nEnd\n";
 
-std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
-                             const std::string& name)
-{
-    return write_edited(dir / name, k_good, from, to);
-}
+const auto edited = editor(k_good);
 
 } // namespace
 
 TEST(MeditRead, HandMadeWithRefsAndSkippedBlocks)
 {
     io::ReadNotes notes;
-    const TetMesh m = io::read_mesh(data_file("medit/two_tets.mesh").string(), &notes);
-    expect_same_geometry(m, two_tets(), "two_tets.mesh");
+    const TetMesh m = read_two_tets_file("medit/two_tets.mesh", &notes);
     EXPECT_EQ(m.tet_label, (std::vector<Index>{7, -2}));
     EXPECT_EQ(m.vertex_label, (std::vector<Index>{1, 2, 0, 3, 4}));
     EXPECT_EQ(notes.skipped_cells, 3); // 1 edge + 2 triangles
@@ -34,10 +29,7 @@ TEST(MeditWrite, RoundTripExact)
 {
     const auto dir = temp_dir();
     TetMesh m = grid_mesh(3, 2, 2);
-    io::write_mesh((dir / "g.mesh").string(), m);
-    const TetMesh r = io::read_mesh((dir / "g.mesh").string());
-    expect_same_geometry(r, m, "medit round trip");
-    EXPECT_EQ(r.tet_label, m.tet_label);
+    round_trip(m, dir, "g.mesh", "g.mesh", "medit round trip");
 }
 
 TEST(MeditMeshio, WeReadWhatMeshioWritesAndViceVersa)
@@ -45,16 +37,12 @@ TEST(MeditMeshio, WeReadWhatMeshioWritesAndViceVersa)
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
     const auto dir = temp_dir();
     const TetMesh ref = grid_mesh(3, 2, 2);
-    write_reference(dir / "ref.txt", ref);
-    const std::string script = std::string(python_read_reference()) + R"PY(
-import meshio
-pts, tets, labels = read_reference(sys.argv[1])
+    const RunResult w = meshio_writes(py, dir, ref, R"PY(
 tri = np.array([[0, 1, 2], [1, 2, 3]])
 m = meshio.Mesh(pts, [("triangle", tri), ("tetra", tets)], cell_data={"medit:ref": [np.array([5, 6]), labels]})
 meshio.write(sys.argv[2], m, file_format="medit")
-print("written")
-)PY";
-    const RunResult w = run_python(py, dir, script, q(dir / "ref.txt") + " " + q(dir / "mio.mesh"));
+)PY",
+                                      "mio.mesh");
     ASSERT_EQ(w.status, 0) << w.out << w.err;
     io::ReadNotes notes;
     const TetMesh m = io::read_mesh((dir / "mio.mesh").string(), &notes);
@@ -63,10 +51,7 @@ print("written")
     EXPECT_EQ(notes.skipped_cells, 2);
 
     io::write_mesh((dir / "ours.mesh").string(), ref);
-    const RunResult r =
-        run_python(py, dir, python_check_with_meshio("medit:ref"), q(dir / "ref.txt") + " " + q(dir / "ours.mesh"));
-    EXPECT_EQ(r.status, 0) << r.out << r.err;
-    EXPECT_NE(r.out.find("OK "), std::string::npos) << r.out << r.err;
+    expect_meshio_reads(py, dir, "medit:ref", {"ours.mesh"});
 }
 
 TEST(MeditErrors, VersionAndDimension)

@@ -15,6 +15,7 @@
 
 using namespace tethash;
 using tethash::test::enclosed_volume;
+using tethash::test::expect_error;
 using tethash::test::sphere_surface;
 using tethash::test::temp_dir;
 using tethash::test::volume;
@@ -76,12 +77,7 @@ TEST(Surface, ReadErrorsNameTheFile)
     SKIP_WITHOUT_ASSIMP();
     const auto dir = temp_dir();
     const std::string missing = (dir / "missing.obj").string();
-    try {
-        io::read_surface(missing);
-        FAIL() << "no error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
-    }
+    expect_error([&] { io::read_surface(missing); }, {missing});
     const auto garbage = dir / "garbage.stl";
     tethash::test::write_text(garbage, "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0\n");
     try {

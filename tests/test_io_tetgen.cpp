@@ -83,12 +83,8 @@ TEST(TetgenWrite, RoundTripExactWithLabelsAndMarkers)
     m.vertex_label.resize(static_cast<std::size_t>(m.num_vertices()));
     for (std::size_t v = 0; v < m.vertex_label.size(); ++v)
         m.vertex_label[v] = static_cast<Index>(v % 4);
-    io::write_mesh((dir / "g.ele").string(), m); // either name writes both files
-    ASSERT_TRUE(std::filesystem::exists(dir / "g.node"));
-    const TetMesh r = io::read_mesh((dir / "g.node").string());
-    expect_same_geometry(r, m, "tetgen round trip");
-    EXPECT_EQ(r.tet_label, m.tet_label);
-    EXPECT_EQ(r.vertex_label, m.vertex_label);
+    // Either name writes both files.
+    EXPECT_EQ(round_trip(m, dir, "g.ele", "g.node", "tetgen round trip").vertex_label, m.vertex_label);
 }
 
 TEST(TetgenMeshio, WeReadWhatMeshioWritesAndViceVersa)
@@ -96,25 +92,18 @@ TEST(TetgenMeshio, WeReadWhatMeshioWritesAndViceVersa)
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
     const auto dir = temp_dir();
     const TetMesh ref = grid_mesh(3, 2, 2);
-    write_reference(dir / "ref.txt", ref);
-    const std::string script = std::string(python_read_reference()) + R"PY(
-import meshio
-pts, tets, labels = read_reference(sys.argv[1])
+    const RunResult w = meshio_writes(py, dir, ref, R"PY(
 m = meshio.Mesh(pts, [("tetra", tets)], cell_data={"tetgen:ref": [labels]})
 meshio.write(sys.argv[2], m, file_format="tetgen")
-print("written")
-)PY";
-    const RunResult w = run_python(py, dir, script, q(dir / "ref.txt") + " " + q(dir / "mio.node"));
+)PY",
+                                      "mio.node");
     ASSERT_EQ(w.status, 0) << w.out << w.err;
     const TetMesh m = io::read_mesh((dir / "mio.ele").string());
     expect_same_geometry(m, ref, "meshio tetgen");
     EXPECT_EQ(m.tet_label, ref.tet_label);
 
     io::write_mesh((dir / "ours.node").string(), ref);
-    const RunResult r =
-        run_python(py, dir, python_check_with_meshio("tetgen:ref"), q(dir / "ref.txt") + " " + q(dir / "ours.node"));
-    EXPECT_EQ(r.status, 0) << r.out << r.err;
-    EXPECT_NE(r.out.find("OK "), std::string::npos) << r.out << r.err;
+    expect_meshio_reads(py, dir, "tetgen:ref", {"ours.node"});
 }
 
 TEST(TetgenErrors, MissingPartner)
@@ -180,10 +169,5 @@ TEST(TetgenShared, ReadsArmadillo)
 {
     const auto p = shared_mesh("armadillo_4k.node");
     if (!p) GTEST_SKIP() << "shared mesh absent";
-    const TetMesh m = io::read_mesh(p->string());
-    EXPECT_EQ(m.num_vertices(), 1180);
-    EXPECT_EQ(m.num_tets(), 3717);
-    const ValidationReport rep = validate(m);
-    EXPECT_TRUE(rep.ok());
-    EXPECT_EQ(rep.inverted_tets, 0);
+    expect_valid_with_counts(io::read_mesh(p->string()), 1180, 3717);
 }

@@ -12,19 +12,14 @@ namespace {
 const char* k_good = "# comment\n*VERTICES\n5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n"
                      "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n2 2 3 4 5\n";
 
-std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
-                             const std::string& name)
-{
-    return write_edited(dir / name, k_good, from, to);
-}
+const auto edited = editor(k_good);
 
 } // namespace
 
 TEST(VegaRead, HandMadeWithSkippedSections)
 {
     io::ReadNotes notes;
-    const TetMesh m = io::read_mesh(data_file("vega/two_tets.veg").string(), &notes);
-    expect_same_geometry(m, two_tets(), "two_tets.veg");
+    read_two_tets_file("vega/two_tets.veg", &notes);
     EXPECT_EQ(notes.messages.size(), 3u); // *MATERIAL, *REGION, *SET
 }
 
@@ -79,10 +74,5 @@ TEST(VegaShared, ReadsQuintupleTorus)
 {
     const auto p = shared_mesh("quintupleTorus.veg");
     if (!p) GTEST_SKIP() << "shared mesh absent";
-    const TetMesh m = io::read_mesh(p->string());
-    EXPECT_EQ(m.num_vertices(), 15789);
-    EXPECT_EQ(m.num_tets(), 71427);
-    const ValidationReport rep = validate(m);
-    EXPECT_TRUE(rep.ok());
-    EXPECT_EQ(rep.inverted_tets, 0);
+    expect_valid_with_counts(io::read_mesh(p->string()), 15789, 71427);
 }

@@ -1,5 +1,6 @@
 // Static obstacles given as closed surfaces, friction, per-pair contact stiffness, and the per-substep
 // blow-up test of the simulator.
+#include "sim_support.hpp"
 #include "support.hpp"
 
 #include "tethash/error.hpp"
@@ -15,22 +16,6 @@ using namespace tethash::sim;
 using namespace tethash::test;
 
 namespace {
-
-ObjectSpec box_object(const Eigen::Vector3d& size, const Eigen::Vector3d& at, int res = 2)
-{
-    ObjectSpec o;
-    meshing::GenerateParams g;
-    g.shape = "box";
-    g.resolution = res;
-    g.size = size;
-    o.generate = g;
-    o.translate = at;
-    o.material.density = 100;
-    o.material.young = 1e4;
-    o.material.damping = 0.01;
-    o.self_collision = false;
-    return o;
-}
 
 /// Horizontal speed of object k (mean over its vertices).
 double horizontal_speed(const Simulation& sim, int k)

@@ -31,8 +31,6 @@ struct Orientation {
 Orientation orient3d(const double* a, const double* b, const double* c, const double* d);
 /// Exact orientation without filter (always expansion arithmetic); for tests and fallbacks.
 Orientation orient3d_exact(const double* a, const double* b, const double* c, const double* d);
-/// Plain floating-point orient3d (no guarantee on the sign).
-double orient3d_fast(const double* a, const double* b, const double* c, const double* d);
 
 /// Closed inside test of point p in tet (a, b, c, d): exact.
 struct InsideResult {

@@ -1,5 +1,6 @@
 #pragma once
-// Input checks shared by the Detector (src/core/detect.cpp) and the oracle (src/oracle): private header.
+// Input checks shared by the Detector (src/core/detect.cpp) and the oracle (src/oracle): private header
+// (defined in detect_checks.cpp; validate_params with the parameter grammar in detect_params.cpp).
 #include "tethash/detect.hpp"
 
 #include <span>
@@ -14,6 +15,9 @@ void check_topology(const TetsRef& tets, Index num_vertices, std::span<const Ind
                     std::span<const Index> tet_object);
 /// Throws Error on a wrong row count or a non-finite coordinate (naming the vertex).
 void check_positions(const PositionsRef& positions, Index num_vertices);
+
+/// Throws Error naming the first parameter out of range (cell size, table size, threads, skin, hash).
+void validate_params(const DetectParams& params);
 
 /// Per-object flags expanded to the number of objects in use (1 + largest id; ids ≥ objects.size() get defaults).
 struct ObjectFlags {

@@ -1,5 +1,6 @@
 // The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
+#include "detect_checks.hpp"
 #include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -9,6 +10,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <thread>
 
 namespace tethash {
@@ -139,5 +141,51 @@ void parse_skin(const std::string& text, DetectParams& params, const std::string
     params.skin_mode = factor ? DetectParams::SkinMode::factor_of_cell_size : DetectParams::SkinMode::absolute;
     params.skin = v;
 }
+
+HashFunction parse_hash_function(const std::string& name)
+{
+    if (name == "teschner") return HashFunction::teschner;
+    if (name == "column") return HashFunction::column;
+    throw Error("unknown hash function '" + name + "' (expected teschner or column)");
+}
+
+const char* to_string(HashFunction h)
+{
+    switch (h) {
+    case HashFunction::teschner:
+        return "teschner";
+    case HashFunction::column:
+        return "column";
+    }
+    return "?";
+}
+
+namespace detail {
+
+void validate_params(const DetectParams& p)
+{
+    using Mode = DetectParams::CellSizeMode;
+    if (p.cell_size_mode == Mode::absolute && !(p.cell_size > 0 && std::isfinite(p.cell_size)))
+        throw Error("cell_size must be positive and finite, got " + std::to_string(p.cell_size));
+    if (p.cell_size_mode == Mode::factor_of_mean_edge && !(p.cell_size > 0 && std::isfinite(p.cell_size)))
+        throw Error("cell_size factor must be positive and finite, got " + std::to_string(p.cell_size));
+    if (p.table_size < 0)
+        throw Error("table_size must be ≥ 1 (or 0 for automatic), got " + std::to_string(p.table_size));
+    if (p.table_size > max_table_size)
+        throw Error("table_size " + std::to_string(p.table_size) + " is too large (at most " +
+                    std::to_string(max_table_size) + ")");
+    check_threads(p.threads, "threads");
+    if (!(p.skin >= 0) || !std::isfinite(p.skin)) {
+        std::ostringstream s;
+        s << "skin must be ≥ 0 and finite (0 = no candidate reuse), got " << p.skin;
+        throw Error(s.str());
+    }
+    if (p.skin_mode != DetectParams::SkinMode::absolute && p.skin_mode != DetectParams::SkinMode::factor_of_cell_size)
+        throw Error("skin mode out of range: " + std::to_string(static_cast<int>(p.skin_mode)));
+    if (p.hash != HashFunction::teschner && p.hash != HashFunction::column)
+        throw Error("hash function out of range: " + std::to_string(static_cast<int>(p.hash)));
+}
+
+} // namespace detail
 
 } // namespace tethash

@@ -147,18 +147,6 @@ inline Expansion<2> diff(double a, double b)
 
 } // namespace
 
-double orient3d_fast(const double* a, const double* b, const double* c, const double* d)
-{
-    // (a − d) · ((c − d) × (b − d))
-    const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
-    const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
-    const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
-    const double nx = cdy * bdz - cdz * bdy;
-    const double ny = cdz * bdx - cdx * bdz;
-    const double nz = cdx * bdy - cdy * bdx;
-    return adx * nx + ady * ny + adz * nz;
-}
-
 Orientation orient3d_exact(const double* a, const double* b, const double* c, const double* d)
 {
     const Expansion<2> adx = diff(a[0], d[0]), ady = diff(a[1], d[1]), adz = diff(a[2], d[2]);

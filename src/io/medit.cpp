@@ -86,9 +86,7 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
             if (!have_dimension) r.fail("Dimension 3 before Vertices", "Vertices");
             if (have_vertices) r.fail_message("a second Vertices block");
             const std::int64_t n = r.next_int_in("the number of vertices", 0, k_max_int32);
-            if (n > static_cast<std::int64_t>(r.size()))
-                r.fail("a number of vertices that fits in a file of " + std::to_string(r.size()) + " bytes",
-                       std::to_string(n));
+            r.check_count_fits(n, "vertices");
             mesh.positions.resize(static_cast<Index>(n), 3);
             mesh.vertex_label.resize(static_cast<std::size_t>(n));
             static const char* axis[] = {"x", "y", "z"};
@@ -109,9 +107,7 @@ TetMesh read_medit(const std::string& path, ReadNotes* notes)
         } else if (key == "tetrahedra") {
             if (have_tets) r.fail_message("a second Tetrahedra block");
             const std::int64_t m = r.next_int_in("the number of tetrahedra", 0, k_max_int32);
-            if (m > static_cast<std::int64_t>(r.size()))
-                r.fail("a number of tetrahedra that fits in a file of " + std::to_string(r.size()) + " bytes",
-                       std::to_string(m));
+            r.check_count_fits(m, "tetrahedra");
             mesh.tets.resize(static_cast<Index>(m), 4);
             mesh.tet_label.resize(static_cast<std::size_t>(m));
             const std::int64_t nv = mesh.num_vertices();

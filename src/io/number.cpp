@@ -58,4 +58,23 @@ std::string to_lower(std::string_view s)
     return r;
 }
 
+std::string quote_token(std::string_view token, std::size_t limit)
+{
+    std::string s = "'";
+    for (std::size_t i = 0; i < token.size() && i < limit; ++i) {
+        const auto c = static_cast<unsigned char>(token[i]);
+        if (c >= 32 && c < 127) {
+            s += static_cast<char>(c);
+        } else {
+            static const char* hex = "0123456789abcdef";
+            s += "\\x";
+            s += hex[c >> 4];
+            s += hex[c & 15];
+        }
+    }
+    if (token.size() > limit) s += "...";
+    s += "'";
+    return s;
+}
+
 } // namespace tethash::io::detail

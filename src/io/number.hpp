@@ -1,5 +1,6 @@
 #pragma once
 // Private to tethash::io: numbers read from and written as text, the same way in every format.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -19,6 +20,10 @@ std::string format_double(double value);
 /// Appends format_double(value), or the integer, to `out`.
 void append_double(std::string& out, double value);
 void append_int(std::string& out, std::int64_t value);
+
+/// A token as error messages show it: in single quotes, at most `limit` characters (then "..."),
+/// bytes outside printable ASCII as \xNN.
+std::string quote_token(std::string_view token, std::size_t limit);
 
 /// `s` in lower case (ASCII).
 std::string to_lower(std::string_view s);

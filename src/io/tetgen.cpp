@@ -74,9 +74,7 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
         const std::int64_t nmark = header_value(r, header, "the number of boundary markers (0 or 1)", 0);
         if (nmark != 0 && nmark != 1) r.fail("0 or 1 boundary markers", std::to_string(nmark));
         // Each node takes more than one byte: a larger count is wrong (and is not allocated for).
-        if (n > static_cast<std::int64_t>(r.size()))
-            r.fail("a number of nodes that fits in a file of " + std::to_string(r.size()) + " bytes",
-                   std::to_string(n) + " in the header");
+        r.check_count_fits(n, "nodes", " in the header");
         mesh.positions.resize(static_cast<Index>(n), 3);
         if (nmark) mesh.vertex_label.resize(static_cast<std::size_t>(n));
         for (std::int64_t i = 0; i < n; ++i) {
@@ -114,9 +112,7 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
         const std::int64_t nattr = header_value(r, header, "the number of tet attributes", 0);
         if (nattr < 0 || nattr > 1000) r.fail("a number of tet attributes in 0..1000", std::to_string(nattr));
         const auto nv = static_cast<std::int64_t>(mesh.num_vertices());
-        if (m > static_cast<std::int64_t>(r.size()))
-            r.fail("a number of tets that fits in a file of " + std::to_string(r.size()) + " bytes",
-                   std::to_string(m) + " in the header");
+        r.check_count_fits(m, "tets", " in the header");
         mesh.tets.resize(static_cast<Index>(m), 4);
         std::vector<double> first_attr;
         if (nattr) first_attr.resize(static_cast<std::size_t>(m));
@@ -161,6 +157,45 @@ TetMesh read_tetgen(const std::string& path, ReadNotes* notes)
     return mesh;
 }
 
+namespace {
+
+/// One TetGen file: the comment `columns_comment` (naming `label_name` when there are labels), the header
+/// line "COUNT HEADER_FIELDS 0|1" (the last: whether a label column follows), then one line per row: its
+/// 1-based index, `columns` values written by `append_value(out, row, column)` and its label.
+template <class AppendValue>
+std::string tetgen_table(const std::string& columns_comment, const char* label_name, Index count,
+                         const char* header_fields, int columns, std::size_t bytes_per_row, AppendValue append_value,
+                         const std::vector<Index>* labels)
+{
+    std::string out;
+    out.reserve(static_cast<std::size_t>(count) * bytes_per_row + 128);
+    out += columns_comment;
+    if (labels) {
+        out += ' ';
+        out += label_name;
+    }
+    out += '\n';
+    detail::append_int(out, count);
+    out += ' ';
+    out += header_fields;
+    out += labels ? " 1\n" : " 0\n";
+    for (Index i = 0; i < count; ++i) {
+        detail::append_int(out, i + 1);
+        for (int c = 0; c < columns; ++c) {
+            out += ' ';
+            append_value(out, i, c);
+        }
+        if (labels) {
+            out += ' ';
+            detail::append_int(out, (*labels)[static_cast<std::size_t>(i)]);
+        }
+        out += '\n';
+    }
+    return out;
+}
+
+} // namespace
+
 void write_tetgen(const std::string& path, const TetMesh& mesh)
 {
     mesh.check_consistency("mesh to write to " + path);
@@ -168,45 +203,14 @@ void write_tetgen(const std::string& path, const TetMesh& mesh)
     const Index n = mesh.num_vertices(), m = mesh.num_tets();
     const bool markers = static_cast<Index>(mesh.vertex_label.size()) == n && n > 0;
     const bool labels = static_cast<Index>(mesh.tet_label.size()) == m && m > 0;
-    using detail::append_double;
-    using detail::append_int;
-
-    std::string s;
-    s.reserve(static_cast<std::size_t>(n) * 64 + 128);
-    s += "# TetGen .node written by tethash: index x y z";
-    s += markers ? " marker\n" : "\n";
-    append_int(s, n);
-    s += markers ? " 3 0 1\n" : " 3 0 0\n";
-    for (Index v = 0; v < n; ++v) {
-        append_int(s, v + 1);
-        for (int a = 0; a < 3; ++a) {
-            s += ' ';
-            append_double(s, mesh.positions(v, a));
-        }
-        if (markers) {
-            s += ' ';
-            append_int(s, mesh.vertex_label[static_cast<std::size_t>(v)]);
-        }
-        s += '\n';
-    }
-    std::string e;
-    e.reserve(static_cast<std::size_t>(m) * 48 + 128);
-    e += "# TetGen .ele written by tethash: index v0 v1 v2 v3 (1-based)";
-    e += labels ? " label\n" : "\n";
-    append_int(e, m);
-    e += labels ? " 4 1\n" : " 4 0\n";
-    for (Index t = 0; t < m; ++t) {
-        append_int(e, t + 1);
-        for (int k = 0; k < 4; ++k) {
-            e += ' ';
-            append_int(e, mesh.tets(t, k) + 1);
-        }
-        if (labels) {
-            e += ' ';
-            append_int(e, mesh.tet_label[static_cast<std::size_t>(t)]);
-        }
-        e += '\n';
-    }
+    const std::string s = tetgen_table(
+        "# TetGen .node written by tethash: index x y z", "marker", n, "3 0", 3, 64,
+        [&](std::string& out, Index v, int a) { detail::append_double(out, mesh.positions(v, a)); },
+        markers ? &mesh.vertex_label : nullptr);
+    const std::string e = tetgen_table(
+        "# TetGen .ele written by tethash: index v0 v1 v2 v3 (1-based)", "label", m, "4", 4, 48,
+        [&](std::string& out, Index t, int k) { detail::append_int(out, mesh.tets(t, k) + 1); },
+        labels ? &mesh.tet_label : nullptr);
     // Both files are complete before either replaces an existing one: a failed write never leaves a
     // new .node beside an old .ele.
     write_text_files({node_path, ele_path}, {s, e});

@@ -94,6 +94,13 @@ std::int64_t TextReader::next_int(std::string_view what)
     return *v;
 }
 
+void TextReader::check_count_fits(std::int64_t count, std::string_view items, std::string_view found_suffix) const
+{
+    if (count > static_cast<std::int64_t>(size()))
+        fail("a number of " + std::string(items) + " that fits in a file of " + std::to_string(size()) + " bytes",
+             std::to_string(count) + std::string(found_suffix));
+}
+
 std::int64_t TextReader::next_int_in(std::string_view what, std::int64_t lo, std::int64_t hi)
 {
     const std::int64_t v = next_int(what);
@@ -170,23 +177,7 @@ bool TextReader::skip_past_line(std::string_view marker)
 
 std::string TextReader::describe(std::string_view token)
 {
-    if (token.empty()) return "end of file";
-    std::string s = "'";
-    const std::size_t limit = 40;
-    for (std::size_t i = 0; i < token.size() && i < limit; ++i) {
-        const unsigned char c = static_cast<unsigned char>(token[i]);
-        if (std::isprint(c)) {
-            s += static_cast<char>(c);
-        } else {
-            static const char* hex = "0123456789abcdef";
-            s += "\\x";
-            s += hex[c >> 4];
-            s += hex[c & 15];
-        }
-    }
-    if (token.size() > limit) s += "...";
-    s += "'";
-    return s;
+    return token.empty() ? "end of file" : quote_token(token, 40);
 }
 
 void TextReader::fail(std::string_view expected, std::string_view found) const

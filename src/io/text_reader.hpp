@@ -47,6 +47,9 @@ class TextReader {
     std::int64_t next_int(std::string_view what);
     /// The next token as an integer in [lo, hi].
     std::int64_t next_int_in(std::string_view what, std::int64_t lo, std::int64_t hi);
+    /// Fails with "expected a number of ITEMS that fits in a file of N bytes, found COUNT`found_suffix`" when
+    /// `count` items (each more than one byte) cannot be in the file: a broken header is not allocated for.
+    void check_count_fits(std::int64_t count, std::string_view items, std::string_view found_suffix = "") const;
     /// The next token as a finite double (NaN and Inf are rejected).
     double next_double(std::string_view what);
     /// The next token as a double, NaN and Inf allowed.

@@ -30,6 +30,19 @@ std::string upper(std::string_view s)
     return out;
 }
 
+/// Reads the number of item `index` (0-based) of `count` items (`kind` "vertex" or "element", `kinds` its
+/// plural), which must be index + 1: Vega numbers them 1..count in order.
+std::int64_t next_number(TextReader& r, const std::string& kind, const std::string& kinds, std::int64_t index,
+                         std::int64_t count)
+{
+    const std::int64_t id = r.next_int((kind == "element" ? "an " : "a ") + kind + " number");
+    if (id != index + 1)
+        r.fail(kind + " number " + std::to_string(index + 1) + " (" + kinds + " are numbered 1.." +
+                   std::to_string(count) + " in order)",
+               std::to_string(id));
+    return id;
+}
+
 } // namespace
 
 TetMesh read_veg(const std::string& path, ReadNotes* notes)
@@ -49,17 +62,11 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
             const std::int64_t dim = r.next_int("the dimension");
             if (dim != 3) r.fail("dimension 3 in the *VERTICES header", std::to_string(dim));
             r.skip_rest_of_line();
-            if (n > static_cast<std::int64_t>(r.size()))
-                r.fail("a number of vertices that fits in a file of " + std::to_string(r.size()) + " bytes",
-                       std::to_string(n));
+            r.check_count_fits(n, "vertices");
             mesh.positions.resize(static_cast<Index>(n), 3);
             static const char* axis[] = {"x", "y", "z"};
             for (std::int64_t i = 0; i < n; ++i) {
-                const std::int64_t id = r.next_int("a vertex number");
-                if (id != i + 1)
-                    r.fail("vertex number " + std::to_string(i + 1) + " (vertices are numbered 1.." +
-                               std::to_string(n) + " in order)",
-                           std::to_string(id));
+                const std::int64_t id = next_number(r, "vertex", "vertices", i, n);
                 for (int a = 0; a < 3; ++a)
                     mesh.positions(static_cast<Index>(i), a) =
                         r.next_double(std::string(axis[a]) + " coordinate of vertex " + std::to_string(id));
@@ -74,17 +81,11 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
             const std::int64_t per = r.next_int("the number of vertices per element");
             if (per != 4) r.fail("4 vertices per TET element", std::to_string(per));
             r.skip_rest_of_line();
-            if (m > static_cast<std::int64_t>(r.size()))
-                r.fail("a number of elements that fits in a file of " + std::to_string(r.size()) + " bytes",
-                       std::to_string(m));
+            r.check_count_fits(m, "elements");
             mesh.tets.resize(static_cast<Index>(m), 4);
             tet_lines.resize(static_cast<std::size_t>(m));
             for (std::int64_t t = 0; t < m; ++t) {
-                const std::int64_t id = r.next_int("an element number");
-                if (id != t + 1)
-                    r.fail("element number " + std::to_string(t + 1) + " (elements are numbered 1.." +
-                               std::to_string(m) + " in order)",
-                           std::to_string(id));
+                const std::int64_t id = next_number(r, "element", "elements", t, m);
                 tet_lines[static_cast<std::size_t>(t)] = r.line();
                 for (int k = 0; k < 4; ++k) {
                     const std::int64_t v =

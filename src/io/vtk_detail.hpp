@@ -1,14 +1,17 @@
 #pragma once
-// Private helpers shared by the VTK legacy (.vtk) and XML (.vtu/.pvd) readers and writers:
-// scalar types, byte order, label fields, base64 (numbers as text: number.hpp).
+// Private helpers shared by the VTK legacy (.vtk) and XML (.vtu/.pvd) readers and writers: scalar types,
+// byte order, cell type names, what both readers share (label arrays: vtk_labels.hpp; base64 and zlib:
+// vtk_encoding.hpp; numbers as text: number.hpp).
 #include "number.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace tethash::io::vtk_detail {
@@ -35,8 +38,15 @@ using detail::format_double;
 using detail::parse_double;
 using detail::parse_int;
 
-/// A token for an error message: printable, at most ~24 characters, in quotes.
-std::string quote_token(std::string_view token);
+/// A value of an integer array read as text: an integer, or for a floating-point array `type` an integral
+/// value below 9e18 in magnitude; nullopt otherwise.
+std::optional<std::int64_t> parse_integer_value(std::string_view token, Scalar type);
+
+/// A token for an error message: printable, at most 24 characters, in quotes.
+inline std::string quote_token(std::string_view token)
+{
+    return detail::quote_token(token, 24);
+}
 
 /// Human-readable VTK cell type name ("triangle") for notes.
 std::string cell_type_name(std::int64_t type);
@@ -53,67 +63,25 @@ template <class T> void append_bytes(std::string& out, T v, bool big_endian)
     out.append(reinterpret_cast<const char*>(b), sizeof(T));
 }
 
-/// A single-component data array a reader kept because its name may hold labels or object ids.
-struct NamedArray {
-    std::string name;
-    std::vector<double> values; ///< one per point or per cell of the file
-    std::string where;          ///< "FILE:LINE" of the array, for notes
-};
-
-/// True if a point/cell array called `name` may be turned into object ids or labels.
-bool is_label_array_name(std::string_view name, bool cell);
-
-/// Fills tet_object/tet_label/vertex_object/vertex_label from arrays named like "object",
-/// "tet_label", "gmsh:physical", "medit:ref", ... `tet_cells[t]` is the file's cell index of tet t;
-/// cell arrays must have `num_cells_in_file` values, point arrays one per vertex.
-/// Arrays with non-integer values or of the wrong length are ignored with a note.
-void apply_label_arrays(TetMesh& mesh, const std::vector<NamedArray>& point_arrays,
-                        const std::vector<NamedArray>& cell_arrays, const std::vector<std::int64_t>& tet_cells,
-                        std::size_t num_cells_in_file, ReadNotes* notes);
-
-/// Arrays a writer puts into a file: user fields plus object ids and labels of the mesh.
-struct OutArray {
-    std::string name;
-    int components = 1;
-    bool integer = false; ///< written as Int32
-    const std::vector<double>* values = nullptr;
-    const std::vector<Index>* ints = nullptr;
-};
-/// Checks the fields against the mesh (sizes, names; throws Error naming `path` and the field)
-/// and returns point and cell arrays to write. `allow_spaces`: legacy .vtk cannot store them.
-void collect_out_arrays(const std::string& path, const TetMesh& mesh, const Fields& fields, bool allow_spaces,
-                        std::vector<OutArray>& point, std::vector<OutArray>& cell);
-
-/// Base64 of `bytes` (with '=' padding).
-std::string base64_encode(const unsigned char* bytes, std::size_t size);
-
-/// Decodes base64 text piece by piece; whitespace is skipped and '=' padding may occur in the
-/// middle (VTK encodes header and data separately), so concatenated encodings decode correctly.
-class Base64Reader {
+/// What the legacy and XML readers share: the file, where notes go, the options, and messages that name a
+/// line or a byte offset of the file.
+class FileReaderBase {
   public:
-    Base64Reader(const char* begin, const char* end) : m_p(begin), m_end(end) {}
-    /// Appends up to `n` decoded bytes to `out`; returns how many were appended (fewer at the end).
-    std::size_t read(std::size_t n, std::vector<unsigned char>& out);
-    /// Characters consumed so far from `begin`.
-    const char* position() const { return m_p; }
-    /// Set when a character outside the base64 alphabet was met (decoding stops there).
-    bool bad() const { return m_bad; }
-    char bad_char() const { return m_bad_char; }
+    FileReaderBase(std::string path, ReadNotes* notes, const ReadOptions& options)
+        : m_path(std::move(path)), m_notes(notes), m_options(options)
+    {
+    }
 
-  private:
-    bool fill();
-    const char* m_p;
-    const char* m_end;
-    unsigned char m_buf[3] = {0, 0, 0};
-    int m_have = 0, m_next = 0;
-    bool m_bad = false;
-    char m_bad_char = 0;
+  protected:
+    std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
+    std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
+    [[noreturn]] void fail(const std::string& where, const std::string& msg) const;
+    /// Adds to the notes (if any) the cells skipped by VTK cell type (type -> count).
+    void note_skipped_cells(const std::map<std::int64_t, std::int64_t>& skipped) const;
+
+    std::string m_path;
+    ReadNotes* m_notes;
+    ReadOptions m_options;
 };
-
-/// Inflates one zlib block into `out` (appended); false on a corrupt block or a size mismatch.
-/// `out` grows with the data actually inflated, never to `expected` before the stream yields it.
-/// Throws Error(`where` ...) if tethash was built without zlib.
-bool zlib_inflate(const unsigned char* src, std::size_t size, std::size_t expected, std::vector<unsigned char>& out,
-                  const std::string& where);
 
 } // namespace tethash::io::vtk_detail

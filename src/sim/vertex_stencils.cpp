@@ -154,6 +154,26 @@ __attribute__((target("avx2,fma"), always_inline)) inline void load3(const doubl
     pz = _mm256_permute2f128_pd(t0, t2, 0x31);
 }
 
+/// For four tets (one per lane) with corners a, b, c opposite the lane's vertex (xi, yi, zi): the face normal
+/// n = (b − a) × (c − a) and w = (a − x)·n, six times the signed volume, which the return value holds.
+__attribute__((target("avx2,fma"), always_inline)) inline __m256d face_normal_and_w(const double* x, const TetLanes& t,
+                                                                                    __m256d xi, __m256d yi, __m256d zi,
+                                                                                    __m256d& nx, __m256d& ny,
+                                                                                    __m256d& nz)
+{
+    __m256d ax, ay, az, bx, by, bz, cx, cy, cz;
+    load3(x, t.a, ax, ay, az);
+    load3(x, t.b, bx, by, bz);
+    load3(x, t.c, cx, cy, cz);
+    const __m256d bax = _mm256_sub_pd(bx, ax), bay = _mm256_sub_pd(by, ay), baz = _mm256_sub_pd(bz, az);
+    const __m256d cax = _mm256_sub_pd(cx, ax), cay = _mm256_sub_pd(cy, ay), caz = _mm256_sub_pd(cz, az);
+    nx = _mm256_fmsub_pd(bay, caz, _mm256_mul_pd(baz, cay));
+    ny = _mm256_fmsub_pd(baz, cax, _mm256_mul_pd(bax, caz));
+    nz = _mm256_fmsub_pd(bax, cay, _mm256_mul_pd(bay, cax));
+    return _mm256_fmadd_pd(_mm256_sub_pd(ax, xi), nx,
+                           _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny, _mm256_mul_pd(_mm256_sub_pd(az, zi), nz)));
+}
+
 __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const SpringLanes* springs,
                                                      const TetLanes* tets, const double* x, double inv_h,
                                                      LaneTerms& out)
@@ -196,18 +216,8 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
     const __m256d tet_scale = _mm256_add_pd(one, dh);
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         const TetLanes& t = tets[s];
-        __m256d ax, ay, az, bx, by, bz, cx, cy, cz;
-        load3(x, t.a, ax, ay, az);
-        load3(x, t.b, bx, by, bz);
-        load3(x, t.c, cx, cy, cz);
-        const __m256d bax = _mm256_sub_pd(bx, ax), bay = _mm256_sub_pd(by, ay), baz = _mm256_sub_pd(bz, az);
-        const __m256d cax = _mm256_sub_pd(cx, ax), cay = _mm256_sub_pd(cy, ay), caz = _mm256_sub_pd(cz, az);
-        const __m256d nx = _mm256_fmsub_pd(bay, caz, _mm256_mul_pd(baz, cay));
-        const __m256d ny = _mm256_fmsub_pd(baz, cax, _mm256_mul_pd(bax, caz));
-        const __m256d nz = _mm256_fmsub_pd(bax, cay, _mm256_mul_pd(bay, cax));
-        const __m256d w =
-            _mm256_fmadd_pd(_mm256_sub_pd(ax, xi), nx,
-                            _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny, _mm256_mul_pd(_mm256_sub_pd(az, zi), nz)));
+        __m256d nx, ny, nz;
+        const __m256d w = face_normal_and_w(x, t, xi, yi, zi, nx, ny, nz);
         const __m256d k36 = _mm256_load_pd(t.k36);
         const __m256d excess =
             _mm256_fmadd_pd(dh, _mm256_sub_pd(w, _mm256_load_pd(t.wt)), _mm256_sub_pd(w, _mm256_load_pd(t.w0)));
@@ -250,18 +260,8 @@ __attribute__((target("avx2,fma"))) void start_avx2(const LaneGroup& g, SpringLa
     }
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         TetLanes& t = tets[s];
-        __m256d ax, ay, az, bx, by, bz, cx, cy, cz;
-        load3(x, t.a, ax, ay, az);
-        load3(x, t.b, bx, by, bz);
-        load3(x, t.c, cx, cy, cz);
-        const __m256d bax = _mm256_sub_pd(bx, ax), bay = _mm256_sub_pd(by, ay), baz = _mm256_sub_pd(bz, az);
-        const __m256d cax = _mm256_sub_pd(cx, ax), cay = _mm256_sub_pd(cy, ay), caz = _mm256_sub_pd(cz, az);
-        const __m256d nx = _mm256_fmsub_pd(bay, caz, _mm256_mul_pd(baz, cay));
-        const __m256d ny = _mm256_fmsub_pd(baz, cax, _mm256_mul_pd(bax, caz));
-        const __m256d nz = _mm256_fmsub_pd(bax, cay, _mm256_mul_pd(bay, cax));
-        _mm256_store_pd(t.wt, _mm256_fmadd_pd(_mm256_sub_pd(ax, xi), nx,
-                                              _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny,
-                                                              _mm256_mul_pd(_mm256_sub_pd(az, zi), nz))));
+        __m256d nx, ny, nz;
+        _mm256_store_pd(t.wt, face_normal_and_w(x, t, xi, yi, zi, nx, ny, nz));
     }
 }
 

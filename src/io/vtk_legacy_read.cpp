@@ -1,8 +1,9 @@
-// Legacy VTK (.vtk) UNSTRUCTURED_GRID reader and writer.
-#include "tethash/io/vtk_legacy.hpp"
+// Legacy VTK (.vtk) UNSTRUCTURED_GRID reader (ASCII and binary, versions 1.0 to 5.1).
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
+#include "tethash/io/vtk_legacy.hpp"
 #include "vtk_detail.hpp"
+#include "vtk_labels.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,23 +28,17 @@ struct ArrayPlace {
     int value_size = 0;    ///< bytes per value (binary)
 };
 
-class LegacyReader {
+class LegacyReader : FileReaderBase {
   public:
-    LegacyReader(std::string path, ReadNotes* notes, const ReadOptions& options)
-        : m_path(std::move(path)), m_notes(notes), m_options(options)
-    {
-    }
+    using FileReaderBase::FileReaderBase;
     TetMesh read();
 
   private:
     // ---- positions and errors
-    std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
-    std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
     /// Place of the last token read (line in ASCII files, byte offset in binary ones).
     std::string at_token() const { return m_binary ? at_byte(m_tok_pos) : at_line(m_tok_line); }
     /// Place of value k of an array.
     std::string at_value(const ArrayPlace& a, std::size_t k) const;
-    [[noreturn]] void fail(const std::string& where, const std::string& msg) const { throw Error(where + ": " + msg); }
     std::string found_token() const { return m_tok.empty() ? "end of file" : quote_token(m_tok); }
 
     // ---- text
@@ -62,13 +57,14 @@ class LegacyReader {
     template <class T>
     std::vector<T> read_values(std::size_t count, Scalar type, const std::string& what, ArrayPlace* place = nullptr);
     void skip_values(std::size_t count, Scalar type, const std::string& what);
+    /// Fails when `count` values cannot fit in the rest of the file (before anything is allocated for them).
+    void check_count_plausible(std::size_t count, const std::string& what);
+    /// Binary data: moves to the start of the values and returns their size in bytes (checked to be in the file).
+    std::size_t binary_extent(std::size_t count, Scalar type, const std::string& what);
     void read_field_block(bool in_data, std::size_t count, std::vector<NamedArray>* keep);
     void read_attribute(const std::string& key, std::size_t count, std::vector<NamedArray>* keep);
     void skip_metadata();
 
-    std::string m_path;
-    ReadNotes* m_notes;
-    ReadOptions m_options;
     std::string m_data;
     std::size_t m_pos = 0;
     std::int64_t m_line = 1;
@@ -179,22 +175,33 @@ std::string LegacyReader::at_value(const ArrayPlace& a, std::size_t k) const
     return at_line(line);
 }
 
+void LegacyReader::check_count_plausible(std::size_t count, const std::string& what)
+{
+    if (count > 8 * (m_data.size() - std::min(m_pos, m_data.size())) + 8) // also keeps count × size from overflowing
+        fail(m_binary ? at_byte(m_pos) : at_token(), "expected " + std::to_string(count) + " values of " + what +
+                                                         ", but the rest of the file is far too short to hold them");
+}
+
+std::size_t LegacyReader::binary_extent(std::size_t count, Scalar type, const std::string& what)
+{
+    end_line();
+    const std::size_t need =
+        type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
+    if (need > m_data.size() - m_pos)
+        fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" + std::to_string(count) +
+                                 " values), found only " + std::to_string(m_data.size() - m_pos) +
+                                 " before the end of the file");
+    return need;
+}
+
 template <class T>
 std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const std::string& what, ArrayPlace* place)
 {
     std::vector<T> out;
-    if (count > 8 * (m_data.size() - std::min(m_pos, m_data.size())) + 8) // also keeps count × size from overflowing
-        fail(m_binary ? at_byte(m_pos) : at_token(), "expected " + std::to_string(count) + " values of " + what +
-                                                         ", but the rest of the file is far too short to hold them");
+    check_count_plausible(count, what);
     if (m_binary) {
-        end_line();
-        const std::size_t need =
-            type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
+        const std::size_t need = binary_extent(count, type, what);
         if (place) *place = {m_pos, m_line, scalar_size(type)};
-        if (need > m_data.size() - m_pos)
-            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" +
-                                     std::to_string(count) + " values), found only " +
-                                     std::to_string(m_data.size() - m_pos) + " before the end of the file");
         out.resize(count);
         const auto* src = reinterpret_cast<const unsigned char*>(m_data.data() + m_pos);
         if (type == Scalar::Bit) {
@@ -222,12 +229,7 @@ std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const s
                                      " of " + what + "), found " + found_token());
             out.push_back(*v);
         } else {
-            auto v = parse_int(m_tok);
-            if (!v && !scalar_is_integer(type)) {
-                const auto d = parse_double(m_tok);
-                if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18)
-                    v = static_cast<std::int64_t>(*d);
-            }
+            const auto v = parse_integer_value(m_tok, type);
             if (!v)
                 fail(at_token(), "expected an integer (value " + std::to_string(i + 1) + " of " +
                                      std::to_string(count) + " of " + what + "), found " + found_token());
@@ -239,29 +241,12 @@ std::vector<T> LegacyReader::read_values(std::size_t count, Scalar type, const s
 
 void LegacyReader::skip_values(std::size_t count, Scalar type, const std::string& what)
 {
-    if (count > 8 * (m_data.size() - std::min(m_pos, m_data.size())) + 8)
-        fail(m_binary ? at_byte(m_pos) : at_token(), "expected " + std::to_string(count) + " values of " + what +
-                                                         ", but the rest of the file is far too short to hold them");
-    if (m_binary) {
-        end_line();
-        const std::size_t need =
-            type == Scalar::Bit ? (count + 7) / 8 : count * static_cast<std::size_t>(scalar_size(type));
-        if (need > m_data.size() - m_pos)
-            fail(at_byte(m_pos), "expected " + std::to_string(need) + " bytes of " + what + " (" +
-                                     std::to_string(count) + " values), found only " +
-                                     std::to_string(m_data.size() - m_pos) + " before the end of the file");
-        m_pos += need;
+    if (!m_binary) {
+        (void)read_values<double>(count, type, what); // every value must still be a number
         return;
     }
-    for (std::size_t i = 0; i < count; ++i) {
-        next_token();
-        if (m_tok.empty())
-            fail(at_token(), "expected " + std::to_string(count) + " values of " + what + ", found end of file after " +
-                                 std::to_string(i));
-        if (!parse_double(m_tok))
-            fail(at_token(), "expected a number (value " + std::to_string(i + 1) + " of " + std::to_string(count) +
-                                 " of " + what + "), found " + found_token());
-    }
+    check_count_plausible(count, what);
+    m_pos += binary_extent(count, type, what);
 }
 
 void LegacyReader::skip_metadata()
@@ -570,50 +555,9 @@ TetMesh LegacyReader::read()
         for (int k = 0; k < 4; ++k)
             mesh.tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(conn[first + k]);
     }
-    if (m_notes) {
-        for (const auto& [type, count] : skipped) {
-            m_notes->skipped_cells += count;
-            m_notes->messages.push_back(m_path + ": skipped " + std::to_string(count) + " cells of type " +
-                                        std::to_string(type) + " (" + cell_type_name(type) + ")");
-            m_notes->skipped.push_back(
-                {count, "type " + std::to_string(type) + " (" + cell_type_name(type) + ")", type == 24});
-        }
-    }
+    note_skipped_cells(skipped);
     apply_label_arrays(mesh, point_arrays, cell_arrays, tet_cells, static_cast<std::size_t>(num_cells), m_notes);
     return mesh;
-}
-
-// ---- writer ----------------------------------------------------------------------------------
-
-void write_values(std::string& out, bool binary, bool integer, const double* d, const Index* ints, std::size_t count,
-                  int per_line)
-{
-    for (std::size_t i = 0; i < count; ++i) {
-        if (binary) {
-            if (integer)
-                append_bytes<std::int32_t>(out, ints[i], true);
-            else
-                append_bytes<double>(out, d[i], true);
-        } else {
-            out += integer ? std::to_string(ints[i]) : format_double(d[i]);
-            out += (i + 1) % static_cast<std::size_t>(per_line) == 0 ? '\n' : ' ';
-        }
-    }
-    if (binary || count % static_cast<std::size_t>(per_line) != 0) out += '\n';
-}
-
-void write_arrays(std::string& out, bool binary, const char* section, std::size_t count,
-                  const std::vector<OutArray>& arrays)
-{
-    if (arrays.empty()) return;
-    out += std::string(section) + " " + std::to_string(count) + "\n";
-    out += "FIELD FieldData " + std::to_string(arrays.size()) + "\n";
-    for (const OutArray& a : arrays) {
-        out += a.name + " " + std::to_string(a.components) + " " + std::to_string(count) +
-               (a.integer ? " int\n" : " double\n");
-        write_values(out, binary, a.integer, a.values ? a.values->data() : nullptr, a.ints ? a.ints->data() : nullptr,
-                     count * static_cast<std::size_t>(a.components), a.components);
-    }
 }
 
 } // namespace
@@ -621,53 +565,6 @@ void write_arrays(std::string& out, bool binary, const char* section, std::size_
 TetMesh read_vtk(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
     return LegacyReader(path, notes, options).read();
-}
-
-void write_vtk(const std::string& path, const TetMesh& mesh, const Fields& fields, bool binary)
-{
-    std::vector<OutArray> point_arrays, cell_arrays;
-    collect_out_arrays(path, mesh, fields, false, point_arrays, cell_arrays);
-    const std::size_t n = static_cast<std::size_t>(mesh.num_vertices()), m = static_cast<std::size_t>(mesh.num_tets());
-    for (std::size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k)
-            if (!std::isfinite(mesh.positions(static_cast<Eigen::Index>(i), k)))
-                throw Error(path + ": point " + std::to_string(i) + " has a non-finite coordinate; not writing it");
-
-    std::string out;
-    out += "# vtk DataFile Version 4.2\n";
-    out += "tethash tet mesh: " + std::to_string(n) + " vertices, " + std::to_string(m) + " tets\n";
-    out += binary ? "BINARY\n" : "ASCII\n";
-    out += "DATASET UNSTRUCTURED_GRID\n";
-    out += "POINTS " + std::to_string(n) + " double\n";
-    write_values(out, binary, false, mesh.positions.data(), nullptr, 3 * n, 3);
-    out += "CELLS " + std::to_string(m) + " " + std::to_string(5 * m) + "\n";
-    for (std::size_t t = 0; t < m; ++t) {
-        if (binary) {
-            append_bytes<std::int32_t>(out, 4, true);
-            for (int k = 0; k < 4; ++k)
-                append_bytes<std::int32_t>(out, mesh.tets(static_cast<Eigen::Index>(t), k), true);
-        } else {
-            out += "4";
-            for (int k = 0; k < 4; ++k) {
-                out += ' ';
-                out += std::to_string(mesh.tets(static_cast<Eigen::Index>(t), k));
-            }
-            out += '\n';
-        }
-    }
-    if (binary) out += '\n';
-    out += "CELL_TYPES " + std::to_string(m) + "\n";
-    for (std::size_t t = 0; t < m; ++t) {
-        if (binary)
-            append_bytes<std::int32_t>(out, 10, true);
-        else
-            out += "10\n";
-    }
-    if (binary) out += '\n';
-    write_arrays(out, binary, "POINT_DATA", n, point_arrays);
-    write_arrays(out, binary, "CELL_DATA", m, cell_arrays);
-
-    write_text_file(path, out);
 }
 
 } // namespace tethash::io

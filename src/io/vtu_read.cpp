@@ -1,10 +1,12 @@
-// VTK XML UnstructuredGrid (.vtu) reader and writer.
+// VTK XML UnstructuredGrid (.vtu) reader: ASCII, base64 (plain or zlib) and appended raw data.
 #include "tethash/io/vtu.hpp"
 
 #include "number.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
 #include "vtk_detail.hpp"
+#include "vtk_encoding.hpp"
+#include "vtk_labels.hpp"
 #include "xml.hpp"
 
 #include <algorithm>
@@ -17,25 +19,18 @@ namespace tethash::io {
 namespace {
 
 using namespace vtk_detail;
-using detail::xml_escape;
 using detail::XmlDocument;
 using detail::XmlElement;
 constexpr auto is_space = detail::is_xml_space;
 
 // ---- .vtu reader ---------------------------------------------------------------------------
 
-class VtuReader {
+class VtuReader : FileReaderBase {
   public:
-    VtuReader(std::string path, ReadNotes* notes, const ReadOptions& options)
-        : m_path(std::move(path)), m_notes(notes), m_options(options)
-    {
-    }
+    using FileReaderBase::FileReaderBase;
     TetMesh read();
 
   private:
-    std::string at_line(std::int64_t line) const { return m_path + ":" + std::to_string(line); }
-    std::string at_byte(std::size_t pos) const { return m_path + ": byte " + std::to_string(pos); }
-    [[noreturn]] void fail(const std::string& where, const std::string& msg) const { throw Error(where + ": " + msg); }
     std::string attr(const XmlElement& el, const char* key, bool required = true) const
     {
         const std::string* v = el.attr(key);
@@ -62,9 +57,6 @@ class VtuReader {
     std::vector<unsigned char> read_block(Source& src, const XmlElement& da, std::size_t expected_bytes,
                                           const std::string& what);
 
-    std::string m_path;
-    ReadNotes* m_notes;
-    ReadOptions m_options;
     std::string m_data;
     XmlDocument m_doc;
     bool m_big_endian = false;
@@ -160,12 +152,7 @@ std::vector<T> VtuReader::read_ascii(const XmlElement& da, Scalar type, std::siz
                                             "), found " + quote_token(tok));
                 out.push_back(*v);
             } else {
-                auto v = parse_int(tok);
-                if (!v && !scalar_is_integer(type)) {
-                    const auto d = parse_double(tok);
-                    if (d && std::isfinite(*d) && *d == std::floor(*d) && std::abs(*d) < 9e18)
-                        v = static_cast<std::int64_t>(*d);
-                }
+                const auto v = parse_integer_value(tok, type);
                 if (!v)
                     fail(at_line(line), "expected an integer (value " + std::to_string(count) + " of " + what +
                                             "), found " + quote_token(tok));
@@ -515,14 +502,7 @@ TetMesh VtuReader::read()
     std::copy(coords.begin(), coords.end(), mesh.positions.data());
     mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
     std::copy(tet_ids.begin(), tet_ids.end(), mesh.tets.data());
-    if (m_notes) {
-        for (const auto& [t, count] : skipped) {
-            m_notes->skipped_cells += count;
-            m_notes->messages.push_back(m_path + ": skipped " + std::to_string(count) + " cells of type " +
-                                        std::to_string(t) + " (" + cell_type_name(t) + ")");
-            m_notes->skipped.push_back({count, "type " + std::to_string(t) + " (" + cell_type_name(t) + ")", t == 24});
-        }
-    }
+    note_skipped_cells(skipped);
     std::vector<NamedArray> pa, ca;
     for (auto& [k, a] : point_arrays)
         pa.push_back(std::move(a));
@@ -546,110 +526,6 @@ bool vtu_zlib_supported()
 TetMesh read_vtu(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
     return VtuReader(path, notes, options).read();
-}
-
-void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)
-{
-    std::vector<OutArray> point_arrays, cell_arrays;
-    collect_out_arrays(path, mesh, fields, true, point_arrays, cell_arrays);
-    const std::size_t n = static_cast<std::size_t>(mesh.num_vertices()), m = static_cast<std::size_t>(mesh.num_tets());
-    for (std::size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k)
-            if (!std::isfinite(mesh.positions(static_cast<Eigen::Index>(i), k)))
-                throw Error(path + ": point " + std::to_string(i) + " has a non-finite coordinate; not writing it");
-
-    const bool offsets64 = 4 * m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
-    // Every array as (XML attributes, byte size, writer of its little-endian data).
-    struct Block {
-        std::string section; // "PointData", "CellData", "Points", "Cells"
-        std::string attrs;
-        std::size_t bytes;
-        std::function<void(std::string&)> write;
-    };
-    std::vector<Block> blocks;
-    const auto add_fields = [&](const std::vector<OutArray>& arrays, const char* section, std::size_t count) {
-        for (const OutArray& a : arrays) {
-            const std::size_t values = count * static_cast<std::size_t>(a.components);
-            std::string at = std::string("type=\"") + (a.integer ? "Int32" : "Float64") + "\" Name=\"" +
-                             xml_escape(a.name) + "\" NumberOfComponents=\"" + std::to_string(a.components) + "\"";
-            blocks.push_back({section, at, values * (a.integer ? 4 : 8), [a, values](std::string& out) {
-                                  for (std::size_t i = 0; i < values; ++i) {
-                                      if (a.integer)
-                                          append_bytes<std::int32_t>(out, (*a.ints)[i], false);
-                                      else
-                                          append_bytes<double>(out, (*a.values)[i], false);
-                                  }
-                              }});
-        }
-    };
-    add_fields(point_arrays, "PointData", n);
-    add_fields(cell_arrays, "CellData", m);
-    blocks.push_back(
-        {"Points", "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * n * 8, [&](std::string& out) {
-             for (std::size_t i = 0; i < 3 * n; ++i)
-                 append_bytes<double>(out, mesh.positions.data()[i], false);
-         }});
-    blocks.push_back({"Cells", "type=\"Int32\" Name=\"connectivity\"", 4 * m * 4, [&](std::string& out) {
-                          for (std::size_t i = 0; i < 4 * m; ++i)
-                              append_bytes<std::int32_t>(out, mesh.tets.data()[i], false);
-                      }});
-    blocks.push_back({"Cells", std::string("type=\"") + (offsets64 ? "Int64" : "Int32") + "\" Name=\"offsets\"",
-                      m * (offsets64 ? 8 : 4), [&](std::string& out) {
-                          for (std::size_t t = 1; t <= m; ++t) {
-                              if (offsets64)
-                                  append_bytes<std::int64_t>(out, static_cast<std::int64_t>(4 * t), false);
-                              else
-                                  append_bytes<std::int32_t>(out, static_cast<std::int32_t>(4 * t), false);
-                          }
-                      }});
-    blocks.push_back({"Cells", "type=\"UInt8\" Name=\"types\"", m, [&](std::string& out) { out.append(m, '\x0a'); }});
-
-    bool header64 = false;
-    for (const Block& b : blocks)
-        header64 = header64 || b.bytes > 0xffffffffu;
-    const std::size_t hs = header64 ? 8 : 4;
-
-    std::string xml = "<?xml version=\"1.0\"?>\n";
-    xml +=
-        std::string("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"") +
-        (header64 ? "UInt64" : "UInt32") + "\">\n";
-    xml += "  <UnstructuredGrid>\n";
-    xml += "    <Piece NumberOfPoints=\"" + std::to_string(n) + "\" NumberOfCells=\"" + std::to_string(m) + "\">\n";
-    // The data go in reverse document order (the last DataArray at offset 0). VTK does not care;
-    // meshio's raw-appended reader looks arrays up by offset after renumbering the ones it has
-    // seen, and this order keeps a renumbered offset from shadowing one still to be read.
-    std::size_t offset = 0;
-    std::vector<std::size_t> offsets(blocks.size());
-    for (std::size_t i = blocks.size(); i-- > 0;) {
-        offsets[i] = offset;
-        offset += hs + blocks[i].bytes;
-    }
-    for (const char* section : {"PointData", "CellData", "Points", "Cells"}) {
-        bool any = false;
-        for (std::size_t i = 0; i < blocks.size(); ++i) {
-            if (blocks[i].section != section) continue;
-            if (!any) xml += std::string("      <") + section + ">\n";
-            any = true;
-            xml += "        <DataArray " + blocks[i].attrs + " format=\"appended\" offset=\"" +
-                   std::to_string(offsets[i]) + "\"/>\n";
-        }
-        if (any)
-            xml += std::string("      </") + section + ">\n";
-        else if (std::string(section) == "PointData" || std::string(section) == "CellData")
-            xml += std::string("      <") + section + "/>\n";
-    }
-    xml += "    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _";
-    xml.reserve(xml.size() + offset + 64);
-    for (auto it = blocks.rbegin(); it != blocks.rend(); ++it) {
-        const Block& b = *it;
-        if (header64)
-            append_bytes<std::uint64_t>(xml, b.bytes, false);
-        else
-            append_bytes<std::uint32_t>(xml, static_cast<std::uint32_t>(b.bytes), false);
-        b.write(xml);
-    }
-    xml += "\n  </AppendedData>\n</VTKFile>\n";
-    write_text_file(path, xml);
 }
 
 } // namespace tethash::io
