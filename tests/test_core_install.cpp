@@ -41,16 +41,16 @@ TEST(CoreInstall, CConsumerBuildsAndRuns)
     const auto dir = temp_dir();
     const std::filesystem::path build = std::filesystem::path(TETHASH_TEST_TMP).parent_path().parent_path();
     const auto prefix = dir / "prefix";
-    const auto inst = run_shell("cmake --install " + sq(build) + " --prefix " + sq(prefix));
+    const auto inst = run_shell("cmake --install " + quote(build) + " --prefix " + quote(prefix));
     ASSERT_EQ(inst.status, 0) << inst.out << inst.err;
     const auto src = std::filesystem::path(TETHASH_SOURCE_DIR) / "tests/install_consumer_c";
     const auto cbuild = dir / "consumer";
-    const auto conf = run_shell("cmake -S " + sq(src) + " -B " + sq(cbuild) + " -DCMAKE_BUILD_TYPE=Release" +
-                                " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+    const auto conf = run_shell("cmake -S " + quote(src) + " -B " + quote(cbuild) + " -DCMAKE_BUILD_TYPE=Release" +
+                                " -DCMAKE_PREFIX_PATH=" + quote(prefix));
     ASSERT_EQ(conf.status, 0) << conf.out << conf.err;
-    const auto bld = run_shell("cmake --build " + sq(cbuild) + " -j2");
+    const auto bld = run_shell("cmake --build " + quote(cbuild) + " -j2");
     ASSERT_EQ(bld.status, 0) << bld.out << bld.err;
-    const auto run = run_shell(sq(cbuild / "detect_c"));
+    const auto run = run_shell(quote(cbuild / "detect_c"));
     EXPECT_EQ(run.status, 0) << run.out << run.err;
     EXPECT_NE(run.out.find("contact vertex 7 tet 0"), std::string::npos) << run.out;
 
@@ -62,7 +62,7 @@ TEST(CoreInstall, CConsumerBuildsAndRuns)
         cm << "cmake_minimum_required(VERSION 3.25)\nproject(c_only LANGUAGES C)\nfind_package(tethash REQUIRED)\n";
     }
     const auto bad =
-        run_shell("cmake -S " + sq(c_only) + " -B " + sq(c_only / "build") + " -DCMAKE_PREFIX_PATH=" + sq(prefix));
+        run_shell("cmake -S " + quote(c_only) + " -B " + quote(c_only / "build") + " -DCMAKE_PREFIX_PATH=" + quote(prefix));
     EXPECT_NE(bad.status, 0);
     EXPECT_NE((bad.out + bad.err).find("enable CXX"), std::string::npos) << bad.out << bad.err;
 }
