@@ -61,8 +61,8 @@ TEST(CoreInstall, CConsumerBuildsAndRuns)
         std::ofstream cm(c_only / "CMakeLists.txt");
         cm << "cmake_minimum_required(VERSION 3.25)\nproject(c_only LANGUAGES C)\nfind_package(tethash REQUIRED)\n";
     }
-    const auto bad =
-        run_shell("cmake -S " + quote(c_only) + " -B " + quote(c_only / "build") + " -DCMAKE_PREFIX_PATH=" + quote(prefix));
+    const auto bad = run_shell("cmake -S " + quote(c_only) + " -B " + quote(c_only / "build") +
+                               " -DCMAKE_PREFIX_PATH=" + quote(prefix));
     EXPECT_NE(bad.status, 0);
     EXPECT_NE((bad.out + bad.err).find("enable CXX"), std::string::npos) << bad.out << bad.err;
 }

@@ -90,8 +90,8 @@ void MshReader::read_elements22()
                                              std::to_string(total) + " in all), found " + std::to_string(count));
             if (ntags < 0 || ntags > 1000)
                 m_r.fail_at_byte(at + 8, "expected a number of tags 0..1000, found " + std::to_string(ntags));
-            check_room(count, 4 * static_cast<std::size_t>(1 + ntags + nn),
-                       static_cast<std::size_t>(1 + ntags + nn), "elements");
+            check_room(count, 4 * static_cast<std::size_t>(1 + ntags + nn), static_cast<std::size_t>(1 + ntags + nn),
+                       "elements");
             for (std::int64_t e = 0; e < count; ++e) {
                 const std::int64_t etag = read_int("an element tag");
                 read_element22(type, ntags, etag);
@@ -112,8 +112,8 @@ void MshReader::read_elements22()
             read_int("the number of tags");
             if (count != 0)
                 m_r.fail_at_byte(at, "expected $EndElements after " + std::to_string(total) +
-                                         " elements (the $Elements header), found a group of " +
-                                         std::to_string(count) + " more");
+                                         " elements (the $Elements header), found a group of " + std::to_string(count) +
+                                         " more");
         }
     }
     expect_end("$EndElements");

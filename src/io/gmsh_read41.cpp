@@ -34,8 +34,7 @@ void MshReader::read_entities41()
                 if (k == 0) m_entity_physical[d].emplace(tag, p);
             }
             if (d > 0) {
-                const std::int64_t nb =
-                    read_size("the number of bounding entities of entity " + std::to_string(tag));
+                const std::int64_t nb = read_size("the number of bounding entities of entity " + std::to_string(tag));
                 check_room(nb, 4, 1, "bounding entity tags");
                 for (std::int64_t k = 0; k < nb; ++k)
                     read_int("a bounding entity tag");
@@ -118,17 +117,15 @@ void MshReader::read_elements41()
         const std::int64_t type = read_int("an element type");
         const std::int64_t count = read_size("the number of elements in the block");
         if (count > total - seen) {
-            const std::string msg = "expected at most " + std::to_string(total - seen) +
-                                    " elements in element block " + std::to_string(b + 1) +
-                                    " (the $Elements header says " + std::to_string(total) + " in all), found " +
-                                    std::to_string(count);
+            const std::string msg = "expected at most " + std::to_string(total - seen) + " elements in element block " +
+                                    std::to_string(b + 1) + " (the $Elements header says " + std::to_string(total) +
+                                    " in all), found " + std::to_string(count);
             if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
             m_r.fail_message(msg);
         }
         const int nn = gmsh_nodes_per_element(type);
         if (is_tet(type)) {
-            check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn),
-                       "tets");
+            check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn), "tets");
             const std::int64_t label = label_of(dim, entity);
             for (std::int64_t e = 0; e < count; ++e) {
                 const std::int64_t etag = read_size("an element tag");
