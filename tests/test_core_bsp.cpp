@@ -29,10 +29,12 @@ Soup make_soup(const std::vector<Vec3>& v, const std::vector<std::array<Index, 3
 {
     Soup s;
     s.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-    for (std::size_t i = 0; i < v.size(); ++i) s.vertices.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+    for (std::size_t i = 0; i < v.size(); ++i)
+        s.vertices.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
     s.triangles.resize(static_cast<Eigen::Index>(t.size()), 3);
     for (std::size_t i = 0; i < t.size(); ++i)
-        for (int c = 0; c < 3; ++c) s.triangles(static_cast<Eigen::Index>(i), c) = t[i][static_cast<std::size_t>(c)];
+        for (int c = 0; c < 3; ++c)
+            s.triangles(static_cast<Eigen::Index>(i), c) = t[i][static_cast<std::size_t>(c)];
     return s;
 }
 
@@ -43,7 +45,8 @@ using Voxel = std::array<int, 3>;
 Soup voxel_surface(const std::vector<Voxel>& voxels)
 {
     std::map<Voxel, bool> filled;
-    for (const Voxel& v : voxels) filled[v] = true;
+    for (const Voxel& v : voxels)
+        filled[v] = true;
     std::map<Voxel, Index> ids;
     std::vector<Vec3> points;
     std::vector<std::array<Index, 3>> tris;
@@ -98,14 +101,17 @@ Soup octahedron()
 Soup dented_cube()
 {
     std::vector<Vec3> v;
-    for (int k = 0; k < 8; ++k) v.emplace_back(2 * (k & 1), 2 * (k >> 1 & 1), 2 * (k >> 2 & 1));
+    for (int k = 0; k < 8; ++k)
+        v.emplace_back(2 * (k & 1), 2 * (k >> 1 & 1), 2 * (k >> 2 & 1));
     v.emplace_back(1, 1, 1);
     std::vector<std::array<Index, 3>> t;
-    for (const auto& q : std::vector<std::array<Index, 4>>{{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}}) {
+    for (const auto& q :
+         std::vector<std::array<Index, 4>>{{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}}) {
         t.push_back({q[0], q[1], q[2]});
         t.push_back({q[0], q[2], q[3]});
     }
-    for (const auto& e : std::vector<std::array<Index, 2>>{{4, 5}, {5, 7}, {7, 6}, {6, 4}}) t.push_back({e[0], e[1], 8});
+    for (const auto& e : std::vector<std::array<Index, 2>>{{4, 5}, {5, 7}, {7, 6}, {6, 4}})
+        t.push_back({e[0], e[1], 8});
     return make_soup(v, t);
 }
 
@@ -142,7 +148,8 @@ double brute_distance(const Soup& s, const Vec3& p)
 }
 
 /// Every point of the lattice of spacing h over [lo, hi]: contains() must equal `inside`.
-void check_lattice(const Bsp& bsp, const Vec3& lo, const Vec3& hi, double h, const std::function<bool(const Vec3&)>& inside)
+void check_lattice(const Bsp& bsp, const Vec3& lo, const Vec3& hi, double h,
+                   const std::function<bool(const Vec3&)>& inside)
 {
     int checked = 0, in = 0;
     for (double x = lo.x(); x <= hi.x(); x += h)
@@ -176,16 +183,17 @@ void check_random(const Bsp& bsp, const Soup& s, int count, unsigned seed)
 const std::vector<Voxel> staircase{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0},
                                    {1, 0, 1}, {2, 0, 1}, {1, 1, 1}, {2, 1, 1}, {2, 0, 2}, {2, 1, 2}};
 const std::vector<Voxel> frame{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {2, 1, 0}, {0, 2, 0}, {1, 2, 0}, {2, 2, 0}};
-const std::vector<Voxel> bowl{
-    {0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}, {0, 2, 0}, {1, 2, 0}, {2, 2, 0},
-    {0, 0, 1}, {1, 0, 1}, {2, 0, 1}, {0, 1, 1}, {2, 1, 1}, {0, 2, 1}, {1, 2, 1}, {2, 2, 1}};
+const std::vector<Voxel> bowl{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0},
+                              {0, 2, 0}, {1, 2, 0}, {2, 2, 0}, {0, 0, 1}, {1, 0, 1}, {2, 0, 1},
+                              {0, 1, 1}, {2, 1, 1}, {0, 2, 1}, {1, 2, 1}, {2, 2, 1}};
 
 } // namespace
 
 TEST(Bsp, CubeOfVoxelsMergesCoplanarFaces)
 {
     std::vector<Voxel> cube;
-    for (int k = 0; k < 8; ++k) cube.push_back({k & 1, k >> 1 & 1, k >> 2 & 1});
+    for (int k = 0; k < 8; ++k)
+        cube.push_back({k & 1, k >> 1 & 1, k >> 2 & 1});
     const Soup s = voxel_surface(cube);
     const Bsp bsp(s.vertices, s.triangles);
     EXPECT_EQ(bsp.stats().triangles, 48);
@@ -193,7 +201,8 @@ TEST(Bsp, CubeOfVoxelsMergesCoplanarFaces)
     EXPECT_EQ(bsp.stats().nodes, 6);
     EXPECT_EQ(bsp.stats().leaves_in, 1);
     EXPECT_EQ(bsp.stats().splits, 0);
-    check_lattice(bsp, Vec3(-0.5, -0.5, -0.5), Vec3(2.5, 2.5, 2.5), 0.25, [&](const Vec3& p) { return in_voxels(cube, p); });
+    check_lattice(bsp, Vec3(-0.5, -0.5, -0.5), Vec3(2.5, 2.5, 2.5), 0.25,
+                  [&](const Vec3& p) { return in_voxels(cube, p); });
     // One ulp outside each face is out, one ulp inside is in.
     for (int axis = 0; axis < 3; ++axis)
         for (const double face : {0.0, 2.0}) {
@@ -254,9 +263,9 @@ TEST(Bsp, ConcaveSlantedFacesExactOnTheDent)
         EXPECT_TRUE(bsp.contains(corner));
     }
     EXPECT_TRUE(bsp.contains(apex));
-    EXPECT_TRUE(bsp.contains(Vec3(1, 0.5, 1.5)));    // on face (0,0,2)-(2,0,2)-apex
+    EXPECT_TRUE(bsp.contains(Vec3(1, 0.5, 1.5)));     // on face (0,0,2)-(2,0,2)-apex
     EXPECT_FALSE(bsp.contains(Vec3(1, 0.75, 1.875))); // in the dent, above that face
-    EXPECT_TRUE(bsp.contains(Vec3(1, 0.75, 1.25)));  // below it
+    EXPECT_TRUE(bsp.contains(Vec3(1, 0.75, 1.25)));   // below it
 }
 
 TEST(Bsp, RotatedStaircaseAgreesWithWindingNumber)
@@ -269,7 +278,8 @@ TEST(Bsp, RotatedStaircaseAgreesWithWindingNumber)
     const Bsp bsp(s.vertices, s.triangles);
     check_random(bsp, s, 3000, 5);
     // The vertices themselves are corners of the surface: inside (closed).
-    for (Eigen::Index i = 0; i < s.vertices.rows(); ++i) EXPECT_TRUE(bsp.contains(s.vertices.row(i).transpose()));
+    for (Eigen::Index i = 0; i < s.vertices.rows(); ++i)
+        EXPECT_TRUE(bsp.contains(s.vertices.row(i).transpose()));
 }
 
 TEST(Bsp, DepthIsTheDistanceToTheNearestFace)
@@ -321,7 +331,8 @@ TEST(Bsp, RefusesBadSurfaces)
     two.vertices.conservativeResize(2 * cube.vertices.rows(), 3);
     two.vertices.bottomRows(cube.vertices.rows()) = shifted.vertices.array() + 0.5;
     two.triangles.conservativeResize(2 * cube.triangles.rows(), 3);
-    two.triangles.bottomRows(cube.triangles.rows()) = shifted.triangles.array() + static_cast<Index>(cube.vertices.rows());
+    two.triangles.bottomRows(cube.triangles.rows()) =
+        shifted.triangles.array() + static_cast<Index>(cube.vertices.rows());
     EXPECT_NE(message(two).find("self-intersecting surface: triangles"), std::string::npos) << message(two);
 
     // The same two cubes apart are fine (two components).

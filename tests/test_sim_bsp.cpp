@@ -23,7 +23,8 @@ std::string bowl_scene(const std::string& body_at)
     return R"(dt = 2e-3
 [[object]]
 name = "bowl"
-mesh = ")" + bowl_path +
+mesh = ")" +
+           bowl_path +
            R"("
 static = true
 collider = "bsp"

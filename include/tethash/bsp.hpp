@@ -22,17 +22,17 @@ namespace tethash {
 
 /// What a built tree looks like.
 struct BspStats {
-    Index triangles = 0;       ///< input triangles
-    Index planes = 0;          ///< distinct face planes (coplanar triangles of one facing merged)
-    Index nodes = 0;           ///< inner nodes (planes tested)
-    Index leaves_in = 0;       ///< IN leaves
-    Index leaves_out = 0;      ///< OUT leaves
-    Index depth = 0;           ///< longest root-to-leaf path (inner nodes)
-    double mean_depth = 0;     ///< mean root-to-leaf path length over the leaves
-    std::int64_t splits = 0;   ///< face fragments split by a plane during the build
-    std::int64_t bytes = 0;    ///< memory held by the tree, its faces and their triangle tree
-    bool flipped = false;      ///< the surface was oriented inwards and was turned outwards
-    double build_ms = 0;       ///< wall time of the build (checks included)
+    Index triangles = 0;     ///< input triangles
+    Index planes = 0;        ///< distinct face planes (coplanar triangles of one facing merged)
+    Index nodes = 0;         ///< inner nodes (planes tested)
+    Index leaves_in = 0;     ///< IN leaves
+    Index leaves_out = 0;    ///< OUT leaves
+    Index depth = 0;         ///< longest root-to-leaf path (inner nodes)
+    double mean_depth = 0;   ///< mean root-to-leaf path length over the leaves
+    std::int64_t splits = 0; ///< face fragments split by a plane during the build
+    std::int64_t bytes = 0;  ///< memory held by the tree, its faces and their triangle tree
+    bool flipped = false;    ///< the surface was oriented inwards and was turned outwards
+    double build_ms = 0;     ///< wall time of the build (checks included)
 };
 
 /// The answer for one point.
@@ -52,7 +52,8 @@ class Bsp {
     /// be closed (every edge in exactly two triangles, in opposite directions), without zero-area triangles and
     /// without self-intersections; an inward orientation is turned outwards. Throws Error naming `what` and the
     /// problem (edge, triangles) otherwise.
-    Bsp(const PositionsRef& vertices, const Eigen::Ref<const Triangles>& triangles, const std::string& what = "surface");
+    Bsp(const PositionsRef& vertices, const Eigen::Ref<const Triangles>& triangles,
+        const std::string& what = "surface");
     ~Bsp();
     Bsp(Bsp&&) noexcept;
     Bsp& operator=(Bsp&&) noexcept;
@@ -76,9 +77,9 @@ class Bsp {
 
 /// A vertex inside (or on) an obstacle. Arrays of it are sorted by (vertex, obstacle).
 struct ObstacleContact {
-    Index vertex = -1;              ///< vertex id in the queried positions
-    Index obstacle = -1;            ///< obstacle id in its ObstacleSet
-    double depth = 0;               ///< distance to the obstacle's nearest face, ≥ 0
+    Index vertex = -1;               ///< vertex id in the queried positions
+    Index obstacle = -1;             ///< obstacle id in its ObstacleSet
+    double depth = 0;                ///< distance to the obstacle's nearest face, ≥ 0
     double direction[3] = {0, 0, 0}; ///< unit, out of the obstacle (the way to push the vertex)
 };
 

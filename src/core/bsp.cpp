@@ -58,7 +58,10 @@ struct Node {
     Index back = leaf_in;
 };
 
-std::string edge_text(Index a, Index b) { return "(" + std::to_string(a) + ", " + std::to_string(b) + ")"; }
+std::string edge_text(Index a, Index b)
+{
+    return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
+}
 
 int orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 {
@@ -68,7 +71,10 @@ int orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 // ---- exact triangle intersection tests (closed sets), used to refuse self-intersecting surfaces
 
 /// In-plane orientation of (x, y, z) seen from the lift point w (off their plane).
-int orient2(const Vec3& x, const Vec3& y, const Vec3& z, const Vec3& w) { return orient(x, y, z, w); }
+int orient2(const Vec3& x, const Vec3& y, const Vec3& z, const Vec3& w)
+{
+    return orient(x, y, z, w);
+}
 
 bool segments_meet_coplanar(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s, const Vec3& w)
 {
@@ -188,7 +194,8 @@ void BspImpl::check(const std::string& what)
         if (triangles(t, 0) == triangles(t, 1) || triangles(t, 1) == triangles(t, 2) ||
             triangles(t, 2) == triangles(t, 0))
             throw Error(what + ": triangle " + std::to_string(t) + " repeats a vertex");
-        for (int c = 0; c < 3; ++c) longest = std::max(longest, (corner(t, c) - corner(t, (c + 1) % 3)).norm());
+        for (int c = 0; c < 3; ++c)
+            longest = std::max(longest, (corner(t, c) - corner(t, (c + 1) % 3)).norm());
     }
     for (Index t = 0; t < m; ++t) {
         const Vec3 a = corner(t, 0), b = corner(t, 1), c = corner(t, 2);
@@ -213,7 +220,8 @@ void BspImpl::check(const std::string& what)
     });
     for (std::size_t i = 0; i < half.size();) {
         std::size_t j = i;
-        while (j < half.size() && half[j].lo == half[i].lo && half[j].hi == half[i].hi) ++j;
+        while (j < half.size() && half[j].lo == half[i].lo && half[j].hi == half[i].hi)
+            ++j;
         const std::string edge = edge_text(half[i].lo, half[i].hi);
         if (j - i == 1)
             throw Error(what + ": open surface: edge " + edge + " belongs to triangle " + std::to_string(half[i].t) +
@@ -307,7 +315,8 @@ void BspImpl::group_planes()
     }
     // Largest triangles first, so that each group's plane comes from its best-conditioned triangle.
     std::vector<Index> order(static_cast<std::size_t>(m));
-    for (Index t = 0; t < m; ++t) order[static_cast<std::size_t>(t)] = t;
+    for (Index t = 0; t < m; ++t)
+        order[static_cast<std::size_t>(t)] = t;
     std::stable_sort(order.begin(), order.end(), [&](Index a, Index b) {
         return area[static_cast<std::size_t>(a)] > area[static_cast<std::size_t>(b)];
     });
@@ -576,9 +585,18 @@ double Bsp::distance(const Eigen::Vector3d& p) const
     return std::sqrt(d2);
 }
 
-const Eigen::Vector3d& Bsp::box_lo() const { return m_impl->lo; }
-const Eigen::Vector3d& Bsp::box_hi() const { return m_impl->hi; }
-const BspStats& Bsp::stats() const { return m_impl->stats; }
+const Eigen::Vector3d& Bsp::box_lo() const
+{
+    return m_impl->lo;
+}
+const Eigen::Vector3d& Bsp::box_hi() const
+{
+    return m_impl->hi;
+}
+const BspStats& Bsp::stats() const
+{
+    return m_impl->stats;
+}
 
 Index ObstacleSet::add(Bsp bsp)
 {

@@ -27,10 +27,9 @@ void SceneObstacles::add_contacts(const Positions& x, const std::vector<char>& f
             c.direction[r] = o.direction[r];
         contacts.push_back(c);
     }
-    std::inplace_merge(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(before), contacts.end(),
-                       [](const Contact& a, const Contact& b) {
-                           return std::tie(a.vertex, a.tet) < std::tie(b.vertex, b.tet);
-                       });
+    std::inplace_merge(
+        contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(before), contacts.end(),
+        [](const Contact& a, const Contact& b) { return std::tie(a.vertex, a.tet) < std::tie(b.vertex, b.tet); });
 }
 
 double SceneObstacles::exact_depth(const Positions& x, const Contact& c) const
