@@ -133,4 +133,13 @@ TEST(CliBsp, OpenOrSelfIntersectingSurfacesAreRefused)
     r = run_tethash("info " + quote(dir / "two.obj"));
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("self-intersecting surface"), std::string::npos) << r.err;
+
+    // A scene with an open collider = "bsp" surface: refused before the run, naming the object.
+    write_text(dir / "s.toml", "steps = 2\n[output]\nevery = 0\n[[object]]\nname = \"lid\"\nmesh = \"open.obj\"\n"
+                               "static = true\ncollider = \"bsp\"\n[[object]]\ngenerate = { shape = \"box\", "
+                               "resolution = 2 }\ntranslate = [0.5, 0.5, 2]\n");
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --out " + quote(dir / "out"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("object 'lid'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("open surface"), std::string::npos) << r.err;
 }

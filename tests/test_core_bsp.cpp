@@ -180,6 +180,25 @@ void check_random(const Bsp& bsp, const Soup& s, int count, unsigned seed)
     }
 }
 
+/// Points just off each face (its centroid moved by ± `offset` along the normal): outside in front, inside behind,
+/// as the winding number says.
+void check_near_faces(const Bsp& bsp, const Soup& s, double offset)
+{
+    for (Eigen::Index t = 0; t < s.triangles.rows(); ++t) {
+        const Vec3 a = s.vertices.row(s.triangles(t, 0)).transpose();
+        const Vec3 b = s.vertices.row(s.triangles(t, 1)).transpose();
+        const Vec3 c = s.vertices.row(s.triangles(t, 2)).transpose();
+        const Vec3 n = (b - a).cross(c - a).normalized();
+        for (const double sign : {-1.0, 1.0}) {
+            const Vec3 p = (a + b + c) / 3 + sign * offset * n;
+            const double w = winding(s, p);
+            ASSERT_TRUE(std::abs(w) < 1e-6 || std::abs(w - 1) < 1e-6) << w;
+            ASSERT_EQ(bsp.contains(p), w > 0.5) << "triangle " << t << " offset " << sign * offset;
+            EXPECT_EQ(w > 0.5, sign < 0);
+        }
+    }
+}
+
 const std::vector<Voxel> staircase{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0},
                                    {1, 0, 1}, {2, 0, 1}, {1, 1, 1}, {2, 1, 1}, {2, 0, 2}, {2, 1, 2}};
 const std::vector<Voxel> frame{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {2, 1, 0}, {0, 2, 0}, {1, 2, 0}, {2, 2, 0}};
@@ -256,6 +275,8 @@ TEST(Bsp, ConcaveSlantedFacesExactOnTheDent)
     const Bsp bsp(s.vertices, s.triangles);
     check_lattice(bsp, Vec3(-0.5, -0.5, -0.5), Vec3(2.5, 2.5, 2.5), 0.125, in_dented);
     check_random(bsp, s, 2000, 4);
+    for (const double offset : {1e-3, 1e-9})
+        check_near_faces(bsp, s, offset);
     // Points exactly on the slanted faces (dyadic combinations of their corners), their edges and the apex.
     const Vec3 apex(1, 1, 1);
     for (const Vec3& corner : {Vec3(0, 0, 2), Vec3(2, 0, 2), Vec3(2, 2, 2), Vec3(0, 2, 2)}) {
@@ -277,6 +298,8 @@ TEST(Bsp, RotatedStaircaseAgreesWithWindingNumber)
         s.vertices.row(i) = (r * s.vertices.row(i).transpose() + Vec3(0.1, -3, 7)).transpose();
     const Bsp bsp(s.vertices, s.triangles);
     check_random(bsp, s, 3000, 5);
+    for (const double offset : {1e-3, 1e-7, 1e-9})
+        check_near_faces(bsp, s, offset);
     // The vertices themselves are corners of the surface: inside (closed).
     for (Eigen::Index i = 0; i < s.vertices.rows(); ++i)
         EXPECT_TRUE(bsp.contains(s.vertices.row(i).transpose()));

@@ -278,7 +278,8 @@ void BspImpl::check(const std::string& what)
                     if (!in_s) ot = i;
                     if (!in_t) os = i;
                 }
-                const Vec3 a = u[(ot + 1) % 3], b = u[(ot + 2) % 3];
+                const Vec3& a = u[(ot + 1) % 3];
+                const Vec3& b = u[(ot + 2) % 3];
                 if (orient(a, b, u[ot], v[os]) == 0) {
                     const Vec3 w = lift_point(a, b, u[ot]);
                     meet = orient2(a, b, u[ot], w) == orient2(a, b, v[os], w);
