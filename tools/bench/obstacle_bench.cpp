@@ -97,7 +97,8 @@ int main(int argc, char** argv)
                 missed += in && !rep;
                 outside += rep && !in;
                 if (in && rep && std::isfinite(depth[static_cast<std::size_t>(v)])) {
-                    const double e = std::abs(depth[static_cast<std::size_t>(v)] - truth.distance(x.row(v).transpose()));
+                    const double e =
+                        std::abs(depth[static_cast<std::size_t>(v)] - truth.distance(x.row(v).transpose()));
                     err_sum += e;
                     err_max = std::max(err_max, e);
                     ++valued;
