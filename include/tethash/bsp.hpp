@@ -60,7 +60,7 @@ class Bsp {
     Bsp(const Bsp&) = delete;
     Bsp& operator=(const Bsp&) = delete;
 
-    /// Closed, exact point-in-polyhedron test (the bounding box first, then the tree).
+    /// Closed, exact point-in-polyhedron test (the bounding box first, then the tree); false for a non-finite p.
     bool contains(const Eigen::Vector3d& p) const;
     /// contains() plus, when inside, depth and direction to the nearest face.
     BspHit query(const Eigen::Vector3d& p) const;

@@ -552,6 +552,7 @@ Bsp& Bsp::operator=(Bsp&&) noexcept = default;
 
 bool Bsp::contains(const Eigen::Vector3d& p) const
 {
+    if (!p.allFinite()) return false;
     if ((p.array() < m_impl->lo.array()).any() || (p.array() > m_impl->hi.array()).any()) return false;
     bool near = false;
     const bool inside = m_impl->descend(m_impl->root, p, near);
@@ -611,6 +612,7 @@ std::vector<ObstacleContact> ObstacleSet::query(const PositionsRef& positions) c
     const Index n = static_cast<Index>(positions.rows());
     for (Index i = 0; i < n; ++i) {
         const Vec3 p = positions.row(i).transpose();
+        if (!p.allFinite()) continue; // never inside anything
         for (Index o = 0; o < size(); ++o) {
             const Bsp& b = m_obstacles[static_cast<std::size_t>(o)];
             if ((p.array() < b.box_lo().array()).any() || (p.array() > b.box_hi().array()).any()) continue;
