@@ -25,8 +25,10 @@ constexpr double local_contact_edges = 2.0;
 } // namespace
 
 void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model& model,
-                            const std::vector<ObjectOptions>& options)
+                            const std::vector<ObjectOptions>& options, const SceneObstacles* obstacles)
 {
+    m_obstacles = obstacles && obstacles->size() > 0 ? obstacles : nullptr;
+    const size_t num_obstacles = m_obstacles ? static_cast<size_t>(m_obstacles->size()) : 0;
     m_mesh = &mesh;
     m_model = &model;
     // The positions the run starts from: `mesh` is the live state (its positions change every step and it keeps
@@ -35,7 +37,7 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
     m_rest = mesh.rest();
     m_params = scene.contact;
     m_mu = scene.contact.friction;
-    m_object_k.assign(scene.objects.size(), 0.0);
+    m_object_k.assign(scene.objects.size() + num_obstacles, 0.0); // obstacles: static, no springs
     for (Index e = 0; e < model.springs.edges.rows(); ++e) {
         double& ko =
             m_object_k[static_cast<size_t>(model.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
@@ -47,7 +49,7 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         dynamic_objects += o.is_static ? 0 : 1;
         self = self || (!o.is_static && o.self_collision);
     }
-    m_enabled = dynamic_objects > 0 && (self || scene.objects.size() >= 2);
+    m_enabled = dynamic_objects > 0 && (self || scene.objects.size() >= 2 || num_obstacles > 0);
     if (m_enabled) {
         DetectParams params = scene.detect;
         if (!scene.table_size_of_vertices.empty())
@@ -108,6 +110,11 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
     t0 = Clock::now();
     m_penetration.compute(x, m_contacts);
     stats.ms_depth += ms_since(t0);
+    if (m_obstacles) { // inside test, depth and direction together
+        t0 = Clock::now();
+        m_obstacles->add_contacts(x, model.fixed, model.vertex_object, m_contacts);
+        stats.ms_detect += ms_since(t0);
+    }
 
     t0 = Clock::now();
     const size_t nc = m_contacts.size();
@@ -122,8 +129,8 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
         const double inv_v =
             model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
         double mt = 0;
-        bool tet_fixed = false;
-        for (int k = 0; k < 4; ++k) {
+        bool tet_fixed = c.tet < 0; // an obstacle
+        for (int k = 0; k < 4 && c.tet >= 0; ++k) {
             const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
             if (model.fixed[j] && c.bary[k] > 0.25) tet_fixed = true;
             mt += c.bary[k] * model.mass[j];
@@ -154,6 +161,13 @@ void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
     const Contact& c = m_contacts[q];
     node[0] = c.vertex;
     coef[0] = 1.0;
+    if (c.tet < 0) { // an obstacle: fixed, only the vertex moves
+        for (int k = 1; k < 5; ++k) {
+            node[k] = c.vertex;
+            coef[k] = 0.0;
+        }
+        return;
+    }
     for (int k = 0; k < 4; ++k) {
         node[k + 1] = m_mesh->tets(c.tet, k);
         coef[k + 1] = -c.bary[k];
@@ -271,7 +285,16 @@ double ContactResponse::max_depth() const
 std::vector<double> ContactResponse::exact_depths(const Positions& x) const
 {
     if (!m_enabled) return {};
-    return m_penetration.exact_depths(x, m_contacts);
+    if (!m_obstacles) return m_penetration.exact_depths(x, m_contacts);
+    std::vector<Contact> tets;
+    for (const Contact& c : m_contacts)
+        if (c.tet >= 0) tets.push_back(c);
+    const std::vector<double> tet_depths = m_penetration.exact_depths(x, tets);
+    std::vector<double> out;
+    size_t next = 0;
+    for (const Contact& c : m_contacts)
+        out.push_back(c.tet >= 0 ? tet_depths[next++] : m_obstacles->exact_depth(x, c));
+    return out;
 }
 
 } // namespace tethash::sim

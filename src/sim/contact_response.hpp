@@ -3,6 +3,8 @@
 // self-contacts left to the elastic terms, penetration depth and direction, per-contact stiffness,
 // damping and weights, and the forces and matrix terms every integrator uses.
 
+#include "obstacles.hpp"
+
 #include "tethash/detect.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"
@@ -19,7 +21,9 @@ class ContactResponse {
   public:
     /// Builds the detector and penetration topology when some pair of objects can collide; stiffest spring per
     /// object for the automatic contact stiffness.
-    void setup(const Scene& scene, const TetMesh& mesh, const Model& model, const std::vector<ObjectOptions>& options);
+    /// `obstacles` (kept, may be null): static BSP obstacles whose contacts join the tet contacts (tet −1).
+    void setup(const Scene& scene, const TetMesh& mesh, const Model& model, const std::vector<ObjectOptions>& options,
+               const SceneObstacles* obstacles = nullptr);
     bool enabled() const { return m_enabled; }
 
     /// Detects at `x`, drops the local self-contacts, fills depth/direction and the coefficients. Adds its times
@@ -38,7 +42,8 @@ class ContactResponse {
     const std::vector<double>& damping() const { return m_c; }
     double friction() const { return m_mu; }
     /// The five nodes of contact q (its vertex, then the tet's four) and their coefficients (1, −b0 … −b3):
-    /// the gap along the direction changes by −n · Σ coef_a Δx_a.
+    /// the gap along the direction changes by −n · Σ coef_a Δx_a. An obstacle contact (tet −1): the vertex, then
+    /// the vertex again four times with coefficient 0 (the obstacle does not move).
     void stencil(size_t q, Index node[5], double coef[5]) const;
 
     /// f += penalty + friction forces at velocities `vel` for a step h (friction capped so that it cannot reverse
@@ -57,6 +62,7 @@ class ContactResponse {
     const TetMesh* m_mesh = nullptr;
     const Model* m_model = nullptr;
     Positions m_rest; // rest (start) positions, for telling local self-contacts from folds
+    const SceneObstacles* m_obstacles = nullptr;
     bool m_enabled = false;
     ContactParams m_params;
     Detector m_detector;

@@ -43,18 +43,8 @@ TetMesh load_object(const ObjectSpec& o)
     m.tet_object.clear();
     m.vertex_label.clear();
     m.tet_label.clear();
-    const Mat3 rot = (Eigen::AngleAxisd(o.rotate_deg.z() * M_PI / 180, Vec3::UnitZ()) *
-                      Eigen::AngleAxisd(o.rotate_deg.y() * M_PI / 180, Vec3::UnitY()) *
-                      Eigen::AngleAxisd(o.rotate_deg.x() * M_PI / 180, Vec3::UnitX()))
-                         .toRotationMatrix();
-    auto apply = [&](Positions& p) {
-        for (Index i = 0; i < p.rows(); ++i) {
-            const Vec3 q = rot * (o.scale.cwiseProduct(p.row(i).transpose())) + o.translate;
-            p.row(i) = q.transpose();
-        }
-    };
-    apply(m.positions);
-    if (m.rest_positions.rows()) apply(m.rest_positions);
+    transform_positions(o, m.positions);
+    if (m.rest_positions.rows()) transform_positions(o, m.rest_positions);
     for (Index i = 0; i < m.num_vertices(); ++i)
         if (!m.positions.row(i).allFinite())
             throw Error("object '" + o.name + "': vertex " + std::to_string(i) + " is not finite");
@@ -62,6 +52,18 @@ TetMesh load_object(const ObjectSpec& o)
 }
 
 } // namespace
+
+void transform_positions(const ObjectSpec& o, Positions& p)
+{
+    const Mat3 rot = (Eigen::AngleAxisd(o.rotate_deg.z() * M_PI / 180, Vec3::UnitZ()) *
+                      Eigen::AngleAxisd(o.rotate_deg.y() * M_PI / 180, Vec3::UnitY()) *
+                      Eigen::AngleAxisd(o.rotate_deg.x() * M_PI / 180, Vec3::UnitX()))
+                         .toRotationMatrix();
+    for (Index i = 0; i < p.rows(); ++i) {
+        const Vec3 q = rot * (o.scale.cwiseProduct(p.row(i).transpose())) + o.translate;
+        p.row(i) = q.transpose();
+    }
+}
 
 SceneObjects load_objects(const Scene& scene)
 {

@@ -19,6 +19,9 @@ struct SceneObjects {
     std::vector<ObjectOptions> options;
 };
 
+/// Applies the object's scale, rotations and translation to `p` (n × 3), in that order.
+void transform_positions(const ObjectSpec& o, Positions& p);
+
 /// Loads or generates every object of `scene` (files read, surfaces tetrahedralized, transforms applied).
 /// Throws Error naming the object on a missing file, an empty mesh or a non-finite vertex.
 SceneObjects load_objects(const Scene& scene);

@@ -1,6 +1,7 @@
 #include "tethash/sim/scene.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/io/surface.hpp"
 
 #include <toml++/toml.h>
 
@@ -224,7 +225,7 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
     o.name = "object " + std::to_string(index);
     r.check_keys(t, pre,
                  {"name", "mesh", "generate", "surface_resolution", "scale", "rotate", "translate", "velocity",
-                  "material", "self_collision", "static"});
+                  "material", "self_collision", "static", "collider"});
     for (auto&& [k, v] : t) {
         const std::string key(k.str()), full = pre + key;
         if (key == "name")
@@ -249,7 +250,13 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
             o.self_collision = r.boolean(v, full);
         else if (key == "static")
             o.is_static = r.boolean(v, full);
-        else if (key == "material")
+        else if (key == "collider") {
+            const std::string c = r.string(v, full);
+            if (c == "bsp")
+                o.collider = Collider::bsp;
+            else if (c != "tets")
+                r.fail(&v, full, "unknown collider '" + c + "' (known: tets, bsp)");
+        } else if (key == "material")
             read_material(r, r.table(v, full), full + ".", o.material);
         else if (key == "generate") {
             const toml::table& g = r.table(v, full);
@@ -294,6 +301,9 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object needs 'mesh' or 'generate'");
     if (!o.mesh.empty() && o.generate)
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object has either 'mesh' or 'generate', not both");
+    if (o.collider == Collider::bsp && (!o.is_static || o.mesh.empty() || !io::is_surface_path(o.mesh)))
+        r.fail(t.get("collider"), pre + "collider",
+               "collider = \"bsp\" needs a static object (static = true) whose mesh is a closed surface file");
     return o;
 }
 

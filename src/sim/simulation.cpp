@@ -6,6 +6,7 @@
 #include "failure.hpp"
 #include "integrator.hpp"
 #include "objects.hpp"
+#include "obstacles.hpp"
 
 #include "tethash/error.hpp"
 
@@ -56,7 +57,8 @@ double estimate_dt_limit(const Scene& scene, const Model& model, const TetMesh& 
 
 class SimulationImpl {
   public:
-    Scene scene;
+    Scene scene; // without its collider = "bsp" objects (in obstacles)
+    SceneObstacles obstacles;
     SceneObjects objects; // objects.mesh.positions = current positions
     Positions v;
     Model model;
@@ -88,6 +90,7 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         throw Error("max_substeps must be ≥ 1 (or 0: automatic), found " + std::to_string(scene.max_substeps));
     if (scene.iterations < 0)
         throw Error("iterations must be ≥ 1 (or 0: automatic), found " + std::to_string(scene.iterations));
+    obstacles = take_obstacles(scene);
     objects = load_objects(scene);
     const Index n = mesh().num_vertices();
     model = Model::build(mesh(), objects.materials, objects.is_static);
@@ -100,7 +103,7 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
         for (Index i = objects.vertices[k].first; i < objects.vertices[k].first + objects.vertices[k].second; ++i)
             if (!model.fixed[static_cast<size_t>(i)]) v.row(i) = scene.objects[k].velocity.transpose();
 
-    contacts.setup(scene, mesh(), model, objects.options);
+    contacts.setup(scene, mesh(), model, objects.options, &obstacles);
     model.ground = scene.ground;
     automatic_ground();
 

@@ -1,7 +1,9 @@
 // libFuzzer harness: surfaces through tethash's assimp bridge (io::read_surface). The extension
-// follows the content (ply, OFF, solid, OBJ vertex lines, else binary STL), so that plain files seed it.
+// follows the content (ply, OFF, solid, OBJ vertex lines, else binary STL), so that plain files seed it. A surface
+// read is then built into a BSP tree (an obstacle): built, or refused with Error, never a crash.
 #include "fuzz_support.hpp"
 
+#include "tethash/bsp.hpp"
 #include "tethash/io/surface.hpp"
 
 #include <string_view>
@@ -31,6 +33,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                  s.triangles(t, k), static_cast<long>(n));
                     std::abort();
                 }
+        const tethash::Bsp bsp(s.vertices, s.triangles, path);
+        const Eigen::Vector3d centre = 0.5 * (bsp.box_lo() + bsp.box_hi());
+        if (bsp.query(centre).inside && !(bsp.query(centre).depth >= 0)) std::abort();
     } catch (const tethash::Error&) {
     }
     return 0;

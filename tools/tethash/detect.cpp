@@ -2,9 +2,11 @@
 // optional contacts CSV and statistics JSON.
 #include "command.hpp"
 
+#include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/io/surface.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/study/json.hpp"
 #include "tethash/study/stats_table.hpp"
@@ -16,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -35,6 +38,7 @@ struct DetectOptions {
     std::vector<int> static_objects;
     std::string objects_from_labels; ///< "", "separate" or "join"
     bool linearize = false;
+    std::vector<std::string> obstacles; ///< closed surfaces, each a static BSP obstacle
 };
 
 /// One input file of the scene: where its vertices and tets start in the scene, and its own numbering.
@@ -60,8 +64,14 @@ std::int64_t file_id(const io::ReadNotes& notes, const std::vector<std::int64_t>
 }
 
 /// Contacts as CSV: a header comment saying which id is which, then one row per contact sorted by (vertex, tet).
-std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector<InputFile>& files)
+/// With obstacles, the rows of the vertices inside them follow each vertex's tet contacts (tet columns empty), and
+/// every row has the obstacle (empty for a tet contact), the depth and the direction.
+std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector<InputFile>& files,
+                         const std::vector<std::string>& obstacle_paths = {},
+                         const std::vector<ObstacleContact>& obstacle_contacts = {},
+                         const std::vector<Index>& vertex_object = {})
 {
+    const bool obstacles = !obstacle_paths.empty();
     std::string csv = "# tethash detect: each row is a vertex lying inside a tet it does not belong to.\n"
                       "# vertex, tet: 0-based ids in the scene (the input files joined in argument order).\n"
                       "# vertex_object, tet_object: objects (each file one, in order from 0; its 'object' cell data or "
@@ -70,10 +80,31 @@ std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector
                       "vertex_in_file, tet_in_file: the id in that file's own numbering (Gmsh node and element tags; "
                       "1-based in Medit and Vega; TetGen from its first index; 0-based in VTK).\n"
                       "# b0..b3: barycentric coordinates of the vertex in the tet (corners in the tet's order).\n";
+    if (obstacles)
+        csv += "# obstacle: the surface file (--obstacle) the vertex lies in or on (a static BSP obstacle; tet columns "
+               "empty); depth: distance to the penetrated surface (tets: consistent penetration depth; obstacles: "
+               "distance to the nearest face); n0..n2: unit direction out of it.\n";
     for (std::size_t k = 0; k < files.size(); ++k)
         csv += fmt::format("# file {}: {}\n", k, files[k].path);
-    csv += "vertex,tet,vertex_object,tet_object,vertex_file,vertex_in_file,tet_file,tet_in_file,b0,b1,b2,b3\n";
+    for (std::size_t k = 0; k < obstacle_paths.size(); ++k)
+        csv += fmt::format("# obstacle {}: {}\n", k, obstacle_paths[k]);
+    csv += "vertex,tet,vertex_object,tet_object,vertex_file,vertex_in_file,tet_file,tet_in_file,b0,b1,b2,b3";
+    csv += obstacles ? ",obstacle,depth,n0,n1,n2\n" : "\n";
+    std::size_t next = 0; // next obstacle contact
+    auto obstacle_rows = [&](Index up_to) {
+        for (; next < obstacle_contacts.size() && obstacle_contacts[next].vertex <= up_to; ++next) {
+            const ObstacleContact& c = obstacle_contacts[next];
+            const std::size_t fv = file_of(files, c.vertex, &InputFile::first_vertex);
+            const io::ReadNotes& nv = files[fv].notes;
+            csv += fmt::format("{},,{},,{},{},,,,,,,{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex,
+                               vertex_object[static_cast<std::size_t>(c.vertex)], fv,
+                               file_id(nv, nv.vertex_ids, c.vertex - files[fv].first_vertex),
+                               obstacle_paths[static_cast<std::size_t>(c.obstacle)], c.depth, c.direction[0],
+                               c.direction[1], c.direction[2]);
+        }
+    };
     for (const Contact& c : contacts) {
+        obstacle_rows(c.vertex - 1);
         const std::size_t fv = file_of(files, c.vertex, &InputFile::first_vertex);
         const std::size_t ft = file_of(files, c.tet, &InputFile::first_tet);
         const io::ReadNotes& nv = files[fv].notes;
@@ -82,14 +113,21 @@ std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector
             "{},{},{},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", c.vertex, c.tet, c.vertex_object, c.tet_object,
             fv, file_id(nv, nv.vertex_ids, c.vertex - files[fv].first_vertex), ft,
             file_id(nt, nt.tet_ids, c.tet - files[ft].first_tet), c.bary[0], c.bary[1], c.bary[2], c.bary[3]);
+        if (obstacles) {
+            csv.pop_back();
+            csv += fmt::format(",,{:.17g},{:.17g},{:.17g},{:.17g}\n", c.depth, c.direction[0], c.direction[1],
+                               c.direction[2]);
+        }
     }
+    obstacle_rows(std::numeric_limits<Index>::max());
     return csv;
 }
 
 /// Contacts as a VTU of the scene: point data contact (number of tets the vertex lies in), penetration_depth
 /// (the largest over its contacts, 0 where none) and contact_tet (the scene id of the first such tet, -1 where
 /// none); cell data object (written from the mesh) and contacts (vertices inside the tet).
-void write_contacts_vtu(const std::string& path, const TetMesh& scene, std::vector<Contact>& contacts)
+void write_contacts_vtu(const std::string& path, const TetMesh& scene, std::vector<Contact>& contacts,
+                        const std::vector<ObstacleContact>& obstacle_contacts)
 {
     Penetration pen;
     pen.set_topology(scene);
@@ -106,6 +144,11 @@ void write_contacts_vtu(const std::string& path, const TetMesh& scene, std::vect
         if (std::isfinite(c.depth)) f.point[1].values[v] = std::max(f.point[1].values[v], c.depth);
         if (f.point[2].values[v] < 0) f.point[2].values[v] = c.tet;
         f.cell[0].values[static_cast<std::size_t>(c.tet)] += 1;
+    }
+    for (const ObstacleContact& c : obstacle_contacts) {
+        const auto v = static_cast<std::size_t>(c.vertex);
+        f.point[0].values[v] += 1;
+        f.point[1].values[v] = std::max(f.point[1].values[v], c.depth);
     }
     io::write_mesh(path, scene, f);
 }
@@ -129,6 +172,12 @@ void run(const DetectOptions& o)
                         "' (expected .csv for a table or .vtu for the meshes with contact fields)");
     }
     if (!o.stats_path.empty()) io::check_output_file(o.stats_path, "--stats");
+    // Obstacles: read and built (checked closed, not self-intersecting) before the work.
+    ObstacleSet obstacles;
+    for (const std::string& path : o.obstacles) {
+        const io::SurfaceMesh surface = io::read_surface(path);
+        obstacles.add(Bsp(surface.vertices, surface.triangles, "--obstacle " + path));
+    }
 
     // The scene: each file one object (or the objects of its 'object' cell data, or of its labels); ids global in
     // argument order.
@@ -231,12 +280,34 @@ void run(const DetectOptions& o)
                stats.cells_visited, stats.entries_scanned, stats.hash_collisions, stats.box_rejections,
                stats.own_vertex_skips, stats.inside_tests, stats.exact_fallbacks, stats.degenerate_tets);
     fmt::print("contacts: {}\n", contacts.size());
+    std::vector<ObstacleContact> inside;
+    if (obstacles.size() > 0) {
+        const auto t0 = std::chrono::steady_clock::now();
+        inside = obstacles.query(scene.positions);
+        const double obstacle_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        for (Index k = 0; k < obstacles.size(); ++k) {
+            const BspStats& b = obstacles[k].stats();
+            const auto n =
+                std::count_if(inside.begin(), inside.end(), [k](const ObstacleContact& c) { return c.obstacle == k; });
+            fmt::print("obstacle {}: {}: {} vertices inside (bsp: {} triangles, {} planes, {} nodes, depth {})\n", k,
+                       o.obstacles[static_cast<std::size_t>(k)], n, b.triangles, b.planes, b.nodes, b.depth);
+        }
+        fmt::print("obstacle contacts: {} ({:.3f} ms, depth and direction included)\n", inside.size(), obstacle_ms);
+    }
 
     if (!o.contacts_path.empty()) {
         if (io::extension_of(o.contacts_path) == ".vtu") {
             scene.vertex_object = vobj;
             scene.tet_object = tobj;
-            write_contacts_vtu(o.contacts_path, scene, det.contacts());
+            write_contacts_vtu(o.contacts_path, scene, det.contacts(), inside);
+        } else if (obstacles.size() > 0) {
+            // Rows carry depths: the tet contacts' are computed here.
+            std::vector<Contact> valued = contacts;
+            scene.vertex_object = vobj;
+            scene.tet_object = tobj;
+            compute_penetration(scene, valued);
+            io::write_text_file(o.contacts_path, contacts_csv(valued, files, o.obstacles, inside, vobj));
         } else {
             io::write_text_file(o.contacts_path, contacts_csv(contacts, files));
         }
@@ -248,6 +319,7 @@ void run(const DetectOptions& o)
             .member("vertices", nv)
             .member("tets", nt)
             .member("contacts", contacts.size())
+            .member("obstacle_contacts", inside.size())
             .member("hash", to_string(params.hash))
             .member("repeat", o.repeat)
             .member("median_ms", median_ms)
@@ -296,6 +368,11 @@ Registrar reg{
                         "Object index (file order, from 0) that never moves; repeat the option or give a list 0,2")
              ->allow_extra_args(false)
              ->delimiter(',');
+         sub.add_option("--obstacle", o->obstacles,
+                        "Closed surface file (.obj .off .stl .ply ...): a static obstacle kept as a BSP tree; the "
+                        "vertices inside it (closed: on its faces counts) are reported with depth and direction. "
+                        "Repeatable")
+             ->allow_extra_args(false);
          add_objects_from_labels_option(sub, o->objects_from_labels);
          add_linearize_option(sub, o->linearize);
          sub.callback([o] { run(*o); });

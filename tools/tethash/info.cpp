@@ -1,8 +1,10 @@
 // tethash info MESH... : counts, bounding box, edge lengths, volume, quality histogram, problems.
 #include "command.hpp"
 
+#include "tethash/bsp.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
 #include "tethash/study/json.hpp"
 
@@ -168,8 +170,62 @@ void print_text(const Summary& s)
         fmt::print("  note: {}\n", n);
 }
 
-void run(const InfoOptions& opt)
+/// A closed surface (an obstacle): its BSP tree's statistics.
+void print_surface(const std::string& path, const io::SurfaceMesh& surface, const Bsp& bsp, bool json)
 {
+    const BspStats& s = bsp.stats();
+    if (json) {
+        study::JsonWriter j;
+        j.begin_object()
+            .member("file", path)
+            .member("vertices", static_cast<Index>(surface.vertices.rows()))
+            .member("triangles", s.triangles)
+            .member("planes", s.planes)
+            .member("nodes", s.nodes)
+            .member("leaves_in", s.leaves_in)
+            .member("leaves_out", s.leaves_out)
+            .member("depth", s.depth)
+            .member("mean_depth", s.mean_depth)
+            .member("splits", s.splits)
+            .member("bytes", s.bytes)
+            .member("flipped", s.flipped)
+            .member("build_ms", s.build_ms)
+            .end_object();
+        fmt::print("{}\n", j.str());
+        return;
+    }
+    fmt::print("{}: closed surface, {} vertices, {} triangles, {} planes (coplanar triangles merged)\n", path,
+               surface.vertices.rows(), s.triangles, s.planes);
+    fmt::print("  box: ({:.6g}, {:.6g}, {:.6g}) .. ({:.6g}, {:.6g}, {:.6g})\n", bsp.box_lo().x(), bsp.box_lo().y(),
+               bsp.box_lo().z(), bsp.box_hi().x(), bsp.box_hi().y(), bsp.box_hi().z());
+    fmt::print("  bsp: {} nodes, {} IN leaves, {} OUT leaves, depth {} (mean {:.2f}), {} face splits, {} bytes, "
+               "built in {:.3f} ms{}\n",
+               s.nodes, s.leaves_in, s.leaves_out, s.depth, s.mean_depth, s.splits, s.bytes, s.build_ms,
+               s.flipped ? " (the surface was oriented inwards: turned outwards)" : "");
+}
+
+void run(const InfoOptions& given)
+{
+    // Surface files are obstacles: their BSP statistics; the tet meshes follow as one scene.
+    InfoOptions opt = given;
+    std::vector<std::string> surfaces;
+    std::erase_if(opt.meshes, [&](const std::string& path) {
+        const bool surface = io::is_surface_path(path) && !io::is_tet_mesh_path(path);
+        if (surface) surfaces.push_back(path);
+        return surface;
+    });
+    if (!surfaces.empty()) {
+        // Every tree is built before printing, so that a bad surface fails before any output.
+        std::vector<io::SurfaceMesh> meshes;
+        std::vector<Bsp> trees;
+        for (const std::string& path : surfaces) {
+            meshes.push_back(io::read_surface(path));
+            trees.emplace_back(meshes.back().vertices, meshes.back().triangles, path);
+        }
+        for (std::size_t k = 0; k < surfaces.size(); ++k)
+            print_surface(surfaces[k], meshes[k], trees[k], opt.json);
+        if (opt.meshes.empty()) return;
+    }
     check_objects_from_labels_value(opt.objects_from_labels);
     // Read everything first, so that a bad file fails before any output.
     std::vector<Summary> summaries;
@@ -213,11 +269,14 @@ void run(const InfoOptions& opt)
 }
 
 Registrar reg{
-    {"info", "Print counts, bounding box, edge lengths, volume, quality and problems of tet meshes", [](CLI::App& sub) {
+    {"info",
+     "Print counts, bounding box, edge lengths, volume, quality and problems of tet meshes; BSP statistics of surfaces",
+     [](CLI::App& sub) {
          auto opt = std::make_shared<InfoOptions>();
          sub.add_option("meshes", opt->meshes,
                         "Tet mesh files (.vtk .vtu .msh .node/.ele .mesh .veg); "
-                        "several files are one scene, one object each")
+                        "several files are one scene, one object each. A closed surface (.obj .off .stl .ply ...) "
+                        "prints the statistics of its BSP tree (the obstacle of detect --obstacle)")
              ->required();
          sub.add_flag("--json", opt->json, "Print JSON for scripts");
          sub.add_flag("--per-file", opt->per_file, "With several files, also print each file");

@@ -32,6 +32,13 @@ enum class LinearSolver { cg, ldlt };
 LinearSolver parse_linear_solver(const std::string& name);
 const char* to_string(LinearSolver solver);
 
+/// How a static object collides.
+enum class Collider {
+    tets, ///< its tets (a surface file is tetrahedralized on load), hashed with the deformable objects
+    bsp,  ///< a closed surface kept as a polyhedron: exact inside test against its BSP tree (bsp.hpp), depth and
+          ///< direction from its nearest face
+};
+
 /// One object of the scene.
 struct ObjectSpec {
     std::string name; ///< for messages; default "object K"
@@ -45,7 +52,8 @@ struct ObjectSpec {
     Eigen::Vector3d velocity{0, 0, 0};   ///< initial velocity of every vertex
     Material material;
     bool self_collision = true;
-    bool is_static = false; ///< never moves: an obstacle (hashed once by the detector)
+    bool is_static = false;             ///< never moves: an obstacle (hashed once by the detector)
+    Collider collider = Collider::tets; ///< `collider = "bsp"`: a static closed surface as a BSP tree
 };
 
 /// Vertices held fixed: by ids (local to `object`, or global when object < 0) and/or by a box.

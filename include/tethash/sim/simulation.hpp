@@ -65,15 +65,18 @@ class Simulation {
     const Positions& positions() const;  ///< n × 3
     const Positions& velocities() const; ///< n × 3
     const Model& model() const;
-    /// Vertex range [first, first + count) and tet range of object k in mesh().
+    /// Vertex range [first, first + count) and tet range of object k in mesh(). Objects with collider = "bsp" are
+    /// not in mesh(): k counts the other objects, in scene order (scene() lists them only).
     std::pair<Index, Index> object_vertices(int k) const;
     std::pair<Index, Index> object_tets(int k) const;
 
     Energy energy() const;            ///< at the current state (contact term from the last contacts)
     Eigen::Vector3d momentum() const; ///< Σ m v over non-fixed vertices
 
-    const std::vector<Contact>& contacts() const; ///< of the last detection, depth/direction filled
-    double max_penetration() const;               ///< max depth over contacts() (0 if none)
+    /// Of the last detection, depth/direction filled. A vertex in a collider = "bsp" obstacle has a contact with
+    /// tet −1 and tet_object = (number of tet objects) + (the obstacle's rank among the bsp objects).
+    const std::vector<Contact>& contacts() const;
+    double max_penetration() const; ///< max depth over contacts() (0 if none)
     double mean_penetration() const;
     /// Exact distance of each contact's vertex to the penetrated object's boundary (for error studies).
     std::vector<double> exact_depths() const;
