@@ -206,9 +206,8 @@ void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, b
     }
 }
 
-void ContactResponse::add_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const
+template <class Visit> void ContactResponse::for_each_term(double scale_k, double scale_c, Visit&& visit) const
 {
-    const std::vector<char>& fixed = m_model->fixed;
     for (size_t q = 0; q < m_contacts.size(); ++q) {
         const Contact& c = m_contacts[q];
         if (!(c.depth > 0)) continue;
@@ -216,54 +215,49 @@ void ContactResponse::add_triplets(double scale_k, double scale_c, std::vector<E
         double coef[5];
         stencil(q, node, coef);
         const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
-        const Mat3 nn = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]) * nrm * nrm.transpose();
+        visit(node, coef, nrm, m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]));
+    }
+}
+
+void ContactResponse::add_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const
+{
+    const std::vector<char>& fixed = m_model->fixed;
+    for_each_term(scale_k, scale_c, [&](const Index* node, const double* coef, const Vec3& nrm, double s) {
+        const Mat3 nn = s * nrm * nrm.transpose();
         for (int a = 0; a < 5; ++a) {
             if (fixed[static_cast<size_t>(node[a])]) continue;
             for (int b = 0; b < 5; ++b) {
                 if (fixed[static_cast<size_t>(node[b])]) continue;
                 const Mat3 blk = coef[a] * coef[b] * nn;
                 for (int r = 0; r < 3; ++r)
-                    for (int s = 0; s < 3; ++s)
-                        if (blk(r, s) != 0) out.emplace_back(3 * node[a] + r, 3 * node[b] + s, blk(r, s));
+                    for (int t = 0; t < 3; ++t)
+                        if (blk(r, t) != 0) out.emplace_back(3 * node[a] + r, 3 * node[b] + t, blk(r, t));
             }
         }
-    }
+    });
 }
 
 void ContactResponse::apply(double scale_k, double scale_c, const Eigen::VectorXd& p, Eigen::VectorXd& out) const
 {
     const std::vector<char>& fixed = m_model->fixed;
-    for (size_t q = 0; q < m_contacts.size(); ++q) {
-        const Contact& c = m_contacts[q];
-        if (!(c.depth > 0)) continue;
-        Index node[5];
-        double coef[5];
-        stencil(q, node, coef);
-        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+    for_each_term(scale_k, scale_c, [&](const Index* node, const double* coef, const Vec3& nrm, double s) {
         double jp = 0;
         for (int a = 0; a < 5; ++a)
             if (!fixed[static_cast<size_t>(node[a])]) jp += coef[a] * nrm.dot(p.segment<3>(3 * node[a]));
-        const Vec3 y = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]) * jp * nrm;
+        const Vec3 y = s * jp * nrm;
         for (int a = 0; a < 5; ++a)
             if (!fixed[static_cast<size_t>(node[a])]) out.segment<3>(3 * node[a]) += coef[a] * y;
-    }
+    });
 }
 
 void ContactResponse::add_diagonal(double scale_k, double scale_c, Eigen::VectorXd& diag) const
 {
     const std::vector<char>& fixed = m_model->fixed;
-    for (size_t q = 0; q < m_contacts.size(); ++q) {
-        const Contact& c = m_contacts[q];
-        if (!(c.depth > 0)) continue;
-        Index node[5];
-        double coef[5];
-        stencil(q, node, coef);
-        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
-        const double s = m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]);
+    for_each_term(scale_k, scale_c, [&](const Index* node, const double* coef, const Vec3& nrm, double s) {
         for (int a = 0; a < 5; ++a)
             if (!fixed[static_cast<size_t>(node[a])])
                 diag.segment<3>(3 * node[a]) += coef[a] * coef[a] * s * nrm.cwiseProduct(nrm);
-    }
+    });
 }
 
 double ContactResponse::energy() const

@@ -59,6 +59,10 @@ class ContactResponse {
     std::vector<double> exact_depths(const Positions& x) const;
 
   private:
+    /// Calls visit(node, coef, normal, s) for each contact with depth > 0: its stencil, direction and weighted
+    /// scale_k · k + scale_c · c (the matrix terms of the three functions above).
+    template <class Visit> void for_each_term(double scale_k, double scale_c, Visit&& visit) const;
+
     const TetMesh* m_mesh = nullptr;
     const Model* m_model = nullptr;
     Positions m_rest; // rest (start) positions, for telling local self-contacts from folds
