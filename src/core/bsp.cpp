@@ -60,7 +60,13 @@ struct Node {
 
 std::string edge_text(Index a, Index b)
 {
-    return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
+    // Appended piece by piece: g++ 12 warns (-Wrestrict, a false positive) on "(" + std::to_string(a) + ….
+    std::string s = "(";
+    s += std::to_string(a);
+    s += ", ";
+    s += std::to_string(b);
+    s += ")";
+    return s;
 }
 
 int orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
