@@ -1,7 +1,30 @@
 #pragma once
-// Input files shared by the command-line tests.
+// Input files and output readers shared by the command-line tests.
+
+#include <sstream>
+#include <string>
+#include <vector>
 
 namespace tethash::test {
+
+/// Rows of a CSV after its '#' comment lines (the header first), split at commas; a trailing comma gives a
+/// trailing empty cell.
+inline std::vector<std::vector<std::string>> csv_rows(const std::string& text)
+{
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        std::vector<std::string> cells;
+        std::string cell;
+        std::istringstream ls(line);
+        while (std::getline(ls, cell, ','))
+            cells.push_back(cell);
+        if (line.back() == ',') cells.emplace_back();
+        rows.push_back(cells);
+    }
+    return rows;
+}
 
 /// Two bodies in one Gmsh 2.2 file: a tet (physical tag 6, tet 0) and a unit tet (physical tag 5, tet 1); the
 /// first vertex of tet 0 (node 5, 0-based vertex 4) lies inside the unit tet; node 9 belongs to no tet.

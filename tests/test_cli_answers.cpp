@@ -2,6 +2,7 @@
 // tets are skipped with a note, contacts name their objects and each side's file ids (CSV) or come as a VTU,
 // simulation frames keep their objects, tetrahedralize and info report connected components, and the boundary
 // .obj is one surface for meshio.
+#include "cli_support.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -61,22 +62,6 @@ std::string surface_vtu()
 <DataArray type="UInt8" Name="types" format="ascii">5 5</DataArray>
 </Cells></Piece></UnstructuredGrid></VTKFile>
 )";
-}
-
-/// Rows of a CSV after its '#' comment lines: the header first.
-std::vector<std::vector<std::string>> csv_rows(const std::string& text)
-{
-    std::vector<std::vector<std::string>> rows;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) {
-        if (line.empty() || line[0] == '#') continue;
-        std::vector<std::string> cells;
-        std::istringstream l(line);
-        for (std::string c; std::getline(l, c, ',');)
-            cells.push_back(c);
-        rows.push_back(cells);
-    }
-    return rows;
 }
 
 } // namespace

@@ -1,5 +1,6 @@
 // `tethash detect --obstacle` and `tethash info SURFACE`: vertices inside polyhedral obstacles (closed, with depth
 // and direction) in the contacts CSV, BSP statistics, refusal of open surfaces.
+#include "cli_support.hpp"
 #include "support.hpp"
 
 #include <sstream>
@@ -28,23 +29,6 @@ Tetrahedra
 1 2 3 4 1
 End
 )";
-
-std::vector<std::vector<std::string>> csv_rows(const std::string& text)
-{
-    std::vector<std::vector<std::string>> rows;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) {
-        if (line.empty() || line[0] == '#') continue;
-        std::vector<std::string> cells;
-        std::string cell;
-        std::istringstream ls(line);
-        while (std::getline(ls, cell, ','))
-            cells.push_back(cell);
-        if (!line.empty() && line.back() == ',') cells.emplace_back();
-        rows.push_back(cells);
-    }
-    return rows;
-}
 
 } // namespace
 

@@ -185,9 +185,15 @@ void Simulation::step()
         s.refined_until = s.t + 0.05;
     }
     substeps = std::min(max_substeps, std::max(substeps, s.refined));
-    const std::int64_t inverted_before = s.inverted;
-    const std::int64_t allowed =
-        std::max(inverted_before, static_cast<std::int64_t>(s.model.volumes.tets.rows()) / 100);
+    const std::int64_t allowed = std::max(s.inverted, static_cast<std::int64_t>(s.model.volumes.tets.rows()) / 100);
+    // Back to the step's start with twice the substeps, while max_substeps allows.
+    auto refine = [&] {
+        if (substeps * 2 > max_substeps) return false;
+        x = s.x_save;
+        s.v = s.v_save;
+        substeps *= 2;
+        return true;
+    };
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
@@ -206,33 +212,16 @@ void Simulation::step()
             bad = s.failure.check_substep(s.model, x, s.v, s.t + (sub + 1) * h);
             if (!bad.empty()) break;
         }
+        if (bad.empty()) {
+            const Energy e = s.model.energy(x, s.v);
+            bad = s.failure.check_energy(e.internal() + s.contacts.energy());
+        }
         if (!bad.empty()) {
-            x = s.x_save;
-            s.v = s.v_save;
-            if (substeps * 2 <= max_substeps) {
-                substeps *= 2;
-                continue;
-            }
+            if (refine()) continue;
             fail(bad);
         }
-        const Energy e = s.model.energy(x, s.v);
-        const std::string energy = s.failure.check_energy(e.internal() + s.contacts.energy());
-        if (!energy.empty()) {
-            if (substeps * 2 <= max_substeps) {
-                x = s.x_save;
-                s.v = s.v_save;
-                substeps *= 2;
-                continue;
-            }
-            fail(energy);
-        }
         s.inverted = count_inverted_tets(s.model, x);
-        if (s.inverted > allowed && substeps * 2 <= max_substeps) {
-            x = s.x_save;
-            s.v = s.v_save;
-            substeps *= 2;
-            continue;
-        }
+        if (s.inverted > allowed && refine()) continue;
         break;
     }
     if (substeps > s.refined) {
