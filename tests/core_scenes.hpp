@@ -4,6 +4,7 @@
 #include "tethash/detect.hpp"
 
 #include <Eigen/Geometry>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -31,6 +32,34 @@ inline bool identical(const std::vector<Contact>& a, const std::vector<Contact>&
             a[i].tet_object != b[i].tet_object || std::memcmp(a[i].bary, b[i].bary, sizeof a[i].bary) != 0)
             return false;
     return true;
+}
+
+/// Identical (vertex, tet, objects) sequence, barycentric coordinates equal up to rounding.
+inline ::testing::AssertionResult same_contacts(const std::vector<Contact>& got, const std::vector<Contact>& want)
+{
+    const std::size_t n = std::min(got.size(), want.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        const Contact &a = got[i], &b = want[i];
+        if (a.vertex != b.vertex || a.tet != b.tet)
+            return ::testing::AssertionFailure() << "contact " << i << ": got (" << a.vertex << ", " << a.tet
+                                                 << "), oracle (" << b.vertex << ", " << b.tet << ")";
+        if (a.vertex_object != b.vertex_object || a.tet_object != b.tet_object)
+            return ::testing::AssertionFailure() << "contact " << i << ": objects differ";
+        double sum = 0;
+        for (int k = 0; k < 4; ++k) {
+            sum += a.bary[k];
+            if (std::fabs(a.bary[k] - b.bary[k]) > 1e-6 || a.bary[k] < -1e-9)
+                return ::testing::AssertionFailure()
+                       << "contact " << i << ": bary[" << k << "] " << a.bary[k] << " vs oracle " << b.bary[k];
+            if ((a.bary[k] == 0.0) != (b.bary[k] == 0.0))
+                return ::testing::AssertionFailure() << "contact " << i << ": exact zero of bary[" << k << "] differs";
+        }
+        if (std::fabs(sum - 1.0) > 1e-9)
+            return ::testing::AssertionFailure() << "contact " << i << ": bary sum " << sum;
+    }
+    if (got.size() != want.size())
+        return ::testing::AssertionFailure() << got.size() << " contacts, oracle " << want.size();
+    return ::testing::AssertionSuccess();
 }
 
 /// One object as the text of a Medit .mesh file (1-based indices).

@@ -20,6 +20,7 @@
 using namespace tethash;
 using tethash::test::expect_error;
 using tethash::test::identical;
+using tethash::test::same_contacts;
 using tethash::test::Scene;
 
 namespace {
@@ -40,34 +41,6 @@ std::vector<Contact> run_detector(const Scene& s, const DetectParams& p, DetectS
 std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
 {
     return brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects, stats);
-}
-
-/// Identical (vertex, tet, objects) sequence, barycentric coordinates equal up to rounding.
-::testing::AssertionResult same_contacts(const std::vector<Contact>& got, const std::vector<Contact>& want)
-{
-    const std::size_t n = std::min(got.size(), want.size());
-    for (std::size_t i = 0; i < n; ++i) {
-        const Contact &a = got[i], &b = want[i];
-        if (a.vertex != b.vertex || a.tet != b.tet)
-            return ::testing::AssertionFailure() << "contact " << i << ": got (" << a.vertex << ", " << a.tet
-                                                 << "), oracle (" << b.vertex << ", " << b.tet << ")";
-        if (a.vertex_object != b.vertex_object || a.tet_object != b.tet_object)
-            return ::testing::AssertionFailure() << "contact " << i << ": objects differ";
-        double sum = 0;
-        for (int k = 0; k < 4; ++k) {
-            sum += a.bary[k];
-            if (std::fabs(a.bary[k] - b.bary[k]) > 1e-6 || a.bary[k] < -1e-9)
-                return ::testing::AssertionFailure()
-                       << "contact " << i << ": bary[" << k << "] " << a.bary[k] << " vs oracle " << b.bary[k];
-            if ((a.bary[k] == 0.0) != (b.bary[k] == 0.0))
-                return ::testing::AssertionFailure() << "contact " << i << ": exact zero of bary[" << k << "] differs";
-        }
-        if (std::fabs(sum - 1.0) > 1e-9)
-            return ::testing::AssertionFailure() << "contact " << i << ": bary sum " << sum;
-    }
-    if (got.size() != want.size())
-        return ::testing::AssertionFailure() << got.size() << " contacts, oracle " << want.size();
-    return ::testing::AssertionSuccess();
 }
 
 struct Variant {

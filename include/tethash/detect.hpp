@@ -49,6 +49,41 @@ enum class HashFunction {
 HashFunction parse_hash_function(const std::string& name);
 const char* to_string(HashFunction h);
 
+/// The broad phase that hands candidate (vertex, tet) pairs to the exact inside test. Every method returns the same
+/// contacts (the oracle's); they differ in time, memory and the candidates they hand on (docs/partitions.md).
+enum class Method {
+    hash,              ///< the spatial hash of Teschner et al. 2003 (the default; the only one with candidate reuse)
+    brute_force,       ///< every vertex against every tet box (vertices sorted by x: each tet looks at its x-extent)
+    uniform_grid,      ///< a dense array of cells over the scene's bounding box (the storage the hash replaces)
+    hierarchical_grid, ///< hashed grids of doubling cell size, each tet on the level its size fits (Mirtich 1998)
+    octree,            ///< region octree over the vertices: split at the cell centre
+    octree_point,      ///< point octree: split at the median of the contents
+    octree_loose,      ///< loose octree over the tets: cells enlarged by `looseness`, each tet in one cell
+    kd_tree,           ///< region k-d tree: mid-plane, axis cycling
+    kd_tree_point,     ///< point k-d tree: median plane, axis cycling
+    bsp_tree,          ///< BSP tree with the comparison paper's rule (median point, normal turned 90° about x, y, z)
+    bsp_tree_balanced, ///< BSP tree choosing among candidate planes the most even split
+    sort_sweep,        ///< sort and sweep on the axis of largest variance, insertion sort from the last order
+    bvh,               ///< bounding-volume hierarchy over the tet boxes, rebuilt every call
+    bvh_refit,         ///< the same hierarchy, built once and refitted (rebuilt when refitting has degraded it)
+    automatic,         ///< the method that measured fastest for the scene's kind (docs/results.md)
+};
+/// The names of the text grammar ("hash", "brute", "grid", "hgrid", "octree", "octree-point", "octree-loose", "kd",
+/// "kd-point", "bsp", "bsp-balanced", "sort-sweep", "bvh", "bvh-refit", "auto"); parse_method throws Error naming
+/// `option`, the text and the list.
+Method parse_method(const std::string& text, const std::string& option = "--method");
+const char* to_string(Method m);
+/// Every method but `automatic`, in the order above.
+std::span<const Method> all_methods();
+
+/// Parameters of the methods other than the hash. 0 = the method's default.
+struct PartitionParams {
+    int max_depth = 0;    ///< trees: deepest level (0: the method's default; at most 40)
+    int leaf_size = 0;    ///< trees: items a node holds before it splits (0: the method's default)
+    double looseness = 0; ///< loose octree: cell enlargement factor ≥ 1 (0: 2)
+    int levels = 0;       ///< hierarchical grid: most levels (0: as many as the tet sizes span, at most 32)
+};
+
 /// Per-object options. Objects not listed get the defaults.
 struct ObjectOptions {
     bool self_collision = true; ///< report contacts between a vertex and a tet of the same object
@@ -73,6 +108,10 @@ struct DetectParams {
     enum class SkinMode { absolute, factor_of_cell_size };
     SkinMode skin_mode = SkinMode::absolute;
     double skin = 0; ///< a length, or the factor of the cell size for factor_of_cell_size
+    /// The broad phase. Methods other than `hash` ignore `table_size`, `hash` and the skin; the grids use the cell
+    /// size (the hierarchical grid as its finest level).
+    Method method = Method::hash;
+    PartitionParams partition;
 };
 
 // ---- the text grammar of the detector's parameters: one parser for every command and scene file ----------
@@ -135,6 +174,9 @@ struct DetectStats {
     double skin = 0;                    ///< skin actually used (length; 0 = no candidate reuse, or paused)
     int reused = 0;                     ///< 1: stages 1-2 skipped, the kept candidates were tested (skin > 0)
     std::int64_t cached_candidates = 0; ///< candidates kept for reuse (skin > 0; 0 otherwise)
+    /// Candidate pairs handed to the exact stage (for the hash: the vertices its scan kept, own vertices included).
+    std::int64_t candidates = 0;
+    std::int64_t nodes = 0; ///< other methods: cells, nodes or levels of the structure (0 for the hash)
 };
 
 class DetectorImpl;

@@ -5,6 +5,7 @@
 
 #include "detect_checks.hpp"
 #include "hash_grid.hpp"
+#include "partition_detect.hpp"
 #include "scan.hpp"
 #include "team.hpp"
 #include "tethash/error.hpp"
@@ -111,6 +112,8 @@ class DetectorImpl {
     detail::ObjectFlags flags;
     std::vector<Index> dynamic_ids, static_ids;
     bool any_static = false, any_self_off = false;
+    std::vector<unsigned char> tet_static; // per tet: its object is static (the other methods' broad phases)
+    detail::PartitionDetector partition;   // the methods other than the hash
     // per-scene state fixed at the first detect() after set_topology/set_params
     bool prepared = false;
     double cell_size = 0;
@@ -147,6 +150,8 @@ class DetectorImpl {
     void detect_full(const PositionsRef& positions, int T, Index m, Index num_chunks, bool with_stats,
                      Clock::time_point t_start, double& ms_vertices);
     void merge_contacts();
+    const std::vector<Contact>& detect_partition(const PositionsRef& positions, DetectStats* stats, bool first,
+                                                 Clock::time_point t_call, double ms_setup);
     void fill_stats(DetectStats& s, int T, Index m, bool reuse, double ms_vertices, double ms_sort) const;
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
     void stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs, const Index* candidates,
@@ -199,8 +204,9 @@ void DetectorImpl::prepare(const PositionsRef& positions)
                                     static_cast<std::int64_t>(static_ids.size())};
     for (int k = 0; k < 2; ++k)
         table_sizes[k] = params.table_size > 0 ? params.table_size : auto_table_size(params.hash, counts[k]);
-    // Static vertices: hashed once.
-    if (!tables[1].build(positions.data(), static_ids.data(), static_cast<Index>(static_ids.size()), cell_size, origin,
+    // Static vertices: hashed once (the hash only; the other methods keep their own structures).
+    if (params.method == Method::hash &&
+        !tables[1].build(positions.data(), static_ids.data(), static_cast<Index>(static_ids.size()), cell_size, origin,
                          table_sizes[1], params.hash, resolve_threads(params.threads)))
         diagnose_build_failure(positions, static_ids.data(), static_cast<Index>(static_ids.size()));
     prepared = true;
@@ -764,6 +770,8 @@ void DetectorImpl::fill_stats(DetectStats& s, int T, Index m, bool reuse, double
     s.memory_bytes = memory_bytes();
     s.skin = skin;
     s.reused = reuse ? 1 : 0;
+    for (const ThreadState& ts : threads)
+        s.candidates += static_cast<std::int64_t>(ts.used);
     if (skin > 0)
         for (const ThreadState& ts : threads)
             s.cached_candidates += static_cast<std::int64_t>(ts.used);
@@ -776,11 +784,14 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
         throw Error("positions has " + std::to_string(positions.rows()) + " rows, expected " +
                     std::to_string(num_vertices) + " (the number of vertices given to set_topology)");
     double ms_setup = 0; // the first call's one-off set-up, reported apart from stage 1
-    if (!prepared) {
+    const bool first = !prepared;
+    if (first) {
         prepare(positions);
         ms_setup = ms_since(t_call);
     }
     const auto t_start = Clock::now();
+    if (params.method != Method::hash && params.method != Method::automatic)
+        return detect_partition(positions, stats, first, t_call, ms_setup);
     // Automatic thread count: one thread for small scenes, where waking the others costs more than it saves
     // (fewer than 2,000 tets: well under 0.2 ms of work at one thread). An explicit count is always honoured.
     const int T = params.threads == 0 && tets.size() / 4 < 2000 ? 1 : resolve_threads(params.threads);
@@ -813,6 +824,33 @@ const std::vector<Contact>& DetectorImpl::detect(const PositionsRef& positions, 
     return contacts;
 }
 
+/// The methods other than the hash: their broad phase, the shared exact stage (partition_detect.cpp).
+const std::vector<Contact>& DetectorImpl::detect_partition(const PositionsRef& positions, DetectStats* stats,
+                                                           bool first, Clock::time_point t_call, double ms_setup)
+{
+    detail::PartitionScene scene;
+    scene.positions = positions.data();
+    scene.num_vertices = num_vertices;
+    scene.tets = tets.data();
+    scene.num_tets = static_cast<Index>(tets.size() / 4);
+    scene.moving_vertices = dynamic_ids;
+    scene.static_vertices = static_ids;
+    scene.tet_static = tet_static.data();
+    scene.cell_size = cell_size;
+    scene.params = params.partition;
+    // As the hash: one thread for small scenes unless a count is asked for.
+    scene.threads = params.threads == 0 && scene.num_tets < 2000 ? 1 : resolve_threads(params.threads);
+    scene.first = first;
+    if (!first)
+        detail::check_positions(positions, num_vertices); // non-finite coordinates (prepare() checked the first)
+    partition.detect(params.method, scene, vertex_object.data(), tet_object.data(), flags, contacts, stats);
+    if (stats) {
+        stats->ms_setup = ms_setup;
+        stats->ms_total = ms_since(t_call);
+    }
+    return contacts;
+}
+
 // ---- public wrappers -------------------------------------------------------------------------------
 
 Detector::Detector() : m_impl(std::make_unique<DetectorImpl>()) {}
@@ -829,6 +867,7 @@ void Detector::set_params(const DetectParams& params)
     detail::validate_params(params);
     m_impl->params = params;
     m_impl->prepared = false;
+    m_impl->partition.reset();
 }
 
 const DetectParams& Detector::params() const
@@ -855,6 +894,11 @@ void Detector::set_topology(const TetsRef& tets, Index num_vertices, std::span<c
     d.any_static = std::any_of(d.flags.is_static.begin(), d.flags.is_static.end(), [](unsigned char c) { return c; });
     d.any_self_off =
         std::any_of(d.flags.self_collision.begin(), d.flags.self_collision.end(), [](unsigned char c) { return !c; });
+    d.tet_static.resize(static_cast<std::size_t>(m));
+    for (Index t = 0; t < m; ++t)
+        d.tet_static[static_cast<std::size_t>(t)] =
+            d.flags.is_static[static_cast<std::size_t>(d.tet_object[static_cast<std::size_t>(t)])];
+    d.partition.reset();
     d.dynamic_ids.clear();
     d.static_ids.clear();
     for (Index v = 0; v < num_vertices; ++v)

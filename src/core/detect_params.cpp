@@ -6,6 +6,7 @@
 #include "tethash/error.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -142,6 +143,63 @@ void parse_skin(const std::string& text, DetectParams& params, const std::string
     params.skin = v;
 }
 
+namespace {
+
+struct MethodName {
+    Method method;
+    const char* name;
+};
+constexpr MethodName method_names[] = {
+    {Method::hash, "hash"},
+    {Method::brute_force, "brute"},
+    {Method::uniform_grid, "grid"},
+    {Method::hierarchical_grid, "hgrid"},
+    {Method::octree, "octree"},
+    {Method::octree_point, "octree-point"},
+    {Method::octree_loose, "octree-loose"},
+    {Method::kd_tree, "kd"},
+    {Method::kd_tree_point, "kd-point"},
+    {Method::bsp_tree, "bsp"},
+    {Method::bsp_tree_balanced, "bsp-balanced"},
+    {Method::sort_sweep, "sort-sweep"},
+    {Method::bvh, "bvh"},
+    {Method::bvh_refit, "bvh-refit"},
+    {Method::automatic, "auto"},
+};
+constexpr std::size_t num_methods = sizeof method_names / sizeof method_names[0];
+
+// The methods in the order of method_names, without `automatic` (the last entry).
+constexpr auto method_list = [] {
+    std::array<Method, num_methods - 1> out{};
+    for (std::size_t k = 0; k + 1 < num_methods; ++k)
+        out[k] = method_names[k].method;
+    return out;
+}();
+
+} // namespace
+
+Method parse_method(const std::string& text, const std::string& option)
+{
+    std::string names;
+    for (const MethodName& m : method_names) {
+        if (text == m.name) return m.method;
+        names += names.empty() ? m.name : std::string(", ") + m.name;
+    }
+    throw Error(option + ": unknown method '" + text + "' (expected one of " + names + ")");
+}
+
+const char* to_string(Method m)
+{
+    for (const MethodName& n : method_names)
+        if (n.method == m) return n.name;
+    return "?";
+}
+
+std::span<const Method> all_methods()
+{
+    return method_list;
+}
+
 HashFunction parse_hash_function(const std::string& name)
 {
     if (name == "teschner") return HashFunction::teschner;
@@ -184,6 +242,20 @@ void validate_params(const DetectParams& p)
         throw Error("skin mode out of range: " + std::to_string(static_cast<int>(p.skin_mode)));
     if (p.hash != HashFunction::teschner && p.hash != HashFunction::column)
         throw Error("hash function out of range: " + std::to_string(static_cast<int>(p.hash)));
+    if (std::string(to_string(p.method)) == "?")
+        throw Error("method out of range: " + std::to_string(static_cast<int>(p.method)));
+    const PartitionParams& q = p.partition;
+    if (q.max_depth < 0 || q.max_depth > 40)
+        throw Error("max_depth must be 1..40 (or 0 for the method's default), got " + std::to_string(q.max_depth));
+    if (q.leaf_size < 0)
+        throw Error("leaf_size must be ≥ 1 (or 0 for the method's default), got " + std::to_string(q.leaf_size));
+    if (!(q.looseness == 0 || (q.looseness >= 1 && q.looseness <= 16))) {
+        std::ostringstream s;
+        s << "looseness must be 1..16 (or 0 for the default 2), got " << q.looseness;
+        throw Error(s.str());
+    }
+    if (q.levels < 0 || q.levels > 32)
+        throw Error("levels must be 1..32 (or 0 for as many as the tet sizes span), got " + std::to_string(q.levels));
 }
 
 } // namespace detail

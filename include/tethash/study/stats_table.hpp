@@ -37,7 +37,7 @@ struct StatField {
 
 /// Every field of DetectStats once (tests/test_study_stats_table.cpp checks it), plus derived ratios.
 /// Order: the parameters used, the scene, the work counters, the result and memory, candidate reuse, the timings.
-inline constexpr std::array<StatField, 26> k_detect_stats = {{
+inline constexpr std::array<StatField, 28> k_detect_stats = {{
     {"cell_size", "length", StatKind::real, [](const DetectStats& s) { return s.cell_size; },
      in_study | in_detect | in_bench, "cell"},
     {"table_size", "buckets", StatKind::count, [](const DetectStats& s) { return double(s.table_size); },
@@ -62,6 +62,9 @@ inline constexpr std::array<StatField, 26> k_detect_stats = {{
      in_study | in_detect | in_bench, "box-rejected"},
     {"own_vertex_skips", "", StatKind::count, [](const DetectStats& s) { return double(s.own_vertex_skips); },
      in_study | in_detect | in_bench, "own"},
+    {"candidates", "", StatKind::count, [](const DetectStats& s) { return double(s.candidates); }, in_study | in_detect,
+     nullptr},
+    {"nodes", "", StatKind::count, [](const DetectStats& s) { return double(s.nodes); }, in_study | in_detect, nullptr},
     {"inside_tests", "", StatKind::count, [](const DetectStats& s) { return double(s.inside_tests); },
      in_study | in_detect | in_bench, "inside tests"},
     {"exact_fallbacks", "", StatKind::count, [](const DetectStats& s) { return double(s.exact_fallbacks); },

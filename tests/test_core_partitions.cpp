@@ -1,0 +1,246 @@
+// Every broad phase (DetectParams::method) against the brute-force oracle: the same contacts bit for bit over the
+// scenes of the hash's own tests (random, inverted, lattice-aligned, offset, coincident, collapsed, object rules),
+// over each method's parameters, over moving scenes (structures kept across calls: refits, sweep orders, static
+// parts) and over thread counts.
+#include "core_scenes.hpp"
+#include "support.hpp"
+#include "tethash/detect.hpp"
+#include "tethash/error.hpp"
+#include "tethash/oracle.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+using namespace tethash;
+using tethash::test::expect_error;
+using tethash::test::identical;
+using tethash::test::same_contacts;
+using tethash::test::Scene;
+
+namespace {
+/// The methods under test.
+std::vector<Method> methods()
+{
+    return {Method::hash, Method::brute_force};
+}
+} // namespace
+
+namespace {
+
+std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
+{
+    return brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects, stats);
+}
+
+/// Parameter variants per method: cell sizes for the grids, depths and leaf sizes for the trees, looseness,
+/// levels, 1 and 2 threads; combined differently per seed.
+std::vector<DetectParams> variants(Method method, std::uint32_t seed)
+{
+    const double cells[] = {0.3, 1.0, 2.5, 1.0 / 8};
+    const int depths[] = {0, 1, 3, 12};
+    const int leaves[] = {0, 1, 4, 64};
+    const double loose[] = {0, 1, 1.5, 4};
+    const int levels[] = {0, 1, 2, 6};
+    std::vector<DetectParams> out;
+    for (unsigned k = 0; k < 4; ++k) {
+        DetectParams p;
+        p.method = method;
+        p.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
+        p.cell_size = cells[(k + seed) % 4];
+        p.partition.max_depth = depths[(k + 2 * seed) % 4];
+        p.partition.leaf_size = leaves[(k + 3 * seed) % 4];
+        p.partition.looseness = loose[(k + seed) % 4];
+        p.partition.levels = levels[(k + 5 * seed) % 4];
+        p.threads = 1 + static_cast<int>(k % 2);
+        out.push_back(p);
+    }
+    return out;
+}
+
+std::string describe(const DetectParams& p)
+{
+    return std::string(to_string(p.method)) + " cell ×" + std::to_string(p.cell_size) + " depth " +
+           std::to_string(p.partition.max_depth) + " leaf " + std::to_string(p.partition.leaf_size) + " loose " +
+           std::to_string(p.partition.looseness) + " levels " + std::to_string(p.partition.levels) + " threads " +
+           std::to_string(p.threads);
+}
+
+/// Every method and variant on scene `s` equals the oracle; with and without statistics the same contacts.
+void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
+{
+    OracleStats os;
+    const std::vector<Contact> want = run_oracle(s, &os);
+    for (Method method : methods())
+        for (const DetectParams& p : variants(method, seed)) {
+            Detector det(p);
+            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object,
+                             s.objects);
+            const std::vector<Contact> lean = det.detect(s.positions);
+            DetectStats st;
+            const std::vector<Contact>& full = det.detect(s.positions, &st);
+            EXPECT_TRUE(same_contacts(full, want)) << what << " seed " << seed << ": " << describe(p);
+            EXPECT_TRUE(identical(lean, full)) << what << ": " << describe(p) << ": with and without statistics";
+            EXPECT_EQ(st.contacts, static_cast<std::int64_t>(want.size()));
+            EXPECT_EQ(st.degenerate_tets, os.degenerate_tets) << what << ": " << describe(p);
+            EXPECT_GE(st.candidates, st.contacts) << describe(p);
+        }
+}
+
+} // namespace
+
+TEST(CorePartitions, RandomDeformedAndInverted)
+{
+    for (std::uint32_t seed = 1; seed <= 4; ++seed)
+        check_scene(test::random_scene(seed, 3 + seed % 3, 3, 0.3), seed, "random");
+    for (std::uint32_t seed = 20; seed < 23; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 1.2);
+        for (Eigen::Index t = 0; t < s.tets.rows(); t += 7)
+            std::swap(s.tets(t, 0), s.tets(t, 1));
+        check_scene(s, seed, "inverted");
+    }
+}
+
+TEST(CorePartitions, LatticeAlignedContactsOnFacesEdgesCorners)
+{
+    const double h = 0.25;
+    const Eigen::Vector3d shifts[] = {{h / 2, 0, 0}, {h / 2, h / 2, h / 2}, {h, h, 0}, {0, 0, 0}};
+    const Eigen::Vector3d origins[] = {{0, 0, 0}, {1e6, 1e6, -1e6}};
+    std::uint32_t seed = 0;
+    for (const auto& o : origins)
+        for (const auto& sh : shifts) {
+            const Scene s = test::lattice_pair(3, h, sh, o);
+            ASSERT_FALSE(run_oracle(s).empty());
+            check_scene(s, seed++, "lattice");
+        }
+}
+
+TEST(CorePartitions, CoincidentVerticesFlatAndCollapsedTets)
+{
+    for (std::uint32_t seed = 40; seed < 43; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 0.3);
+        s.positions.col(1).array() -= 12345.5;
+        std::mt19937 rng(seed);
+        std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
+        for (int k = 0; k < 25; ++k)
+            s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
+        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
+            s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+        for (Eigen::Index t = 2; t < s.tets.rows(); t += 37)
+            s.tets(t, 3) = s.tets(t, t % 3);
+        OracleStats os;
+        run_oracle(s, &os);
+        EXPECT_GT(os.degenerate_tets, 0);
+        check_scene(s, seed, "coincident");
+    }
+}
+
+TEST(CorePartitions, SelfCollisionOffAndStaticObjects)
+{
+    for (std::uint32_t seed = 50; seed < 54; ++seed) {
+        Scene s = test::random_scene(seed, 4, 3, 0.9);
+        s.objects.resize(4);
+        s.objects[seed % 4].self_collision = false;
+        s.objects[(seed + 1) % 4].is_static = true;
+        s.objects[(seed + 2) % 4].is_static = (seed % 2) != 0;
+        check_scene(s, seed, "objects");
+    }
+}
+
+TEST(CorePartitions, TetSizesSpanningDecades)
+{
+    // Objects of cube edge 0.01, 0.1 and 1 overlapping: the case the hierarchical grid is for.
+    Scene s = test::lattice_object(3, 3, 3, 0.01, Eigen::Vector3d(0.1, 0.1, 0.1));
+    test::append_object(s, test::lattice_object(3, 3, 3, 0.1, Eigen::Vector3d(0.05, 0.05, 0.05)));
+    test::append_object(s, test::lattice_object(2, 2, 2, 1.0, Eigen::Vector3d(-0.3, -0.2, -0.1)));
+    ASSERT_FALSE(run_oracle(s).empty());
+    check_scene(s, 7, "decades");
+}
+
+TEST(CorePartitions, MovingScenesKeepTheirStructuresExact)
+{
+    // Structures kept across calls (refitted trees, sort orders, static parts) must follow the motion: one object
+    // flies through the others, the rest jitter, object 0 is static.
+    Scene s = test::random_scene(81, 4, 3, 0.3);
+    s.objects.resize(4);
+    s.objects[0].is_static = true;
+    for (Method method : methods()) {
+        for (int threads : {1, 2}) {
+            DetectParams p;
+            p.method = method;
+            p.threads = threads;
+            Detector det(p);
+            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object,
+                             s.objects);
+            Scene moving = s;
+            std::mt19937 rng(5);
+            std::uniform_real_distribution<double> u(-0.02, 0.02);
+            for (int step = 0; step < 8; ++step) {
+                for (Eigen::Index v = 0; v < moving.positions.rows(); ++v) {
+                    if (moving.vertex_object[static_cast<std::size_t>(v)] == 0) continue;
+                    for (int a = 0; a < 3; ++a)
+                        moving.positions(v, a) += u(rng);
+                    if (moving.vertex_object[static_cast<std::size_t>(v)] == 3) moving.positions(v, 0) += 0.3;
+                }
+                EXPECT_TRUE(same_contacts(det.detect(moving.positions), run_oracle(moving)))
+                    << to_string(method) << " threads " << threads << " step " << step;
+            }
+        }
+    }
+}
+
+TEST(CorePartitions, DeterministicAcrossThreadCounts)
+{
+    const Scene s = test::random_scene(77, 8, 4, 0.4);
+    for (Method method : methods()) {
+        DetectParams p;
+        p.method = method;
+        p.threads = 1;
+        Detector one(p);
+        one.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+        const std::vector<Contact> a = one.detect(s.positions);
+        ASSERT_FALSE(a.empty());
+        for (int threads : {2, 3}) {
+            p.threads = threads;
+            Detector det(p);
+            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+            EXPECT_TRUE(identical(a, det.detect(s.positions))) << to_string(method) << " threads " << threads;
+        }
+    }
+}
+
+TEST(CorePartitions, EmptyAndSingleTetScenes)
+{
+    const Scene one = test::lattice_object(1, 1, 1, 1.0, Eigen::Vector3d::Zero());
+    for (Method method : methods()) {
+        DetectParams p;
+        p.method = method;
+        Detector det(p);
+        det.set_topology(Tets(0, 4), 0);
+        EXPECT_TRUE(det.detect(Positions(0, 3)).empty()) << to_string(method);
+        det.set_topology(one.tets, static_cast<Index>(one.positions.rows()));
+        EXPECT_TRUE(same_contacts(det.detect(one.positions), run_oracle(one))) << to_string(method);
+    }
+}
+
+TEST(CorePartitions, NamesAndParameterErrors)
+{
+    for (Method m : methods())
+        EXPECT_EQ(parse_method(to_string(m)), m);
+    EXPECT_EQ(parse_method("auto"), Method::automatic);
+    expect_error([] { parse_method("quadtree"); }, {"--method: unknown method 'quadtree' (expected one of hash, brute"});
+    expect_error([] { parse_method("kd3", "scene.toml: method"); }, {"scene.toml: method: unknown method 'kd3'"});
+    DetectParams p;
+    p.partition.max_depth = 41;
+    expect_error([&] { Detector d(p); }, {"max_depth must be 1..40"});
+    p = DetectParams{};
+    p.partition.looseness = 0.5;
+    expect_error([&] { Detector d(p); }, {"looseness must be 1..16"});
+    p = DetectParams{};
+    p.partition.leaf_size = -1;
+    expect_error([&] { Detector d(p); }, {"leaf_size must be ≥ 1"});
+    p = DetectParams{};
+    p.method = static_cast<Method>(99);
+    expect_error([&] { Detector d(p); }, {"method out of range"});
+}
