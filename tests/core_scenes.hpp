@@ -165,4 +165,25 @@ inline Scene lattice_pair(int cubes, double h, const Eigen::Vector3d& shift, con
     return s;
 }
 
+/// Object rules of the random scene `seed` of 4 objects: one object without self-collision, one or two static.
+inline void set_object_rules(Scene& s, std::uint32_t seed)
+{
+    s.objects.resize(4);
+    s.objects[seed % 4].self_collision = false;
+    s.objects[(seed + 1) % 4].is_static = true;
+    s.objects[(seed + 2) % 4].is_static = (seed % 2) != 0;
+}
+
+/// Coincident vertices (25 random pairs of distinct ids, across and within objects; tets holding both become
+/// flat) and flat tets (one vertex of every 41st tet moved exactly onto another of its vertices).
+inline void make_coincident(Scene& s, std::uint32_t seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
+    for (int k = 0; k < 25; ++k)
+        s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
+    for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
+        s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+}
+
 } // namespace tethash::test

@@ -135,14 +135,7 @@ TEST(CoreDetect, CoincidentVerticesAndFlatTets)
 {
     for (std::uint32_t seed = 40; seed < 46; ++seed) {
         Scene s = test::random_scene(seed, 3, 3, 0.3);
-        std::mt19937 rng(seed);
-        std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
-        // Coincident vertices (distinct ids, across and within objects): tets holding both become flat.
-        for (int k = 0; k < 25; ++k)
-            s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
-        // Flat tets: one vertex moved exactly onto another vertex of the same tet.
-        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
-            s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+        test::make_coincident(s, seed);
         // A vertex exactly at a corner of a tet of another object.
         s.positions.row(0) = s.positions.row(s.tets(s.tets.rows() - 1, 2)).eval();
         OracleStats os;
@@ -180,10 +173,7 @@ TEST(CoreDetect, SelfCollisionOffAndStaticObjects)
 {
     for (std::uint32_t seed = 50; seed < 56; ++seed) {
         Scene s = test::random_scene(seed, 4, 3, 0.9);
-        s.objects.resize(4);
-        s.objects[seed % 4].self_collision = false;
-        s.objects[(seed + 1) % 4].is_static = true;
-        s.objects[(seed + 2) % 4].is_static = (seed % 2) != 0;
+        test::set_object_rules(s, seed);
         const std::vector<Contact> want = run_oracle(s);
         for (const Contact& c : want) {
             EXPECT_FALSE(s.objects[c.vertex_object].is_static && s.objects[c.tet_object].is_static);

@@ -68,15 +68,15 @@ std::string describe(const DetectParams& p)
 }
 
 /// Every method and variant on scene `s` equals the oracle; with and without statistics the same contacts.
-void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
+/// Returns the oracle's count of degenerate tets.
+std::int64_t check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
 {
     OracleStats os;
     const std::vector<Contact> want = run_oracle(s, &os);
     for (Method method : methods())
         for (const DetectParams& p : variants(method, seed)) {
             Detector det(p);
-            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object,
-                             s.objects);
+            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
             const std::vector<Contact> lean = det.detect(s.positions);
             DetectStats st;
             const std::vector<Contact>& full = det.detect(s.positions, &st);
@@ -86,6 +86,7 @@ void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
             EXPECT_EQ(st.degenerate_tets, os.degenerate_tets) << what << ": " << describe(p);
             EXPECT_GE(st.candidates, st.contacts) << describe(p);
         }
+    return os.degenerate_tets;
 }
 
 } // namespace
@@ -121,18 +122,10 @@ TEST(CorePartitions, CoincidentVerticesFlatAndCollapsedTets)
     for (std::uint32_t seed = 40; seed < 43; ++seed) {
         Scene s = test::random_scene(seed, 3, 3, 0.3);
         s.positions.col(1).array() -= 12345.5;
-        std::mt19937 rng(seed);
-        std::uniform_int_distribution<Index> pick(0, static_cast<Index>(s.positions.rows()) - 1);
-        for (int k = 0; k < 25; ++k)
-            s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
-        for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
-            s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+        test::make_coincident(s, seed);
         for (Eigen::Index t = 2; t < s.tets.rows(); t += 37)
             s.tets(t, 3) = s.tets(t, t % 3);
-        OracleStats os;
-        run_oracle(s, &os);
-        EXPECT_GT(os.degenerate_tets, 0);
-        check_scene(s, seed, "coincident");
+        EXPECT_GT(check_scene(s, seed, "coincident"), 0) << "degenerate tets";
     }
 }
 
@@ -140,10 +133,7 @@ TEST(CorePartitions, SelfCollisionOffAndStaticObjects)
 {
     for (std::uint32_t seed = 50; seed < 54; ++seed) {
         Scene s = test::random_scene(seed, 4, 3, 0.9);
-        s.objects.resize(4);
-        s.objects[seed % 4].self_collision = false;
-        s.objects[(seed + 1) % 4].is_static = true;
-        s.objects[(seed + 2) % 4].is_static = (seed % 2) != 0;
+        test::set_object_rules(s, seed);
         check_scene(s, seed, "objects");
     }
 }
@@ -171,8 +161,7 @@ TEST(CorePartitions, MovingScenesKeepTheirStructuresExact)
             p.method = method;
             p.threads = threads;
             Detector det(p);
-            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object,
-                             s.objects);
+            det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
             Scene moving = s;
             std::mt19937 rng(5);
             std::uniform_real_distribution<double> u(-0.02, 0.02);
@@ -229,7 +218,8 @@ TEST(CorePartitions, NamesAndParameterErrors)
     for (Method m : methods())
         EXPECT_EQ(parse_method(to_string(m)), m);
     EXPECT_EQ(parse_method("auto"), Method::automatic);
-    expect_error([] { parse_method("quadtree"); }, {"--method: unknown method 'quadtree' (expected one of hash, brute"});
+    expect_error([] { parse_method("quadtree"); },
+                 {"--method: unknown method 'quadtree' (expected one of hash, brute"});
     expect_error([] { parse_method("kd3", "scene.toml: method"); }, {"scene.toml: method: unknown method 'kd3'"});
     DetectParams p;
     p.partition.max_depth = 41;

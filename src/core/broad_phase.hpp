@@ -19,8 +19,8 @@ struct PartitionScene {
     Index num_vertices = 0;
     const Index* tets = nullptr; ///< num_tets × 4
     Index num_tets = 0;
-    std::span<const Index> moving_vertices; ///< vertices of objects that are not static, increasing
-    std::span<const Index> static_vertices; ///< vertices of static objects, increasing
+    std::span<const Index> moving_vertices;    ///< vertices of objects that are not static, increasing
+    std::span<const Index> static_vertices;    ///< vertices of static objects, increasing
     const unsigned char* tet_static = nullptr; ///< per tet: 1 when its object is static
     double cell_size = 1;                      ///< the detector's cell size (the grids' cell, the hash's l)
     PartitionParams params;                    ///< as set; 0 fields mean the method's default

@@ -104,8 +104,9 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
     m_all.clear();
     for (const auto& f : m_found)
         m_all.insert(m_all.end(), f.begin(), f.end());
-    std::sort(m_all.begin(), m_all.end(),
-              [](const Found& a, const Found& b) { return a.vertex < b.vertex || (a.vertex == b.vertex && a.tet < b.tet); });
+    std::sort(m_all.begin(), m_all.end(), [](const Found& a, const Found& b) {
+        return a.vertex < b.vertex || (a.vertex == b.vertex && a.tet < b.tet);
+    });
     contacts.resize(m_all.size());
     for (std::size_t i = 0; i < m_all.size(); ++i) {
         Contact& c = contacts[i];
