@@ -96,8 +96,8 @@ void check_queries(const SplitTree& tree, const std::vector<SplitBox>& items, co
         tree.query(queries[k], got, scratch);
         auto sorted = got;
         std::sort(sorted.begin(), sorted.end());
-        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << what << " query " << k
-                                                                                  << ": an item twice";
+        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end())
+            << what << " query " << k << ": an item twice";
         ASSERT_EQ(sorted, expect) << what << " query " << k;
         got2.assign(3, 7); // appends after what is there
         tree.query(queries[k], got2);

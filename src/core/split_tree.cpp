@@ -57,8 +57,8 @@ double max_abs(const SplitBox& b)
 
 bool overlaps(const SplitBox& a, const SplitBox& b)
 {
-    return a.lo[0] <= b.hi[0] && a.hi[0] >= b.lo[0] && a.lo[1] <= b.hi[1] && a.hi[1] >= b.lo[1] &&
-           a.lo[2] <= b.hi[2] && a.hi[2] >= b.lo[2];
+    return a.lo[0] <= b.hi[0] && a.hi[0] >= b.lo[0] && a.lo[1] <= b.hi[1] && a.hi[1] >= b.lo[1] && a.lo[2] <= b.hi[2] &&
+           a.hi[2] >= b.lo[2];
 }
 
 Vec unit_axis(int a)
@@ -78,12 +78,18 @@ bool is_region_rule(SplitRule r)
 std::string_view split_rule_name(SplitRule rule)
 {
     switch (rule) {
-    case SplitRule::region_octree: return "octree";
-    case SplitRule::point_octree: return "octree-point";
-    case SplitRule::region_kd: return "kd";
-    case SplitRule::point_kd: return "kd-point";
-    case SplitRule::bsp: return "bsp";
-    case SplitRule::bsp_balanced: return "bsp-balanced";
+    case SplitRule::region_octree:
+        return "octree";
+    case SplitRule::point_octree:
+        return "octree-point";
+    case SplitRule::region_kd:
+        return "kd";
+    case SplitRule::point_kd:
+        return "kd-point";
+    case SplitRule::bsp:
+        return "bsp";
+    case SplitRule::bsp_balanced:
+        return "bsp-balanced";
     }
     return "?";
 }
@@ -187,8 +193,8 @@ double SplitTree::median(std::size_t begin, std::size_t end, const Vec& dir, boo
     return std::isfinite(next) ? next : m;
 }
 
-void SplitTree::build_node(std::uint32_t node, std::size_t begin, std::size_t end, int depth,
-                           const SplitBox& region, const Vec& parent_ref, bool has_parent_ref)
+void SplitTree::build_node(std::uint32_t node, std::size_t begin, std::size_t end, int depth, const SplitBox& region,
+                           const Vec& parent_ref, bool has_parent_ref)
 {
     const std::size_t n = end - begin;
     if (n <= static_cast<std::size_t>(m_params.leaf_size) || depth >= m_depth_limit) {
@@ -250,9 +256,8 @@ void SplitTree::build_node(std::uint32_t node, std::size_t begin, std::size_t en
             // Balance heuristic: the paper's normal, the 3 axes and the 3 face diagonals, each with the plane at
             // the median of the projected centres; the one whose larger side (straddlers counted) is smallest.
             const double r = 1 / std::sqrt(2.0);
-            const std::array<Vec, 7> candidates{normal,       unit_axis(0), unit_axis(1),
-                                                unit_axis(2), Vec{r, r, 0}, Vec{r, 0, r},
-                                                Vec{0, r, r}};
+            const std::array<Vec, 7> candidates{normal,       unit_axis(0), unit_axis(1), unit_axis(2),
+                                                Vec{r, r, 0}, Vec{r, 0, r}, Vec{0, r, r}};
             std::size_t best_cost = std::numeric_limits<std::size_t>::max();
             for (const Vec& c : candidates) {
                 const double off = median(begin, end, c, true);
@@ -320,8 +325,7 @@ void SplitTree::build_node(std::uint32_t node, std::size_t begin, std::size_t en
             const std::size_t a = split.axis;
             (k == 1 ? sub.lo[a] : sub.hi[a]) = std::clamp(split.value[a], region.lo[a], region.hi[a]);
         }
-        build_node(first + static_cast<std::uint32_t>(k), bounds[k], bounds[k + 1], depth + 1, sub, ref,
-                   bsp_rule);
+        build_node(first + static_cast<std::uint32_t>(k), bounds[k], bounds[k + 1], depth + 1, sub, ref, bsp_rule);
     }
     m_work.resize(bounds[0]);
 }
@@ -365,8 +369,7 @@ bool SplitTree::partition(const Node& split, std::size_t begin, std::size_t end,
     return true;
 }
 
-template <class Emit>
-void SplitTree::walk(std::uint32_t node, const SplitBox& q, double q_scale, Emit& emit) const
+template <class Emit> void SplitTree::walk(std::uint32_t node, const SplitBox& q, double q_scale, Emit& emit) const
 {
     const Node& nd = m_nodes[node];
     switch (nd.kind) {
@@ -470,9 +473,9 @@ SplitTreeStats SplitTree::stats() const
     s.max_depth = m_reached;
     s.items = static_cast<std::int64_t>(m_boxes.size());
     s.items_stored = static_cast<std::int64_t>(m_items.size());
-    s.bytes = static_cast<std::int64_t>(m_nodes.capacity() * sizeof(Node) + m_items.capacity() * 4 +
-                                        m_leaves.capacity() * 4 + m_boxes.capacity() * sizeof(SplitBox) +
-                                        m_is_point.capacity());
+    s.bytes =
+        static_cast<std::int64_t>(m_nodes.capacity() * sizeof(Node) + m_items.capacity() * 4 + m_leaves.capacity() * 4 +
+                                  m_boxes.capacity() * sizeof(SplitBox) + m_is_point.capacity());
     return s;
 }
 
