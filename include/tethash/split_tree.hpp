@@ -129,6 +129,7 @@ class SplitTree {
     std::vector<std::uint32_t> m_leaves; ///< node index of each leaf
     std::vector<std::uint32_t> m_work;   ///< build: item lists of the nodes on the current path
     std::vector<double> m_values;        ///< build: median selection
+    std::vector<std::uint8_t> m_sides;   ///< build: sides each item of a node reaches
     double m_scale = 0;                  ///< max |coordinate| of the items (plane margins)
     int m_reached = 0;
     bool m_duplicates = false;

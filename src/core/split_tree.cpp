@@ -337,27 +337,41 @@ bool SplitTree::partition(const Node& split, std::size_t begin, std::size_t end,
 {
     const std::size_t n = end - begin;
     bounds[0] = m_work.size(); // the children's lists go after every list on the path
-    std::size_t full = 0;
-    for (std::size_t k = 0; k < children; ++k) {
-        for (std::size_t i = begin; i < end; ++i) {
-            const std::uint32_t id = m_work[i];
-            const SplitBox& b = m_boxes[id];
-            bool in = true;
-            if (split.kind == 2) {
-                for (std::size_t a = 0; a < 3 && in; ++a)
-                    in = (k >> a) & 1U ? b.hi[a] >= split.value[a] : b.lo[a] < split.value[a];
-            } else if (split.kind == 1) {
-                const std::size_t a = split.axis;
-                in = k == 1 ? b.hi[a] >= split.value[a] : b.lo[a] < split.value[a];
-            } else if (m_is_point[id]) {
-                const double f = dot(split.value, b.lo) - split.offset;
-                in = k == 1 ? f >= 0 : f < 0;
-            } else {
-                double lo, hi;
-                plane_range(b, split.value, split.offset, lo, hi);
-                in = k == 1 ? hi >= -split.margin : lo <= split.margin;
+    // One pass classifies every item (bits 0-2: reaches the lower side of plane 0-2; bits 3-5: the upper side;
+    // one plane uses bit 0 and bit 3, bits 1-2 set), then each child collects the items reaching all its sides.
+    m_sides.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t id = m_work[begin + i];
+        const SplitBox& b = m_boxes[id];
+        unsigned low = 0, high = 0;
+        if (split.kind == 2) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                low |= b.lo[a] < split.value[a] ? 1U << a : 0U;
+                high |= b.hi[a] >= split.value[a] ? 1U << a : 0U;
             }
-            if (in) m_work.push_back(id);
+        } else if (split.kind == 1) {
+            const std::size_t a = split.axis;
+            low = (b.lo[a] < split.value[a] ? 1U : 0U) | 6U;
+            high = b.hi[a] >= split.value[a] ? 1U : 0U;
+        } else if (m_is_point[id]) {
+            const double f = dot(split.value, b.lo) - split.offset;
+            low = (f < 0 ? 1U : 0U) | 6U;
+            high = f < 0 ? 0U : 1U;
+        } else {
+            double lo, hi;
+            plane_range(b, split.value, split.offset, lo, hi);
+            low = (lo <= split.margin ? 1U : 0U) | 6U;
+            high = hi >= -split.margin ? 1U : 0U;
+        }
+        m_sides[i] = static_cast<std::uint8_t>(low | high << 3);
+    }
+    std::size_t full = 0;
+    for (unsigned k = 0; k < children; ++k) {
+        for (std::size_t i = 0; i < n; ++i) {
+            const unsigned low = m_sides[i] & 7U, high = m_sides[i] >> 3;
+            if (((k & ~high) | (~k & 7U & ~low)) != 0) continue;
+            const std::uint32_t id = m_work[begin + i];
+            m_work.push_back(id);
         }
         bounds[k + 1] = m_work.size();
         full += bounds[k + 1] - bounds[k] == n ? 1 : 0;
