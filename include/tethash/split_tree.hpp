@@ -1,8 +1,9 @@
 #pragma once
 /// \file split_tree.hpp
 /// One splitting-plane tree over axis-aligned boxes, parameterised by its splitting rule: the region and
-/// point octree, the region and point k-d tree and the BSP tree of the comparison of Luque, Comba and
-/// Freitas (2005) are the same structure with different planes. A point is a box with lo == hi.
+/// point octree, the region and point k-d tree and the BSP tree (as compared experimentally in the literature
+/// the project reproduces, docs/partitions.md) are the same structure with different planes. A point is a box
+/// with lo == hi.
 ///
 /// Exact broad phase: `query` reports every item whose closed box intersects the closed query box, each
 /// once, and nothing else. Items straddling a plane are stored in both children; point items never

@@ -1,6 +1,6 @@
 #pragma once
 /// \file study/spheres.hpp
-/// The experiment of the comparison of octree, k-d tree and BSP tree (Luque, Comba and Freitas 2005): spheres
+/// The experiment of the comparison of octree, k-d tree and BSP tree reproduced in docs/results.md: spheres
 /// dropped one per frame into the unit box, gravity, sphere-sphere tests and a positional response, a new
 /// splitting-plane tree per frame (split_tree.hpp). Every method detects on the same positions each frame; the
 /// response uses the one sorted list of colliding pairs, and every method's list must equal it (else
