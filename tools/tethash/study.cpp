@@ -272,7 +272,7 @@ Registrar reg{
          sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
          sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
          sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
-         sub.add_option("-o,--out", a->out, "output folder, made if missing (default: study)");
+         sub.add_option("-o,--out", a->out, "output folder, made if missing (default: study; spheres: spheres)");
          sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
          sub.add_flag("--quiet", a->quiet, "no progress output");
          add_spheres_options(sub, a->spheres);
