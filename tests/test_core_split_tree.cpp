@@ -1,5 +1,6 @@
 // The splitting-plane tree (octree, k-d, BSP rules): every query equals a brute-force scan of closed box
-// overlaps, each item once; leaves cover every item; depth and leaf-size limits; statistics; bad arguments.
+// overlaps, each item once; leaves cover every item; depth and leaf-size limits; statistics; bad arguments;
+// concurrent queries.
 #include "tethash/error.hpp"
 #include "tethash/split_tree.hpp"
 
@@ -321,4 +322,30 @@ TEST(SplitTree, NamesAndBadArguments)
     inverted.lo = {1, 0, 0};
     inverted.hi = {0, 1, 1};
     EXPECT_THROW(tree.build(std::vector<SplitBox>{inverted}), Error);
+}
+
+TEST(SplitTree, ConcurrentQueriesEqualSerial)
+{
+    // query is const: several threads on one tree, each with its own scratch, give the serial answers.
+    std::mt19937 rng(20);
+    const auto items = random_boxes(rng, 400, 0.3); // straddlers: the scratch path
+    const auto queries = random_boxes(rng, 400, 0.4);
+    for (SplitRule r : kRules) {
+        SplitTree tree({r, 6, 2});
+        tree.build(items);
+        ASSERT_TRUE(tree.stores_duplicates()) << split_rule_name(r);
+        std::vector<std::vector<std::uint32_t>> serial(queries.size()), parallel(queries.size());
+        SplitTreeScratch s;
+        for (std::size_t k = 0; k < queries.size(); ++k)
+            tree.query(queries[k], serial[k], s);
+        const auto count = static_cast<std::int64_t>(queries.size());
+#pragma omp parallel num_threads(4)
+        {
+            SplitTreeScratch mine;
+#pragma omp for schedule(dynamic, 7)
+            for (std::int64_t k = 0; k < count; ++k)
+                tree.query(queries[static_cast<std::size_t>(k)], parallel[static_cast<std::size_t>(k)], mine);
+        }
+        EXPECT_EQ(serial, parallel) << split_rule_name(r);
+    }
 }
