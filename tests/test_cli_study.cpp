@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <initializer_list>
 #include <thread>
 
 namespace tethash {
@@ -25,46 +26,57 @@ std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 
 using test::deterministic;
 
+/// Runs `tethash study ARGS --out DIR/s`, which must succeed, and reads its DIR/s/study.csv into `t`, which must
+/// have each of `columns`. `err`, when given, receives the run's standard error.
+void run_study(const std::string& args, const std::filesystem::path& dir, std::initializer_list<const char*> columns,
+               Table& t, std::string* err = nullptr)
+{
+    const auto r = run_tethash("study " + args + " --out " + quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    if (err) *err = r.err;
+    t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : columns)
+        ASSERT_GE(t.index_of(col), 0) << col;
+}
+
 TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
 {
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir);
-    const auto r = run_tethash("study cell-size --mesh " + mesh +
-                               " --from 0.25 --to 4 --points 5 --table-size 1,x1 "
-                               "--repeat 2 --no-plot --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"point",
-                            "repeat",
-                            "scene",
-                            "cell_factor",
-                            "cell_size",
-                            "table_size",
-                            "hash",
-                            "threads",
-                            "vertices",
-                            "tets",
-                            "cells_visited",
-                            "entries_scanned",
-                            "hash_collisions",
-                            "box_rejections",
-                            "own_vertex_skips",
-                            "inside_tests",
-                            "exact_fallbacks",
-                            "degenerate_tets",
-                            "contacts",
-                            "table_load",
-                            "memory_bytes",
-                            "oracle_contacts",
-                            "missed",
-                            "extra",
-                            "ms_total",
-                            "ms_vertices",
-                            "ms_tets",
-                            "ms_inside",
-                            "ms_sort"})
-        EXPECT_GE(t.index_of(col), 0) << col;
+    Table t;
+    std::string err;
+    ASSERT_NO_FATAL_FAILURE(run_study(
+        "cell-size --mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 --repeat 2 --no-plot", dir,
+        {"point",
+         "repeat",
+         "scene",
+         "cell_factor",
+         "cell_size",
+         "table_size",
+         "hash",
+         "threads",
+         "vertices",
+         "tets",
+         "cells_visited",
+         "entries_scanned",
+         "hash_collisions",
+         "box_rejections",
+         "own_vertex_skips",
+         "inside_tests",
+         "exact_fallbacks",
+         "degenerate_tets",
+         "contacts",
+         "table_load",
+         "memory_bytes",
+         "oracle_contacts",
+         "missed",
+         "extra",
+         "ms_total",
+         "ms_vertices",
+         "ms_tets",
+         "ms_inside",
+         "ms_sort"},
+        t, &err));
     ASSERT_EQ(t.rows.size(), 5u * 2 * 2); // 5 cell sizes × 2 table sizes × 2 repeats
     for (const auto& row : t.rows) {
         EXPECT_EQ(row[t.index_of("missed")], "0");
@@ -72,8 +84,8 @@ TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
         EXPECT_EQ(row[t.index_of("contacts")], row[t.index_of("oracle_contacts")]);
     }
     const std::string json = test::read_text(dir / "s" / "study.json");
-    EXPECT_NE(json.find("study cell-size"), std::string::npos);             // the command line is recorded
-    EXPECT_NE(r.err.find("study: point 1/10"), std::string::npos) << r.err; // plain progress lines off a terminal
+    EXPECT_NE(json.find("study cell-size"), std::string::npos);         // the command line is recorded
+    EXPECT_NE(err.find("study: point 1/10"), std::string::npos) << err; // plain progress lines off a terminal
 }
 
 TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
@@ -141,15 +153,14 @@ generate = { shape = "box", resolution = 2, size = [0.2, 0.2, 0.2] }
 translate = [0, 0, 0.5]
 material = { density = 500, young = 1e4 }
 )");
-    const auto r = run_tethash("study integrator --scene " + quote(dir / "tiny.toml") +
-                               " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator implicit_euler,symplectic_euler "
-                               "--reference-factor 4 --no-plot --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration",
-                            "energy_drift", "wall_s_per_sim_s", "ref_dt"})
-        EXPECT_GE(t.index_of(col), 0) << col;
+    Table t;
+    ASSERT_NO_FATAL_FAILURE(run_study("integrator --scene " + quote(dir / "tiny.toml") +
+                                          " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator "
+                                          "implicit_euler,symplectic_euler --reference-factor 4 --no-plot",
+                                      dir,
+                                      {"integrator", "dt", "substeps", "status", "err_rms", "err_max",
+                                       "max_penetration", "energy_drift", "wall_s_per_sim_s", "ref_dt"},
+                                      t));
     ASSERT_EQ(t.rows.size(), 6u);
     for (std::size_t i = 0; i < t.rows.size(); ++i) {
         const auto& row = t.rows[i];
@@ -171,15 +182,14 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     p.shape = "box";
     p.resolution = 3;
     io::write_mesh((dir / "box.vtu").string(), meshing::generate(p));
-    const auto r = run_tethash("study stability --mesh " + quote(dir / "box.vtu") +
-                               " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all --duration 0.6 "
-                               "--no-plot --quiet --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction",
-                            "far_self", "ms_per_step"})
-        ASSERT_GE(t.index_of(col), 0) << col;
+    Table t;
+    ASSERT_NO_FATAL_FAILURE(run_study("stability --mesh " + quote(dir / "box.vtu") +
+                                          " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all "
+                                          "--duration 0.6 --no-plot --quiet",
+                                      dir,
+                                      {"integrator", "young", "dt", "mass_ratio", "verdict", "status",
+                                       "inverted_fraction", "far_self", "ms_per_step"},
+                                      t));
     ASSERT_EQ(t.rows.size(), 24u);
     int ok = 0, stopped = 0;
     for (const auto& row : t.rows) {

@@ -1,6 +1,7 @@
 // The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
 #include "detect_checks.hpp"
+#include "enum_names.hpp"
 #include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -142,22 +143,20 @@ void parse_skin(const std::string& text, DetectParams& params, const std::string
     params.skin = v;
 }
 
+namespace {
+constexpr detail::EnumName<HashFunction> k_hash_names[] = {{HashFunction::teschner, "teschner"},
+                                                           {HashFunction::column, "column"}};
+} // namespace
+
 HashFunction parse_hash_function(const std::string& name)
 {
-    if (name == "teschner") return HashFunction::teschner;
-    if (name == "column") return HashFunction::column;
+    if (const auto h = detail::value_named(k_hash_names, name)) return *h;
     throw Error("unknown hash function '" + name + "' (expected teschner or column)");
 }
 
 const char* to_string(HashFunction h)
 {
-    switch (h) {
-    case HashFunction::teschner:
-        return "teschner";
-    case HashFunction::column:
-        return "column";
-    }
-    return "?";
+    return detail::name_of(k_hash_names, h);
 }
 
 namespace detail {

@@ -1,5 +1,7 @@
 #include "tethash/sim/scene.hpp"
 
+#include "core/enum_names.hpp"
+
 #include "tethash/error.hpp"
 #include "tethash/io/surface.hpp"
 
@@ -14,11 +16,27 @@
 
 namespace tethash::sim {
 
+namespace {
+
+/// The integrators' names, the canonical one first, then the aliases the parser also accepts.
+constexpr tethash::detail::EnumName<Integrator> k_integrator_names[] = {
+    {Integrator::symplectic_euler, "symplectic_euler"},
+    {Integrator::symplectic_euler, "symplectic"},
+    {Integrator::symplectic_euler, "explicit"},
+    {Integrator::implicit_euler, "implicit_euler"},
+    {Integrator::implicit_euler, "implicit"},
+    {Integrator::vbd, "vbd"},
+    {Integrator::vbd, "block_descent"},
+};
+
+constexpr tethash::detail::EnumName<LinearSolver> k_solver_names[] = {{LinearSolver::cg, "cg"},
+                                                                      {LinearSolver::ldlt, "ldlt"}};
+
+} // namespace
+
 Integrator parse_integrator(const std::string& name)
 {
-    if (name == "symplectic_euler" || name == "symplectic" || name == "explicit") return Integrator::symplectic_euler;
-    if (name == "implicit_euler" || name == "implicit") return Integrator::implicit_euler;
-    if (name == "vbd" || name == "block_descent") return Integrator::vbd;
+    if (const auto integrator = tethash::detail::value_named(k_integrator_names, name)) return *integrator;
     if (name == "local_global" || name == "liu" || name == "projective")
         throw Error("integrator '" + name +
                     "' was retired (it blew up on real meshes where implicit Euler held): use 'vbd', the default, "
@@ -28,27 +46,18 @@ Integrator parse_integrator(const std::string& name)
 
 const char* to_string(Integrator integrator)
 {
-    switch (integrator) {
-    case Integrator::symplectic_euler:
-        return "symplectic_euler";
-    case Integrator::implicit_euler:
-        return "implicit_euler";
-    case Integrator::vbd:
-        return "vbd";
-    }
-    return "?";
+    return tethash::detail::name_of(k_integrator_names, integrator);
 }
 
 LinearSolver parse_linear_solver(const std::string& name)
 {
-    if (name == "cg") return LinearSolver::cg;
-    if (name == "ldlt") return LinearSolver::ldlt;
+    if (const auto solver = tethash::detail::value_named(k_solver_names, name)) return *solver;
     throw Error("solver '" + name + "' unknown (cg, ldlt)");
 }
 
 const char* to_string(LinearSolver solver)
 {
-    return solver == LinearSolver::cg ? "cg" : "ldlt";
+    return tethash::detail::name_of(k_solver_names, solver);
 }
 
 namespace {

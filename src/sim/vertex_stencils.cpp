@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -294,24 +295,38 @@ __attribute__((target("avx2,fma"))) int solve_avx2(const LaneTerms& t, double d[
 }
 #endif
 
+/// The kernels that go together, the scalar ones last (what an unknown gather is matched with).
+struct KernelSet {
+    GatherFn gather;
+    StartFn start;
+    SolveFn solve;
+    const char* name;
+};
+
+constexpr KernelSet k_kernel_sets[] = {
+#ifdef TETHASH_X86
+    {gather_avx2, start_avx2, solve_avx2, "avx2"},
+#endif
+    {gather_scalar, start_scalar, solve_scalar, "scalar"},
+};
+
+const KernelSet& kernels_of(GatherFn gather)
+{
+    for (const KernelSet& k : k_kernel_sets)
+        if (k.gather == gather) return k;
+    return k_kernel_sets[std::size(k_kernel_sets) - 1];
+}
+
 } // namespace
 
 SolveFn choose_solve(GatherFn gather)
 {
-#ifdef TETHASH_X86
-    if (gather == gather_avx2) return solve_avx2;
-#endif
-    (void)gather;
-    return solve_scalar;
+    return kernels_of(gather).solve;
 }
 
 StartFn choose_start(GatherFn gather)
 {
-#ifdef TETHASH_X86
-    if (gather == gather_avx2) return start_avx2;
-#endif
-    (void)gather;
-    return start_scalar;
+    return kernels_of(gather).start;
 }
 
 GatherFn choose_gather()
@@ -327,7 +342,7 @@ GatherFn choose_gather()
 
 const char* gather_kernel_name(GatherFn fn)
 {
-    return fn == gather_scalar ? "scalar" : "avx2";
+    return kernels_of(fn).name;
 }
 
 } // namespace tethash::sim::detail
