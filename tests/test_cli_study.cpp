@@ -8,8 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <initializer_list>
+#include <map>
 #include <thread>
+#include <vector>
 
 namespace tethash {
 namespace {
@@ -26,17 +27,57 @@ std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 
 using test::deterministic;
 
-/// Runs `tethash study ARGS --out DIR/s`, which must succeed, and reads its DIR/s/study.csv into `t`, which must
-/// have each of `columns`. `err`, when given, receives the run's standard error.
-void run_study(const std::string& args, const std::filesystem::path& dir, std::initializer_list<const char*> columns,
+/// Columns the table of each sweep must have (among others).
+const std::map<std::string, std::vector<const char*>> k_columns = {
+    {"cell-size",
+     {"point",
+      "repeat",
+      "scene",
+      "cell_factor",
+      "cell_size",
+      "table_size",
+      "hash",
+      "threads",
+      "vertices",
+      "tets",
+      "cells_visited",
+      "entries_scanned",
+      "hash_collisions",
+      "box_rejections",
+      "own_vertex_skips",
+      "inside_tests",
+      "exact_fallbacks",
+      "degenerate_tets",
+      "contacts",
+      "table_load",
+      "memory_bytes",
+      "oracle_contacts",
+      "missed",
+      "extra",
+      "ms_total",
+      "ms_vertices",
+      "ms_tets",
+      "ms_inside",
+      "ms_sort"}},
+    {"integrator",
+     {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration", "energy_drift",
+      "wall_s_per_sim_s", "ref_dt"}},
+    {"stability",
+     {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction", "far_self", "ms_per_step"}},
+};
+
+/// Runs `tethash study SWEEP ARGS --out DIR/s`, which must succeed, and reads its DIR/s/study.csv into `t`, which
+/// must have the sweep's columns (k_columns) and `rows` rows. `err`, when given, receives the run's standard error.
+void run_study(const std::string& sweep, const std::string& args, const std::filesystem::path& dir, std::size_t rows,
                Table& t, std::string* err = nullptr)
 {
-    const auto r = run_tethash("study " + args + " --out " + quote(dir / "s"));
+    const auto r = run_tethash("study " + sweep + " " + args + " --out " + quote(dir / "s"));
     ASSERT_EQ(r.status, 0) << r.err;
     if (err) *err = r.err;
     t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : columns)
+    for (const char* col : k_columns.at(sweep))
         ASSERT_GE(t.index_of(col), 0) << col;
+    ASSERT_EQ(t.rows.size(), rows);
 }
 
 TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
@@ -46,38 +87,8 @@ TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
     Table t;
     std::string err;
     ASSERT_NO_FATAL_FAILURE(run_study(
-        "cell-size --mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 --repeat 2 --no-plot", dir,
-        {"point",
-         "repeat",
-         "scene",
-         "cell_factor",
-         "cell_size",
-         "table_size",
-         "hash",
-         "threads",
-         "vertices",
-         "tets",
-         "cells_visited",
-         "entries_scanned",
-         "hash_collisions",
-         "box_rejections",
-         "own_vertex_skips",
-         "inside_tests",
-         "exact_fallbacks",
-         "degenerate_tets",
-         "contacts",
-         "table_load",
-         "memory_bytes",
-         "oracle_contacts",
-         "missed",
-         "extra",
-         "ms_total",
-         "ms_vertices",
-         "ms_tets",
-         "ms_inside",
-         "ms_sort"},
-        t, &err));
-    ASSERT_EQ(t.rows.size(), 5u * 2 * 2); // 5 cell sizes × 2 table sizes × 2 repeats
+        "cell-size", "--mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 --repeat 2 --no-plot", dir,
+        5u * 2 * 2, t, &err)); // 5 cell sizes × 2 table sizes × 2 repeats
     for (const auto& row : t.rows) {
         EXPECT_EQ(row[t.index_of("missed")], "0");
         EXPECT_EQ(row[t.index_of("extra")], "0");
@@ -154,14 +165,11 @@ translate = [0, 0, 0.5]
 material = { density = 500, young = 1e4 }
 )");
     Table t;
-    ASSERT_NO_FATAL_FAILURE(run_study("integrator --scene " + quote(dir / "tiny.toml") +
+    ASSERT_NO_FATAL_FAILURE(run_study("integrator",
+                                      "--scene " + quote(dir / "tiny.toml") +
                                           " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator "
                                           "implicit_euler,symplectic_euler --reference-factor 4 --no-plot",
-                                      dir,
-                                      {"integrator", "dt", "substeps", "status", "err_rms", "err_max",
-                                       "max_penetration", "energy_drift", "wall_s_per_sim_s", "ref_dt"},
-                                      t));
-    ASSERT_EQ(t.rows.size(), 6u);
+                                      dir, 6, t));
     for (std::size_t i = 0; i < t.rows.size(); ++i) {
         const auto& row = t.rows[i];
         EXPECT_EQ(row[t.index_of("status")], "ok");
@@ -183,14 +191,11 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     p.resolution = 3;
     io::write_mesh((dir / "box.vtu").string(), meshing::generate(p));
     Table t;
-    ASSERT_NO_FATAL_FAILURE(run_study("stability --mesh " + quote(dir / "box.vtu") +
+    ASSERT_NO_FATAL_FAILURE(run_study("stability",
+                                      "--mesh " + quote(dir / "box.vtu") +
                                           " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all "
                                           "--duration 0.6 --no-plot --quiet",
-                                      dir,
-                                      {"integrator", "young", "dt", "mass_ratio", "verdict", "status",
-                                       "inverted_fraction", "far_self", "ms_per_step"},
-                                      t));
-    ASSERT_EQ(t.rows.size(), 24u);
+                                      dir, 24, t));
     int ok = 0, stopped = 0;
     for (const auto& row : t.rows) {
         const std::string verdict = row[t.index_of("verdict")], status = row[t.index_of("status")];

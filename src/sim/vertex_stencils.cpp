@@ -18,6 +18,21 @@
 namespace tethash::sim::detail {
 namespace {
 
+/// Lane l of a volume entry at vertex position (px, py, pz): W = (a − p) · N with N = (b − a) × (c − a), the
+/// opposite face's corners a, b, c read from x. Sets n to N.
+inline double volume_term(const TetLanes& t, int l, const double* x, double px, double py, double pz, double n[3])
+{
+    const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
+    const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
+    const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
+    const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
+    const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
+    n[0] = bay * caz - baz * cay;
+    n[1] = baz * cax - bax * caz;
+    n[2] = bax * cay - bay * cax;
+    return (a[0] - px) * n[0] + (a[1] - py) * n[1] + (a[2] - pz) * n[2];
+}
+
 void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLanes* tets, const double* x, double inv_h,
                    LaneTerms& out)
 {
@@ -59,13 +74,9 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         const TetLanes& t = tets[s];
         for (int l = 0; l < 4; ++l) {
-            const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
-            const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
-            const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
-            const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-            const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-            const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-            const double w = (a[0] - xi[l]) * nx + (a[1] - yi[l]) * ny + (a[2] - zi[l]) * nz;
+            double n[3];
+            const double w = volume_term(t, l, x, xi[l], yi[l], zi[l], n);
+            const double nx = n[0], ny = n[1], nz = n[2];
             const double fs = t.k36[l] * ((w - t.w0[l]) + dh[l] * (w - t.wt[l]));
             f[0][l] += fs * nx;
             f[1][l] += fs * ny;
@@ -98,13 +109,8 @@ void start_scalar(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, cons
         TetLanes& t = tets[s];
         for (int l = 0; l < 4; ++l) {
             const double* xi = x + 4 * static_cast<std::size_t>(g.vertex[l]);
-            const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
-            const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
-            const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
-            const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-            const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-            const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-            t.wt[l] = (a[0] - xi[0]) * nx + (a[1] - xi[1]) * ny + (a[2] - xi[2]) * nz;
+            double n[3];
+            t.wt[l] = volume_term(t, l, x, xi[0], xi[1], xi[2], n);
         }
     }
 }
