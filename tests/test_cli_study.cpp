@@ -66,29 +66,33 @@ const std::map<std::string, std::vector<const char*>> k_columns = {
      {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction", "far_self", "ms_per_step"}},
 };
 
-/// Runs `tethash study SWEEP ARGS --out DIR/s`, which must succeed, and reads its DIR/s/study.csv into `t`, which
-/// must have the sweep's columns (k_columns) and `rows` rows. `err`, when given, receives the run's standard error.
-void run_study(const std::string& sweep, const std::string& args, const std::filesystem::path& dir, std::size_t rows,
-               Table& t, std::string* err = nullptr)
+/// Runs `tethash study SWEEP ARGS --out DIR/s`, which must succeed, and returns its DIR/s/study.csv, which must
+/// have the sweep's columns (k_columns) and `rows` rows; an empty table after such a failure (reported).
+/// `err`, when given, receives the run's standard error.
+Table run_study(const std::string& sweep, const std::string& args, const std::filesystem::path& dir, std::size_t rows,
+                std::string* err = nullptr)
 {
     const auto r = run_tethash("study " + sweep + " " + args + " --out " + quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
     if (err) *err = r.err;
-    t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : k_columns.at(sweep))
-        ASSERT_GE(t.index_of(col), 0) << col;
-    ASSERT_EQ(t.rows.size(), rows);
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (r.status != 0) return {};
+    Table t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : k_columns.at(sweep)) {
+        EXPECT_GE(t.index_of(col), 0) << col;
+        if (t.index_of(col) < 0) return {};
+    }
+    EXPECT_EQ(t.rows.size(), rows);
+    return t.rows.size() == rows ? t : Table{};
 }
 
 TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
 {
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir);
-    Table t;
     std::string err;
-    ASSERT_NO_FATAL_FAILURE(run_study(
+    const Table t = run_study(
         "cell-size", "--mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 --repeat 2 --no-plot", dir,
-        5u * 2 * 2, t, &err)); // 5 cell sizes × 2 table sizes × 2 repeats
+        5u * 2 * 2, &err); // 5 cell sizes × 2 table sizes × 2 repeats
     for (const auto& row : t.rows) {
         EXPECT_EQ(row[t.index_of("missed")], "0");
         EXPECT_EQ(row[t.index_of("extra")], "0");
@@ -164,12 +168,11 @@ generate = { shape = "box", resolution = 2, size = [0.2, 0.2, 0.2] }
 translate = [0, 0, 0.5]
 material = { density = 500, young = 1e4 }
 )");
-    Table t;
-    ASSERT_NO_FATAL_FAILURE(run_study("integrator",
-                                      "--scene " + quote(dir / "tiny.toml") +
-                                          " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator "
-                                          "implicit_euler,symplectic_euler --reference-factor 4 --no-plot",
-                                      dir, 6, t));
+    const Table t = run_study("integrator",
+                              "--scene " + quote(dir / "tiny.toml") +
+                                  " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator "
+                                  "implicit_euler,symplectic_euler --reference-factor 4 --no-plot",
+                              dir, 6);
     for (std::size_t i = 0; i < t.rows.size(); ++i) {
         const auto& row = t.rows[i];
         EXPECT_EQ(row[t.index_of("status")], "ok");
@@ -190,12 +193,11 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     p.shape = "box";
     p.resolution = 3;
     io::write_mesh((dir / "box.vtu").string(), meshing::generate(p));
-    Table t;
-    ASSERT_NO_FATAL_FAILURE(run_study("stability",
-                                      "--mesh " + quote(dir / "box.vtu") +
-                                          " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all "
-                                          "--duration 0.6 --no-plot --quiet",
-                                      dir, 24, t));
+    const Table t = run_study("stability",
+                              "--mesh " + quote(dir / "box.vtu") +
+                                  " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all "
+                                  "--duration 0.6 --no-plot --quiet",
+                              dir, 24);
     int ok = 0, stopped = 0;
     for (const auto& row : t.rows) {
         const std::string verdict = row[t.index_of("verdict")], status = row[t.index_of("status")];

@@ -14,12 +14,13 @@ template <class Enum> struct EnumName {
     const char* name;
 };
 
-/// The name of `value`: its first row in `table`, or "?" when no row names it.
-template <class Enum, std::size_t N> constexpr const char* name_of(const EnumName<Enum> (&table)[N], Enum value)
+/// The name of `value`: its first row in `table`, or `otherwise` when no row names it.
+template <class Enum, std::size_t N>
+constexpr const char* name_of(const EnumName<Enum> (&table)[N], Enum value, const char* otherwise = "?")
 {
     for (const auto& row : table)
         if (row.value == value) return row.name;
-    return "?";
+    return otherwise;
 }
 
 /// The value `name` stands for in `table` (any of its rows), or nothing when no row has that name.

@@ -81,22 +81,12 @@ class Reader {
 
     static const char* type_name(const toml::node& n)
     {
-        switch (n.type()) {
-        case toml::node_type::table:
-            return "a table";
-        case toml::node_type::array:
-            return "an array";
-        case toml::node_type::string:
-            return "a string";
-        case toml::node_type::integer:
-            return "an integer";
-        case toml::node_type::floating_point:
-            return "a number";
-        case toml::node_type::boolean:
-            return "a boolean";
-        default:
-            return "a date/time";
-        }
+        static constexpr tethash::detail::EnumName<toml::node_type> names[] = {
+            {toml::node_type::table, "a table"},           {toml::node_type::array, "an array"},
+            {toml::node_type::string, "a string"},         {toml::node_type::integer, "an integer"},
+            {toml::node_type::floating_point, "a number"}, {toml::node_type::boolean, "a boolean"},
+        };
+        return tethash::detail::name_of(names, n.type(), "a date/time");
     }
 
     /// Throws for keys of `tbl` not in `known`.
