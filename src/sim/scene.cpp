@@ -433,28 +433,40 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                             r.fail(&node, full, e.what());
                         }
                     };
+                    // A number (where a length or count is meant) is read by `number`, text by `parse`.
+                    const auto number_or_grammar = [&](auto&& number, auto&& parse) {
+                        if (dv.is_number())
+                            number();
+                        else
+                            grammar(parse);
+                    };
+                    // The cell size and the skin: a number is an absolute length, text may give a factor instead.
+                    const auto length = [&](auto& mode, auto absolute, double& value,
+                                            double (Reader::*check)(const toml::node&, const std::string&) const,
+                                            void (*parse)(const std::string&, DetectParams&, const std::string&)) {
+                        number_or_grammar(
+                            [&] {
+                                mode = absolute;
+                                value = (r.*check)(dv, full);
+                            },
+                            [&](const std::string& text) { parse(text, s.detect, full); });
+                    };
                     if (d == "cell_size") {
-                        if (dv.is_number()) {
-                            s.detect.cell_size_mode = DetectParams::CellSizeMode::absolute;
-                            s.detect.cell_size = r.positive(dv, full);
-                        } else
-                            grammar([&](const std::string& text) { parse_cell_size(text, s.detect, full); });
+                        length(s.detect.cell_size_mode, DetectParams::CellSizeMode::absolute, s.detect.cell_size,
+                               &Reader::positive, parse_cell_size);
                     } else if (d == "table_size") {
-                        if (dv.is_number()) {
-                            s.detect.table_size = r.integer_at_least(dv, full, 1);
-                            s.table_size_of_vertices.clear();
-                        } else
-                            grammar([&](const std::string& text) {
+                        number_or_grammar(
+                            [&] {
+                                s.detect.table_size = r.integer_at_least(dv, full, 1);
+                                s.table_size_of_vertices.clear();
+                            },
+                            [&](const std::string& text) {
                                 // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
                                 s.detect.table_size = parse_table_size(text, 0, full);
                                 s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
                             });
                     } else if (d == "hash") {
-                        try {
-                            s.detect.hash = parse_hash_function(r.string(dv, full));
-                        } catch (const Error& e) {
-                            r.fail(&dv, full, e.what());
-                        }
+                        grammar([&](const std::string& text) { s.detect.hash = parse_hash_function(text); });
                     } else if (d == "threads") {
                         const long long threads = r.int_at_least(dv, full, 0);
                         try {
@@ -463,11 +475,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                             r.fail(&dv, full, e.what());
                         }
                     } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
-                        if (dv.is_number()) {
-                            s.detect.skin_mode = DetectParams::SkinMode::absolute;
-                            s.detect.skin = r.non_negative(dv, full);
-                        } else
-                            grammar([&](const std::string& text) { parse_skin(text, s.detect, full); });
+                        length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin,
+                               &Reader::non_negative, parse_skin);
                     }
                 }
             } else if (key == "output") {
