@@ -435,7 +435,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                     };
                     // A number (where a length or count is meant) is read by `number`, text by `parse`.
                     const auto number_or_grammar = [&](auto&& number, auto&& parse) {
-                        if (dv.is_number())
+                        if (node.is_number())
                             number();
                         else
                             grammar(parse);
@@ -447,7 +447,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         number_or_grammar(
                             [&] {
                                 mode = absolute;
-                                value = (r.*check)(dv, full);
+                                value = (r.*check)(node, full);
                             },
                             [&](const std::string& text) { parse(text, s.detect, full); });
                     };
@@ -457,7 +457,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                     } else if (d == "table_size") {
                         number_or_grammar(
                             [&] {
-                                s.detect.table_size = r.integer_at_least(dv, full, 1);
+                                s.detect.table_size = r.integer_at_least(node, full, 1);
                                 s.table_size_of_vertices.clear();
                             },
                             [&](const std::string& text) {
