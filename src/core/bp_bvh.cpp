@@ -74,12 +74,14 @@ Index Bvh::build_node(Index begin, Index end, int depth)
     for (int a = 1; a < 3; ++a)
         if (centres.hi[a] - centres.lo[a] > centres.hi[axis] - centres.lo[axis]) axis = a;
     const double lo = centres.lo[axis], extent = centres.hi[axis] - centres.lo[axis];
-    auto centre = [&](Index t) { return m_centroids[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(axis)]; };
+    auto centre = [&](Index t) {
+        return m_centroids[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(axis)];
+    };
     Index* items = m_items.data();
     Index mid = begin + count / 2; // coincident centres: the middle of the list
     if (extent > 0) {
-        const double scale = bins / extent;
-        auto bin_of = [&](Index t) { return std::min(bins - 1, static_cast<int>((centre(t) - lo) * scale)); };
+        // (c − lo) / extent ∈ [0, 1] also for tiny extents (bins / extent could overflow).
+        auto bin_of = [&](Index t) { return std::min(bins - 1, static_cast<int>((centre(t) - lo) / extent * bins)); };
         Box bin_box[bins];
         Index bin_count[bins] = {};
         for (Box& b : bin_box)
@@ -114,8 +116,8 @@ Index Bvh::build_node(Index begin, Index end, int depth)
             }
         }
         if (best >= 0) {
-            mid = static_cast<Index>(std::partition(items + begin, items + end, [&](Index t) { return bin_of(t) <= best; }) -
-                                     items);
+            mid = static_cast<Index>(
+                std::partition(items + begin, items + end, [&](Index t) { return bin_of(t) <= best; }) - items);
         } else { // every centre in one bin: the median centre
             std::nth_element(items + begin, items + mid, items + end, [&](Index a, Index b) {
                 return centre(a) < centre(b) || (centre(a) == centre(b) && a < b);
@@ -146,7 +148,8 @@ void Bvh::build(const PartitionScene& s)
     build_node(0, m, 0);
     m_item_boxes.resize(static_cast<std::size_t>(m));
     for (Index i = 0; i < m; ++i)
-        m_item_boxes[static_cast<std::size_t>(i)] = m_boxes[static_cast<std::size_t>(m_items[static_cast<std::size_t>(i)])];
+        m_item_boxes[static_cast<std::size_t>(i)] =
+            m_boxes[static_cast<std::size_t>(m_items[static_cast<std::size_t>(i)])];
     m_built_quality = quality();
     ++m_builds;
 }

@@ -40,11 +40,11 @@ class Bvh final : public BroadPhase {
     int m_leaf_size = default_leaf_size, m_max_depth = default_max_depth;
     std::int64_t m_builds = 0, m_refits = 0;
     double m_built_quality = 0;
-    std::vector<Node> m_nodes;           // depth-first order: children after their parent
-    std::vector<Index> m_items;          // tets by leaf
-    std::vector<Box> m_boxes;            // per tet
-    std::vector<Box> m_item_boxes;       // per item (leaf order)
-    std::vector<double> m_centroids;     // per tet (3), during the build
+    std::vector<Node> m_nodes;       // depth-first order: children after their parent
+    std::vector<Index> m_items;      // tets by leaf
+    std::vector<Box> m_boxes;        // per tet
+    std::vector<Box> m_item_boxes;   // per item (leaf order)
+    std::vector<double> m_centroids; // per tet (3), during the build
     std::vector<unsigned char> m_static;
 };
 

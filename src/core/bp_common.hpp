@@ -81,8 +81,7 @@ void for_each_vertex(const PartitionScene& s, const std::vector<unsigned char>& 
 }
 
 /// Calls f(i, out) for i in [0, count) in parallel over the sinks' threads (dynamic chunks of `chunk`).
-template <class F>
-void for_each_index(Index count, int chunk, std::vector<CandidateSink>& sinks, F&& f)
+template <class F> void for_each_index(Index count, int chunk, std::vector<CandidateSink>& sinks, F&& f)
 {
     const int T = static_cast<int>(sinks.size());
 #pragma omp parallel num_threads(T) if (T > 1)
@@ -101,8 +100,7 @@ inline double ms_since(std::chrono::steady_clock::time_point t0)
 }
 
 /// Capacity of a vector in bytes.
-template <class T>
-std::int64_t bytes_of(const std::vector<T>& v)
+template <class T> std::int64_t bytes_of(const std::vector<T>& v)
 {
     return static_cast<std::int64_t>(v.capacity() * sizeof(T));
 }

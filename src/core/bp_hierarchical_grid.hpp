@@ -26,13 +26,13 @@ class HierarchicalGrid final : public BroadPhase {
     };
     std::int64_t m_nodes = 0;
     std::vector<Box> m_boxes;
-    std::vector<std::int32_t> m_level;     // per tet: its level, or -1 when it exceeds the top level
-    std::vector<std::uint64_t> m_bucket;   // per tet: its bucket
-    std::vector<std::int64_t> m_cell;      // per tet: its min-corner cell (3)
-    std::vector<Index> m_start;            // buckets + 1
-    std::vector<Entry> m_entries;          // by bucket
-    std::vector<Index> m_big;              // tets exceeding the top level
-    VerticesByX m_sorted;                  // with tets beyond the top level: the vertices by x
+    std::vector<std::int32_t> m_level;   // per tet: its level, or -1 when it exceeds the top level
+    std::vector<std::uint64_t> m_bucket; // per tet: its bucket
+    std::vector<std::int64_t> m_cell;    // per tet: its min-corner cell (3)
+    std::vector<Index> m_start;          // buckets + 1
+    std::vector<Entry> m_entries;        // by bucket
+    std::vector<Index> m_big;            // tets exceeding the top level
+    VerticesByX m_sorted;                // with tets beyond the top level: the vertices by x
     std::vector<unsigned char> m_static;
 };
 

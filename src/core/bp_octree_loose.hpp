@@ -17,20 +17,20 @@ class LooseOctree final : public BroadPhase {
 
   private:
     struct Node {
-        Box loose;               ///< the cell's box enlarged by the looseness (the root's: also every tet box)
-        double centre[3], half;  ///< the cell itself: centre ± half
-        Index children = -1;     ///< first of 8 consecutive children, -1 while none
+        Box loose;                  ///< the cell's box enlarged by the looseness (the root's: also every tet box)
+        double centre[3], half;     ///< the cell itself: centre ± half
+        Index children = -1;        ///< first of 8 consecutive children, -1 while none
         Index first = 0, count = 0; ///< its tets: m_items[first, first + count)
-        Index below = 0;         ///< tets in its subtree
+        Index below = 0;            ///< tets in its subtree
     };
     /// Appends the 8 children of node i.
     void split(Index i, double looseness);
 
     std::vector<Node> m_nodes;
-    std::vector<Box> m_boxes;       // per tet
-    std::vector<Index> m_node_of;   // per tet: its node
-    std::vector<Index> m_items;     // tets by node
-    std::vector<Box> m_item_boxes;  // their boxes
+    std::vector<Box> m_boxes;      // per tet
+    std::vector<Index> m_node_of;  // per tet: its node
+    std::vector<Index> m_items;    // tets by node
+    std::vector<Box> m_item_boxes; // their boxes
     std::vector<unsigned char> m_static;
 };
 

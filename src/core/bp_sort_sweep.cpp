@@ -23,8 +23,7 @@ bool key_less(double xa, Index a, double xb, Index b)
 
 /// Repairs the order of `keys` (keys refreshed, order from the last call) by insertion sort; false (order
 /// unspecified) when more than `budget` moves were needed.
-template <class Key>
-bool insertion_sort(std::vector<Key>& keys, std::int64_t budget)
+template <class Key> bool insertion_sort(std::vector<Key>& keys, std::int64_t budget)
 {
     std::int64_t moves = 0;
     for (std::size_t i = 1; i < keys.size(); ++i) {
@@ -41,8 +40,7 @@ bool insertion_sort(std::vector<Key>& keys, std::int64_t budget)
     return true;
 }
 
-template <class Key>
-void full_sort(std::vector<Key>& keys)
+template <class Key> void full_sort(std::vector<Key>& keys)
 {
     std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return key_less(a.x, a.id, b.x, b.id); });
 }

@@ -18,9 +18,9 @@ class UniformGrid final : public BroadPhase {
   private:
     std::int64_t m_cells = 0;
     std::int64_t m_dims[3] = {0, 0, 0};
-    std::vector<Index> m_start;      // cells + 1: the vertices of cell c are m_ids[m_start[c], m_start[c + 1])
-    std::vector<Index> m_ids;        // vertices by cell (z fastest, then y, then x)
-    std::vector<double> m_xyz;       // their positions in that order (3 per vertex)
+    std::vector<Index> m_start;       // cells + 1: the vertices of cell c are m_ids[m_start[c], m_start[c + 1])
+    std::vector<Index> m_ids;         // vertices by cell (z fastest, then y, then x)
+    std::vector<double> m_xyz;        // their positions in that order (3 per vertex)
     std::vector<std::int32_t> m_cell; // per vertex: its cell
     std::vector<unsigned char> m_static;
 };
