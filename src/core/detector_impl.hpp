@@ -6,8 +6,8 @@
 #include "detect_checks.hpp"
 #include "hash_grid.hpp"
 #include "partition_detect.hpp"
-#include "timing.hpp"
 #include "tethash/detect.hpp"
+#include "timing.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -38,10 +38,9 @@ struct Counters {
                  degenerate = 0;
     void add(const Counters& o)
     {
-        static constexpr std::int64_t Counters::*fields[] = {&Counters::cells,          &Counters::scanned,
-                                                              &Counters::collisions,     &Counters::box_rejections,
-                                                              &Counters::own,            &Counters::inside_tests,
-                                                              &Counters::exact,          &Counters::degenerate};
+        static constexpr std::int64_t Counters::*fields[] = {
+            &Counters::cells, &Counters::scanned,      &Counters::collisions, &Counters::box_rejections,
+            &Counters::own,   &Counters::inside_tests, &Counters::exact,      &Counters::degenerate};
         for (std::int64_t Counters::*f : fields)
             this->*f += o.*f;
     }
@@ -91,8 +90,8 @@ void sort_own_contacts(ThreadState& ts, Index num_vertices);
 
 // The detector's own names, for the three files that implement it.
 using detail::CandidateRun;
-using detail::ChunkRuns;
 using detail::chunk_tets;
+using detail::ChunkRuns;
 using detail::Clock;
 using detail::Counters;
 using detail::max_cells_per_tet;
@@ -104,7 +103,6 @@ using detail::ThreadState;
 
 class DetectorImpl {
   public:
-
     DetectParams params;
     // topology
     Index num_vertices = 0;
