@@ -87,6 +87,18 @@ inline std::string at_line(const std::filesystem::path& path, int line)
     return path.string() + ":" + std::to_string(line) + ":";
 }
 
+/// Expects `good` edited (its first `from` replaced by `to`, written to dir/name) to fail to read with a message that
+/// starts at line `line` of that file and contains `parts`.
+inline void expect_edit_error(const HandMadeFile& good, const std::filesystem::path& dir, const std::string& from,
+                              const std::string& to, const std::string& name, int line,
+                              std::initializer_list<std::string> parts)
+{
+    std::vector<std::string> all{at_line(dir / name, line)};
+    all.insert(all.end(), parts.begin(), parts.end());
+    const std::filesystem::path path = good.edited(dir, from, to, name);
+    expect_error([&] { (void)io::read_mesh(path.string()); }, all);
+}
+
 /// A small mesh: a grid of nx×ny×nz cubes, each split into 6 tets (all positively oriented), with
 /// coordinates that are not short decimals (so that text round trips must be exact), labels by
 /// cube layer and, if `two_objects`, the upper half as object 1.

@@ -18,10 +18,7 @@
 #include <string>
 
 using namespace tethash;
-using tethash::test::expect_error;
-using tethash::test::identical;
-using tethash::test::same_contacts;
-using tethash::test::Scene;
+using namespace tethash::test;
 
 namespace {
 

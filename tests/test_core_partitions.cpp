@@ -2,8 +2,7 @@
 // scenes of the hash's own tests (random, inverted, lattice-aligned, offset, coincident, collapsed, object rules),
 // over each method's parameters, over moving scenes (structures kept across calls: refits, sweep orders, static
 // parts) and over thread counts.
-#include "../src/core/bp_bvh.hpp"
-#include "../src/core/bp_sort_sweep.hpp"
+#include "../src/core/broad_phase.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
@@ -17,10 +16,7 @@
 #include <string>
 
 using namespace tethash;
-using tethash::test::expect_error;
-using tethash::test::identical;
-using tethash::test::same_contacts;
-using tethash::test::Scene;
+using namespace tethash::test;
 
 namespace {
 
@@ -303,8 +299,8 @@ TEST(CorePartitions, RefittedBvhAndSweepFollowTheMotionAndRebuildWhenDegraded)
     std::vector<Index> moving(static_cast<std::size_t>(s.positions.rows()));
     for (std::size_t v = 0; v < moving.size(); ++v)
         moving[v] = static_cast<Index>(v);
-    detail::Bvh refit(true), rebuilt(false);
-    detail::SortSweep sweep;
+    const auto refit = detail::make_bvh(true), rebuilt = detail::make_bvh(false);
+    const auto sweep = detail::make_sort_sweep();
     DetectParams p;
     p.method = Method::bvh_refit;
     Detector det(p);
@@ -330,18 +326,18 @@ TEST(CorePartitions, RefittedBvhAndSweepFollowTheMotionAndRebuildWhenDegraded)
             }
         detail::PartitionScene scene = partition_scene(s, tet_static, moving);
         scene.first = step == 0;
-        const auto want = candidates(rebuilt, scene);
-        EXPECT_EQ(candidates(refit, scene), want) << "step " << step;
-        EXPECT_EQ(candidates(sweep, scene), want) << "step " << step;
+        const auto want = candidates(*rebuilt, scene);
+        EXPECT_EQ(candidates(*refit, scene), want) << "step " << step;
+        EXPECT_EQ(candidates(*sweep, scene), want) << "step " << step;
         EXPECT_TRUE(same_contacts(det.detect(s.positions), run_oracle(s))) << "step " << step;
         if (step == 9) {
-            builds_after_small = refit.builds();
+            builds_after_small = refit->counts().builds;
             EXPECT_EQ(builds_after_small, 1) << "small motions refit the first tree";
-            EXPECT_EQ(sweep.full_sorts(), 1) << "small motions repair the first order";
-            EXPECT_EQ(sweep.incremental_sorts(), 9);
+            EXPECT_EQ(sweep->counts().builds, 1) << "small motions repair the first order";
+            EXPECT_EQ(sweep->counts().updates, 9);
         }
     }
-    EXPECT_GT(refit.builds(), builds_after_small) << "strong motion degrades the tree: rebuilt";
-    EXPECT_LT(refit.builds(), 30) << "not rebuilt on every step";
-    EXPECT_EQ(refit.refits(), 29) << "every later call refits first";
+    EXPECT_GT(refit->counts().builds, builds_after_small) << "strong motion degrades the tree: rebuilt";
+    EXPECT_LT(refit->counts().builds, 30) << "not rebuilt on every step";
+    EXPECT_EQ(refit->counts().updates, 29) << "every later call refits first";
 }

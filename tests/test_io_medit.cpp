@@ -56,12 +56,12 @@ meshio.write(sys.argv[2], m, file_format="medit")
 TEST(MeditErrors, VersionAndDimension)
 {
     const auto dir = temp_dir();
-    expect_read_error(good.edited(dir, "MeshVersionFormatted 2", "MeshVersionFormatted 7", "v.mesh"),
-                      {at_line(dir / "v.mesh", 1), "expected MeshVersionFormatted 1, 2, 3 or 4, found version 7"});
-    expect_read_error(good.edited(dir, "Dimension 3", "Dimension 2", "d.mesh"),
-                      {at_line(dir / "d.mesh", 2), "expected Dimension 3, found Dimension 2"});
-    expect_read_error(good.edited(dir, "MeshVersionFormatted 2\n", "", "nov.mesh"),
-                      {at_line(dir / "nov.mesh", 1), "expected MeshVersionFormatted, found 'Dimension'"});
+    expect_edit_error(good, dir, "MeshVersionFormatted 2", "MeshVersionFormatted 7", "v.mesh", 1,
+                      {"expected MeshVersionFormatted 1, 2, 3 or 4, found version 7"});
+    expect_edit_error(good, dir, "Dimension 3", "Dimension 2", "d.mesh", 2,
+                      {"expected Dimension 3, found Dimension 2"});
+    expect_edit_error(good, dir, "MeshVersionFormatted 2\n", "", "nov.mesh", 1,
+                      {"expected MeshVersionFormatted, found 'Dimension'"});
 }
 
 TEST(MeditErrors, TruncatedAndWrongCounts)
@@ -77,15 +77,13 @@ TEST(MeditErrors, TruncatedAndWrongCounts)
 TEST(MeditErrors, IndexPastTheEndNanGarbage)
 {
     const auto dir = temp_dir();
-    expect_read_error(
-        good.edited(dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh"),
-        {at_line(dir / "i.mesh", 13), "tetrahedron 2: vertex index 6 is past the end (Vertices has 1..5)"});
-    expect_read_error(good.edited(dir, "2 3 4 5 1", "2 3 0 5 1", "z.mesh"),
-                      {at_line(dir / "z.mesh", 13), "tetrahedron 2: vertex index 0"});
-    expect_read_error(good.edited(dir, "0 0 1 0\n", "0 0 NaN 0\n", "n.mesh"),
-                      {at_line(dir / "n.mesh", 8), "finite z coordinate of vertex 4", "found 'NaN'"});
-    expect_read_error(good.edited(dir, "Tetrahedra\n2\n", "Tetrahedra\ntwo\n", "g.mesh"),
-                      {at_line(dir / "g.mesh", 11), "the number of tetrahedra (an integer)", "found 'two'"});
+    expect_edit_error(good, dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh", 13,
+                      {"tetrahedron 2: vertex index 6 is past the end (Vertices has 1..5)"});
+    expect_edit_error(good, dir, "2 3 4 5 1", "2 3 0 5 1", "z.mesh", 13, {"tetrahedron 2: vertex index 0"});
+    expect_edit_error(good, dir, "0 0 1 0\n", "0 0 NaN 0\n", "n.mesh", 8,
+                      {"finite z coordinate of vertex 4", "found 'NaN'"});
+    expect_edit_error(good, dir, "Tetrahedra\n2\n", "Tetrahedra\ntwo\n", "g.mesh", 11,
+                      {"the number of tetrahedra (an integer)", "found 'two'"});
     expect_read_error(good.edited(dir, "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\n", "", "not.mesh"),
                       {(dir / "not.mesh").string() + ": no Tetrahedra block"});
 }

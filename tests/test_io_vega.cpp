@@ -34,34 +34,31 @@ TEST(VegaErrors, TruncatedAndWrongCounts)
     const auto dir = temp_dir();
     const auto cut = good.cut(dir, "2 2 3 4 5", 6, "cut.veg");
     expect_read_error(cut, {cut.string() + ":", "vertex 3 of element 2", "found end of file"});
-    expect_read_error(good.edited(dir, "5 3 0 0", "6 3 0 0", "n.veg"),
-                      {at_line(dir / "n.veg", 9), "expected a vertex number (an integer), found '*ELEMENTS'"});
-    expect_read_error(good.edited(dir, "1 1 2 3 4\n2 2", "1 1 2 3 4\n3 2", "id.veg"),
-                      {at_line(dir / "id.veg", 13), "expected element number 2", "found 3"});
+    expect_edit_error(good, dir, "5 3 0 0", "6 3 0 0", "n.veg", 9,
+                      {"expected a vertex number (an integer), found '*ELEMENTS'"});
+    expect_edit_error(good, dir, "1 1 2 3 4\n2 2", "1 1 2 3 4\n3 2", "id.veg", 13,
+                      {"expected element number 2", "found 3"});
 }
 
 TEST(VegaErrors, IndexPastTheEndNanGarbage)
 {
     const auto dir = temp_dir();
-    expect_read_error(good.edited(dir, "2 2 3 4 5", "2 2 3 4 9", "i.veg"),
-                      {at_line(dir / "i.veg", 13), "element 2: vertex index 9 is past the end (*VERTICES has 1..5)"});
-    expect_read_error(good.edited(dir, "1 1 2 3 4\n", "1 0 2 3 4\n", "z.veg"),
-                      {at_line(dir / "z.veg", 12), "element 1: vertex index 0 is out of range"});
-    expect_read_error(good.edited(dir, "3 0 1 0", "3 0 inf 0", "inf.veg"),
-                      {at_line(dir / "inf.veg", 6), "y coordinate of vertex 3 (a finite number)", "found 'inf'"});
-    expect_read_error(good.edited(dir, "4 0 0 1", "4 0 0 1e", "g.veg"),
-                      {at_line(dir / "g.veg", 7), "z coordinate of vertex 4", "found '1e'"});
+    expect_edit_error(good, dir, "2 2 3 4 5", "2 2 3 4 9", "i.veg", 13,
+                      {"element 2: vertex index 9 is past the end (*VERTICES has 1..5)"});
+    expect_edit_error(good, dir, "1 1 2 3 4\n", "1 0 2 3 4\n", "z.veg", 12,
+                      {"element 1: vertex index 0 is out of range"});
+    expect_edit_error(good, dir, "3 0 1 0", "3 0 inf 0", "inf.veg", 6,
+                      {"y coordinate of vertex 3 (a finite number)", "found 'inf'"});
+    expect_edit_error(good, dir, "4 0 0 1", "4 0 0 1e", "g.veg", 7, {"z coordinate of vertex 4", "found '1e'"});
 }
 
 TEST(VegaErrors, UnsupportedContent)
 {
     const auto dir = temp_dir();
-    expect_read_error(good.edited(dir, "TET", "CUBIC", "cubic.veg"),
-                      {at_line(dir / "cubic.veg", 10), "expected the element type TET", "found 'CUBIC'"});
-    expect_read_error(good.edited(dir, "# comment\n", "*INCLUDE other.veg\n", "inc.veg"),
-                      {at_line(dir / "inc.veg", 1), "*INCLUDE is not supported"});
-    expect_read_error(good.edited(dir, "# comment\n", "VERTICES\n", "kw.veg"),
-                      {at_line(dir / "kw.veg", 1), "expected a section keyword such as *VERTICES", "found 'VERTICES'"});
+    expect_edit_error(good, dir, "TET", "CUBIC", "cubic.veg", 10, {"expected the element type TET", "found 'CUBIC'"});
+    expect_edit_error(good, dir, "# comment\n", "*INCLUDE other.veg\n", "inc.veg", 1, {"*INCLUDE is not supported"});
+    expect_edit_error(good, dir, "# comment\n", "VERTICES\n", "kw.veg", 1,
+                      {"expected a section keyword such as *VERTICES", "found 'VERTICES'"});
 }
 
 TEST(VegaShared, ReadsQuintupleTorus)

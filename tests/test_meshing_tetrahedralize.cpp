@@ -16,10 +16,7 @@
 #endif
 
 using namespace tethash;
-using tethash::test::enclosed_volume;
-using tethash::test::expect_error;
-using tethash::test::sphere_surface;
-using tethash::test::volume;
+using namespace tethash::test;
 
 namespace {
 

@@ -1,4 +1,7 @@
-// The bounding-volume hierarchy (bp_bvh.hpp).
+// A bounding-volume hierarchy over the tet boxes as a broad phase (docs/partitions.md): binned
+// surface-area-heuristic build, point queries per vertex. One class for both methods: `bvh` rebuilds every call,
+// `bvh_refit` builds on the first call and then refits the boxes bottom-up, rebuilding when refitting has degraded
+// the tree (its summed node surface area, relative to the root's, more than twice that of the last build).
 //
 // Build: top-down; a node's items are split on the axis of the largest extent of their box centres into 16 bins,
 // at the bin border of least surface-area cost (area × items on either side); items whose centres all fall in one bin
@@ -8,7 +11,7 @@
 // boxes of the tets in the leaves it reaches (parallel over vertices). Each tet is in one leaf and a vertex reaches a
 // leaf at most once, so each pair is found once; a box contains the boxes below it (unions, no rounding), so a vertex
 // in a tet's box reaches its leaf.
-#include "bp_bvh.hpp"
+#include "bp_common.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,6 +19,51 @@
 namespace tethash::detail {
 
 namespace {
+
+class Bvh final : public BroadPhase {
+  public:
+    explicit Bvh(bool refit) : m_refit(refit) {}
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override
+    {
+        return bytes_of(m_nodes) + bytes_of(m_items) + bytes_of(m_boxes) + bytes_of(m_item_boxes) +
+               bytes_of(m_centroids) + bytes_of(m_static);
+    }
+    std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
+
+    static constexpr int default_leaf_size = 4;
+    static constexpr int default_max_depth = 40;
+    /// Refitted trees are rebuilt when quality() exceeds this factor times its value after the last build.
+    static constexpr double degradation = 2.0;
+
+    /// Builds (the first call's included) and refits since the object was made.
+    BroadPhaseCounts counts() const override { return {m_builds, m_refits}; }
+    /// Summed surface area of the nodes over the root's: the surface-area heuristic's measure of the nodes a query
+    /// visits (lower is better; grows as refitted boxes swell and overlap).
+    double quality() const;
+
+  private:
+    struct Node {
+        Box box;
+        Index right; ///< internal: the right child (the left one is the next node)
+        Index first; ///< leaf: its first item
+        Index count; ///< leaf: its items (> 0); internal: 0
+    };
+    void build(const PartitionScene& s);
+    Index build_node(Index begin, Index end, int depth);
+    void refit();
+
+    bool m_refit;
+    int m_leaf_size = default_leaf_size, m_max_depth = default_max_depth;
+    std::int64_t m_builds = 0, m_refits = 0;
+    double m_built_quality = 0;
+    std::vector<Node> m_nodes;       // depth-first order: children after their parent
+    std::vector<Index> m_items;      // tets by leaf
+    std::vector<Box> m_boxes;        // per tet
+    std::vector<Box> m_item_boxes;   // per item (leaf order)
+    std::vector<double> m_centroids; // per tet (3), during the build
+    std::vector<unsigned char> m_static;
+};
 
 constexpr int bins = 16;
 
@@ -42,8 +90,6 @@ double area(const Box& b)
     const double x = b.hi[0] - b.lo[0], y = b.hi[1] - b.lo[1], z = b.hi[2] - b.lo[2];
     return x < 0 ? 0 : 2 * (x * y + y * z + z * x);
 }
-
-} // namespace
 
 double Bvh::quality() const
 {
@@ -174,13 +220,12 @@ void Bvh::refit()
 
 BroadPhaseTimes Bvh::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     const int T = static_cast<int>(sinks.size());
     if (n == 0 || m == 0) {
         m_nodes.clear();
-        return times;
+        return {};
     }
     tet_boxes(s, m_boxes, T);
     if (!m_refit || s.first || m_items.size() != static_cast<std::size_t>(m)) {
@@ -190,8 +235,7 @@ BroadPhaseTimes Bvh::find(const PartitionScene& s, std::vector<CandidateSink>& s
         if (quality() > degradation * m_built_quality) build(s);
     }
     static_vertex_flags(s, m_static);
-    times.ms_build = ms_since(t0);
-    const auto t1 = std::chrono::steady_clock::now();
+    timer.end_build();
 
     const Node* nodes = m_nodes.data();
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
@@ -211,14 +255,14 @@ BroadPhaseTimes Bvh::find(const PartitionScene& s, std::vector<CandidateSink>& s
             stack[top++] = i + 1;
         }
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
-std::int64_t Bvh::memory_bytes() const
+} // namespace
+
+std::unique_ptr<BroadPhase> make_bvh(bool refit)
 {
-    return bytes_of(m_nodes) + bytes_of(m_items) + bytes_of(m_boxes) + bytes_of(m_item_boxes) + bytes_of(m_centroids) +
-           bytes_of(m_static);
+    return std::make_unique<Bvh>(refit);
 }
 
 } // namespace tethash::detail

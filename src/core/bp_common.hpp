@@ -52,6 +52,14 @@ struct VerticesByX {
     std::int64_t memory_bytes() const;
 };
 
+/// Appends the candidate (v, t) unless both are static (`tet_static`: tet t's flag; `vertex_static`: per vertex, 1
+/// for static).
+inline void add_candidate(Index v, Index t, bool tet_static, const unsigned char* vertex_static,
+                          std::vector<CandidatePair>& out)
+{
+    if (!(tet_static && vertex_static[v])) out.push_back({v, t});
+}
+
 /// Appends (v, items[k]) for each k in [first, last) whose box boxes[k] contains p, except static tets when
 /// `vertex_static`: a vertex against the tets of a leaf or cell.
 inline void find_in_boxes(const PartitionScene& s, const double* p, Index v, bool vertex_static, const Index* items,
@@ -93,6 +101,26 @@ template <class F> void for_each_index(Index count, int chunk, std::vector<Candi
             f(i, out);
     }
 }
+
+/// Times a find() call's two phases: the build from construction to end_build(), the query from there to
+/// end_query(), which returns both.
+class PhaseTimer {
+  public:
+    void end_build()
+    {
+        m_times.ms_build = ms_since(m_start);
+        m_start = std::chrono::steady_clock::now();
+    }
+    BroadPhaseTimes end_query()
+    {
+        m_times.ms_query = ms_since(m_start);
+        return m_times;
+    }
+
+  private:
+    std::chrono::steady_clock::time_point m_start = std::chrono::steady_clock::now();
+    BroadPhaseTimes m_times;
+};
 
 /// Capacity of a vector in bytes.
 template <class T> std::int64_t bytes_of(const std::vector<T>& v)

@@ -1,4 +1,7 @@
-// The hierarchical hash grid (bp_hierarchical_grid.hpp).
+// The hierarchical hash grid of Mirtich 1998 as a broad phase (docs/partitions.md): levels of doubling
+// cell size from the detector's cell size, each tet on the finest level where its box spans at most two cells per
+// axis, stored once under the cell of its box's min corner in one hash table keyed by (level, cell); each vertex looks
+// up, on every occupied level, the 2 × 2 × 2 cells at and below its own.
 //
 // Level k has cells of edge l·2^k and the cell coordinates cell_coord(x, o, 2^−k / l) (o: the vertices' min corner).
 // A tet goes to the finest level k < levels where cell(hi) − cell(lo) ≤ 1 on every axis (with hi − lo ≤ l·2^k that
@@ -10,7 +13,7 @@
 // within ±10 % — while it took 2.5 to 4 times the memory and 3 times the build time.) Tets still spanning more than two
 // cells on the top level (levels capped) are kept apart and matched against the vertices sorted by x (the brute force's
 // layout).
-#include "bp_hierarchical_grid.hpp"
+#include "bp_common.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +21,39 @@
 namespace tethash::detail {
 
 namespace {
+
+class HierarchicalGrid final : public BroadPhase {
+  public:
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override
+    {
+        return bytes_of(m_boxes) + bytes_of(m_level) + bytes_of(m_bucket) + bytes_of(m_start) + bytes_of(m_entries) +
+               bytes_of(m_cell) + bytes_of(m_big) + m_sorted.memory_bytes() + bytes_of(m_static);
+    }
+    /// Occupied levels (plus one when some tets exceed the top level).
+    std::int64_t nodes() const override { return m_nodes; }
+
+    static constexpr int max_levels = 32;
+
+  private:
+    /// A tet in the table: its box, level and min-corner cell, so that a scan compares the exact cell.
+    struct Entry {
+        Box box;
+        std::int64_t cell[3];
+        Index tet;
+        std::int32_t level;
+    };
+    std::int64_t m_nodes = 0;
+    std::vector<Box> m_boxes;
+    std::vector<std::int32_t> m_level;   // per tet: its level, or -1 when it exceeds the top level
+    std::vector<std::uint64_t> m_bucket; // per tet: its bucket
+    std::vector<std::int64_t> m_cell;    // per tet: its min-corner cell (3)
+    std::vector<Index> m_start;          // buckets + 1
+    std::vector<Entry> m_entries;        // by bucket
+    std::vector<Index> m_big;            // tets exceeding the top level
+    VerticesByX m_sorted;                // with tets beyond the top level: the vertices by x
+    std::vector<unsigned char> m_static;
+};
 
 std::uint64_t cell_hash(std::int32_t level, const std::int64_t c[3])
 {
@@ -31,17 +67,14 @@ std::uint64_t cell_hash(std::int32_t level, const std::int64_t c[3])
     return h;
 }
 
-} // namespace
-
 BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     m_nodes = 0;
     m_entries.clear();
     m_big.clear();
-    if (n == 0 || m == 0) return times;
+    if (n == 0 || m == 0) return {};
     const int T = static_cast<int>(sinks.size());
     const int levels = s.params.levels > 0 ? std::min(s.params.levels, max_levels) : max_levels;
 
@@ -118,8 +151,7 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
 
     static_vertex_flags(s, m_static);
     if (!m_big.empty()) m_sorted.build(s); // the vertices by x for the tets beyond the top level
-    times.ms_build = ms_since(t0);
-    const auto t1 = std::chrono::steady_clock::now();
+    timer.end_build();
 
     const std::uint64_t mask = buckets - 1;
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
@@ -145,14 +177,14 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
         const Index t = m_big[static_cast<std::size_t>(i)];
         m_sorted.find(s, m_boxes[static_cast<std::size_t>(t)], t, s.tet_static[t] != 0, m_static.data(), out);
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
-std::int64_t HierarchicalGrid::memory_bytes() const
+} // namespace
+
+std::unique_ptr<BroadPhase> make_hierarchical_grid()
 {
-    return bytes_of(m_boxes) + bytes_of(m_level) + bytes_of(m_bucket) + bytes_of(m_start) + bytes_of(m_entries) +
-           bytes_of(m_cell) + bytes_of(m_big) + m_sorted.memory_bytes() + bytes_of(m_static);
+    return std::make_unique<HierarchicalGrid>();
 }
 
 } // namespace tethash::detail

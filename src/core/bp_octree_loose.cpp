@@ -1,4 +1,7 @@
-// The loose octree (bp_octree_loose.hpp). Rebuilt every call.
+// The loose octree over the tets as a broad phase (docs/partitions.md): cubic cells enlarged by a
+// looseness factor, each tet stored in one cell (the deepest on its path whose loose box contains its box), each
+// vertex descending through the cells whose loose box contains it. Rebuilt
+// every call.
 //
 // The root cell is the cube around the union of the tet boxes; its loose box also covers that union exactly. A cell
 // of half edge h and centre c has the loose box c ± looseness·h, its children the centres c ± h/2. A tet descends from
@@ -8,7 +11,7 @@
 // node on its path (each step checked it), so a vertex in the box reaches the tet's node: no pair is missed whatever
 // the rounding and the looseness (≥ 1). Each tet is in one node and each node is visited once per vertex, so each
 // pair is found once. Subtrees without tets are not entered.
-#include "bp_octree_loose.hpp"
+#include "bp_common.hpp"
 
 #include <algorithm>
 
@@ -16,13 +19,43 @@ namespace tethash::detail {
 
 namespace {
 
+class LooseOctree final : public BroadPhase {
+  public:
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override
+    {
+        return bytes_of(m_nodes) + bytes_of(m_boxes) + bytes_of(m_node_of) + bytes_of(m_items) +
+               bytes_of(m_item_boxes) + bytes_of(m_static);
+    }
+    std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
+
+    static constexpr int default_max_depth = 10;
+    static constexpr double default_looseness = 2;
+
+  private:
+    struct Node {
+        Box loose;                  ///< the cell's box enlarged by the looseness (the root's: also every tet box)
+        double centre[3], half;     ///< the cell itself: centre ± half
+        Index children = -1;        ///< first of 8 consecutive children, -1 while none
+        Index first = 0, count = 0; ///< its tets: m_items[first, first + count)
+        Index below = 0;            ///< tets in its subtree
+    };
+    /// Appends the 8 children of node i.
+    void split(Index i, double looseness);
+
+    std::vector<Node> m_nodes;
+    std::vector<Box> m_boxes;      // per tet
+    std::vector<Index> m_node_of;  // per tet: its node
+    std::vector<Index> m_items;    // tets by node
+    std::vector<Box> m_item_boxes; // their boxes
+    std::vector<unsigned char> m_static;
+};
+
 bool contains(const Box& outer, const Box& inner)
 {
     return outer.lo[0] <= inner.lo[0] && outer.lo[1] <= inner.lo[1] && outer.lo[2] <= inner.lo[2] &&
            outer.hi[0] >= inner.hi[0] && outer.hi[1] >= inner.hi[1] && outer.hi[2] >= inner.hi[2];
 }
-
-} // namespace
 
 void LooseOctree::split(Index i, double looseness)
 {
@@ -44,12 +77,11 @@ void LooseOctree::split(Index i, double looseness)
 
 BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     const int T = static_cast<int>(sinks.size());
     m_nodes.clear();
-    if (n == 0 || m == 0) return times;
+    if (n == 0 || m == 0) return {};
     const double looseness = s.params.looseness > 0 ? s.params.looseness : default_looseness;
     const int max_depth = s.params.max_depth > 0 ? s.params.max_depth : default_max_depth;
 
@@ -125,8 +157,7 @@ BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<Candidate
                 node.below += m_nodes[static_cast<std::size_t>(node.children + k)].below;
     }
     static_vertex_flags(s, m_static);
-    times.ms_build = ms_since(t0);
-    const auto t1 = std::chrono::steady_clock::now();
+    timer.end_build();
 
     const Node* nodes = m_nodes.data();
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
@@ -143,14 +174,14 @@ BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<Candidate
                     stack[top++] = node.children + k;
         }
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
-std::int64_t LooseOctree::memory_bytes() const
+} // namespace
+
+std::unique_ptr<BroadPhase> make_loose_octree()
 {
-    return bytes_of(m_nodes) + bytes_of(m_boxes) + bytes_of(m_node_of) + bytes_of(m_items) + bytes_of(m_item_boxes) +
-           bytes_of(m_static);
+    return std::make_unique<LooseOctree>();
 }
 
 } // namespace tethash::detail

@@ -1,4 +1,5 @@
-// Sort and sweep (bp_sort_sweep.hpp).
+// Sort and sweep as a broad phase (docs/partitions.md): the vertices and the tet boxes sorted on the
+// axis of largest variance, the orders kept across calls and repaired by insertion sort (temporal coherence).
 //
 // The axis is the one of largest variance of the vertex positions; it changes only when another axis's variance
 // exceeds the current one's by 20 % (a new axis means a sort from scratch). Both lists keep their order from the last
@@ -8,13 +9,40 @@
 // the vertices from the cursor while their coordinate is ≤ its high end and keeps those in its box on the other two
 // axes. Chunks of tets run in parallel, each starting its cursor by a binary search. Each (vertex, tet) pair is looked
 // at once, by the tet's scan; comparisons on the closed interval, so boundary points are found.
-#include "bp_sort_sweep.hpp"
+#include "bp_common.hpp"
 
 #include <algorithm>
 
 namespace tethash::detail {
 
 namespace {
+
+class SortSweep final : public BroadPhase {
+  public:
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override
+    {
+        return bytes_of(m_points) + bytes_of(m_tets) + bytes_of(m_boxes) + bytes_of(m_xyz) + bytes_of(m_static);
+    }
+    std::int64_t nodes() const override { return 0; }
+
+    /// Calls whose orders were repaired by insertion sort, and calls that sorted from scratch (first call, new
+    /// axis, or an insertion sort that exceeded its budget of moves).
+    BroadPhaseCounts counts() const override { return {m_full, m_incremental}; }
+
+  private:
+    struct Key {
+        double x;
+        Index id;
+    };
+    int m_axis = -1;
+    std::int64_t m_incremental = 0, m_full = 0;
+    std::vector<Key> m_points; // vertices by their coordinate on the axis
+    std::vector<Key> m_tets;   // tets by their box's low end on the axis
+    std::vector<Box> m_boxes;
+    std::vector<double> m_xyz; // the vertices' positions in the sorted order
+    std::vector<unsigned char> m_static;
+};
 
 bool key_less(double xa, Index a, double xb, Index b)
 {
@@ -45,15 +73,12 @@ template <class Key> void full_sort(std::vector<Key>& keys)
     std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return key_less(a.x, a.id, b.x, b.id); });
 }
 
-} // namespace
-
 BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     const double* P = s.positions;
-    if (n == 0 || m == 0) return times;
+    if (n == 0 || m == 0) return {};
     const int T = static_cast<int>(sinks.size());
 
     // The axis of largest variance (sums relative to the first vertex: no cancellation far from the origin).
@@ -107,8 +132,7 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
         std::copy(p, p + 3, m_xyz.begin() + 3 * static_cast<std::ptrdiff_t>(i));
     }
     static_vertex_flags(s, m_static);
-    times.ms_build = ms_since(t0);
-    const auto t1 = std::chrono::steady_clock::now();
+    timer.end_build();
 
     // The sweep, in chunks of consecutive tets.
     const Index chunk = 512;
@@ -130,19 +154,18 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
                 const double* p = m_xyz.data() + 3 * static_cast<std::size_t>(j);
                 if (p[axis] > box.hi[axis]) break;
                 if (p[b] < box.lo[b] || p[b] > box.hi[b] || p[c] < box.lo[c] || p[c] > box.hi[c]) continue;
-                const Index v = m_points[static_cast<std::size_t>(j)].id;
-                if (tet_static && m_static[static_cast<std::size_t>(v)]) continue;
-                out.push_back({v, t});
+                add_candidate(m_points[static_cast<std::size_t>(j)].id, t, tet_static, m_static.data(), out);
             }
         }
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
-std::int64_t SortSweep::memory_bytes() const
+} // namespace
+
+std::unique_ptr<BroadPhase> make_sort_sweep()
 {
-    return bytes_of(m_points) + bytes_of(m_tets) + bytes_of(m_boxes) + bytes_of(m_xyz) + bytes_of(m_static);
+    return std::make_unique<SortSweep>();
 }
 
 } // namespace tethash::detail

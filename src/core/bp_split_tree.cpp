@@ -26,8 +26,7 @@ class SplitTreeBroadPhase final : public BroadPhase {
 
 BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     SplitTreeParams params;
     params.rule = m_rule;
     params.max_depth = s.params.max_depth > 0 ? s.params.max_depth : -1;
@@ -43,9 +42,8 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
     m_tree.build(m_points);
     m_nodes = m_tree.stats().nodes;
     static_vertex_flags(s, m_static);
-    times.ms_build = ms_since(t0);
+    timer.end_build();
 
-    const auto t1 = std::chrono::steady_clock::now();
     m_found.resize(sinks.size());
     m_scratch.resize(sinks.size());
     for_each_index(s.num_tets, 64, sinks, [&](Index t, std::vector<CandidatePair>& out) {
@@ -57,10 +55,9 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
         m_tree.query(q, found, m_scratch[r]);
         const bool tet_static = s.tet_static[t] != 0;
         for (std::uint32_t v : found)
-            if (!(tet_static && m_static[v])) out.push_back({static_cast<Index>(v), t});
+            add_candidate(static_cast<Index>(v), t, tet_static, m_static.data(), out);
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
 std::int64_t SplitTreeBroadPhase::memory_bytes() const

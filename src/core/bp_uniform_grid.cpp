@@ -1,9 +1,12 @@
-// The dense uniform grid (bp_uniform_grid.hpp). Cell (x, y, z) of the vertices' box [o, h] holds the vertices p with
+// The dense uniform grid as a broad phase (docs/partitions.md): an array of cells over the
+// vertices' bounding box, the vertices counting-sorted into it, each tet box enumerating the cells it overlaps.
+//
+// Cell (x, y, z) of the vertices' box [o, h] holds the vertices p with
 // cell_coord(p, o, 1/l) = (x, y, z); cells are numbered z fastest so that the cells of one (x, y) column of a tet box
 // are one contiguous range of the sorted vertices. A tet box's cell range uses the same expression for its corners
 // (monotone: a vertex in the box has its cell in the range), clamped to the grid (every tet box lies in the vertices'
 // box: its corners are vertex coordinates). Each vertex is in one cell, so each pair is found once.
-#include "bp_uniform_grid.hpp"
+#include "bp_common.hpp"
 
 #include "tethash/error.hpp"
 
@@ -12,14 +15,38 @@
 
 namespace tethash::detail {
 
+namespace {
+
+class UniformGrid final : public BroadPhase {
+  public:
+    /// Throws Error when the grid would need more than max_cells cells or max_bytes bytes.
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override
+    {
+        return bytes_of(m_start) + bytes_of(m_ids) + bytes_of(m_xyz) + bytes_of(m_cell) + bytes_of(m_static);
+    }
+    std::int64_t nodes() const override { return m_cells; }
+
+    static constexpr std::int64_t max_cells = std::int64_t{1} << 28;
+    static constexpr std::int64_t max_bytes = std::int64_t{1} << 31;
+
+  private:
+    std::int64_t m_cells = 0;
+    std::int64_t m_dims[3] = {0, 0, 0};
+    std::vector<Index> m_start;       // cells + 1: the vertices of cell c are m_ids[m_start[c], m_start[c + 1])
+    std::vector<Index> m_ids;         // vertices by cell (z fastest, then y, then x)
+    std::vector<double> m_xyz;        // their positions in that order (3 per vertex)
+    std::vector<std::int32_t> m_cell; // per vertex: its cell
+    std::vector<unsigned char> m_static;
+};
+
 BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    BroadPhaseTimes times;
-    const auto t0 = std::chrono::steady_clock::now();
+    PhaseTimer timer;
     const Index n = s.num_vertices;
     const double* P = s.positions;
     m_cells = 0;
-    if (n == 0 || s.num_tets == 0) return times;
+    if (n == 0 || s.num_tets == 0) return {};
 
     const Box box = vertex_box(s);
     const double *lo = box.lo, *hi = box.hi;
@@ -66,8 +93,7 @@ BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<Candidate
         m_start[static_cast<std::size_t>(c)] = m_start[static_cast<std::size_t>(c) - 1];
     m_start[0] = 0;
     static_vertex_flags(s, m_static);
-    times.ms_build = ms_since(t0);
-    const auto t1 = std::chrono::steady_clock::now();
+    timer.end_build();
 
     for_each_index(s.num_tets, 256, sinks, [&](Index t, std::vector<CandidatePair>& out) {
         double blo[3], bhi[3];
@@ -85,19 +111,18 @@ BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<Candidate
                 const Index last = m_start[column + static_cast<std::size_t>(c1[2]) + 1];
                 for (Index i = first; i < last; ++i) {
                     if (!in_box(m_xyz.data() + 3 * static_cast<std::size_t>(i), blo, bhi)) continue;
-                    const Index v = m_ids[static_cast<std::size_t>(i)];
-                    if (tet_static && m_static[static_cast<std::size_t>(v)]) continue;
-                    out.push_back({v, t});
+                    add_candidate(m_ids[static_cast<std::size_t>(i)], t, tet_static, m_static.data(), out);
                 }
             }
     });
-    times.ms_query = ms_since(t1);
-    return times;
+    return timer.end_query();
 }
 
-std::int64_t UniformGrid::memory_bytes() const
+} // namespace
+
+std::unique_ptr<BroadPhase> make_uniform_grid()
 {
-    return bytes_of(m_start) + bytes_of(m_ids) + bytes_of(m_xyz) + bytes_of(m_cell) + bytes_of(m_static);
+    return std::make_unique<UniformGrid>();
 }
 
 } // namespace tethash::detail

@@ -1,12 +1,6 @@
 // The broad phases by method (broad_phase.hpp): each in its own file, chosen here.
 #include "broad_phase.hpp"
 
-#include "bp_brute_force.hpp"
-#include "bp_bvh.hpp"
-#include "bp_hierarchical_grid.hpp"
-#include "bp_octree_loose.hpp"
-#include "bp_sort_sweep.hpp"
-#include "bp_uniform_grid.hpp"
 #include "tethash/error.hpp"
 
 namespace tethash::detail {
@@ -15,19 +9,19 @@ std::unique_ptr<BroadPhase> make_broad_phase(Method method)
 {
     switch (method) {
     case Method::brute_force:
-        return std::make_unique<BruteForce>();
+        return make_brute_force();
     case Method::uniform_grid:
-        return std::make_unique<UniformGrid>();
+        return make_uniform_grid();
     case Method::hierarchical_grid:
-        return std::make_unique<HierarchicalGrid>();
+        return make_hierarchical_grid();
     case Method::sort_sweep:
-        return std::make_unique<SortSweep>();
+        return make_sort_sweep();
     case Method::bvh:
-        return std::make_unique<Bvh>(false);
+        return make_bvh(false);
     case Method::bvh_refit:
-        return std::make_unique<Bvh>(true);
+        return make_bvh(true);
     case Method::octree_loose:
-        return std::make_unique<LooseOctree>();
+        return make_loose_octree();
     case Method::octree:
     case Method::octree_point:
     case Method::kd_tree:

@@ -46,6 +46,12 @@ struct BroadPhaseTimes {
     double ms_query = 0; ///< finding the candidates
 };
 
+/// Work of a structure kept across calls, counted since the broad phase was made (zero for the others).
+struct BroadPhaseCounts {
+    std::int64_t builds = 0;  ///< built or sorted from scratch (the first call's included)
+    std::int64_t updates = 0; ///< refitted, or its orders repaired by insertion sort
+};
+
 class BroadPhase {
   public:
     virtual ~BroadPhase() = default;
@@ -59,10 +65,19 @@ class BroadPhase {
     virtual std::int64_t memory_bytes() const = 0;
     /// Cells, nodes or levels of the structure after the last call (what `DetectStats::nodes` reports).
     virtual std::int64_t nodes() const = 0;
+    /// Builds and updates so far (the refitted BVH's builds and refits, sort and sweep's full and repaired sorts).
+    virtual BroadPhaseCounts counts() const { return {}; }
 };
 
 /// The broad phase of `method` (not `hash`, not `automatic`).
 std::unique_ptr<BroadPhase> make_broad_phase(Method method);
+/// The broad phases, one per file (bp_*.cpp): `refit` keeps the BVH across calls (bvh_refit) instead of rebuilding.
+std::unique_ptr<BroadPhase> make_brute_force();
+std::unique_ptr<BroadPhase> make_uniform_grid();
+std::unique_ptr<BroadPhase> make_hierarchical_grid();
+std::unique_ptr<BroadPhase> make_sort_sweep();
+std::unique_ptr<BroadPhase> make_bvh(bool refit);
+std::unique_ptr<BroadPhase> make_loose_octree();
 /// The splitting-plane tree of `method` (octrees, k-d trees, BSP trees: bp_split_tree.cpp); nullptr for the others.
 std::unique_ptr<BroadPhase> make_split_tree_broad_phase(Method method);
 

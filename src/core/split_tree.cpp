@@ -1,6 +1,7 @@
 // The splitting-plane tree: octree, k-d tree and BSP tree as one structure (split_tree.hpp, docs/partitions.md).
 #include "tethash/split_tree.hpp"
 
+#include "enum_names.hpp"
 #include "tethash/error.hpp"
 
 #include <algorithm>
@@ -73,33 +74,23 @@ bool is_region_rule(SplitRule r)
     return r == SplitRule::region_octree || r == SplitRule::region_kd;
 }
 
+constexpr detail::EnumName<SplitRule> k_split_rule_names[] = {{SplitRule::region_octree, "octree"},
+                                                              {SplitRule::point_octree, "octree-point"},
+                                                              {SplitRule::region_kd, "kd"},
+                                                              {SplitRule::point_kd, "kd-point"},
+                                                              {SplitRule::bsp, "bsp"},
+                                                              {SplitRule::bsp_balanced, "bsp-balanced"}};
+
 } // namespace
 
 std::string_view split_rule_name(SplitRule rule)
 {
-    switch (rule) {
-    case SplitRule::region_octree:
-        return "octree";
-    case SplitRule::point_octree:
-        return "octree-point";
-    case SplitRule::region_kd:
-        return "kd";
-    case SplitRule::point_kd:
-        return "kd-point";
-    case SplitRule::bsp:
-        return "bsp";
-    case SplitRule::bsp_balanced:
-        return "bsp-balanced";
-    }
-    return "?";
+    return detail::name_of(k_split_rule_names, rule);
 }
 
 std::optional<SplitRule> parse_split_rule(std::string_view name)
 {
-    for (SplitRule r : {SplitRule::region_octree, SplitRule::point_octree, SplitRule::region_kd, SplitRule::point_kd,
-                        SplitRule::bsp, SplitRule::bsp_balanced})
-        if (split_rule_name(r) == name) return r;
-    return std::nullopt;
+    return detail::value_named(k_split_rule_names, name);
 }
 
 int default_split_depth(SplitRule rule)
