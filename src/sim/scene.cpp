@@ -394,7 +394,9 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             }
         } else if (key == "detector") {
             const toml::table& t = r.table(v, key);
-            r.check_keys(t, "detector.", {"cell_size", "table_size", "hash", "threads", "skin"});
+            r.check_keys(t, "detector.",
+                         {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size",
+                          "looseness", "levels"});
             for (auto&& [dk, dv] : t) {
                 const std::string d(dk.str()), full = "detector." + d;
                 // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
@@ -442,6 +444,21 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         s.detect.skin = r.non_negative(dv, full);
                     } else
                         grammar([&](const std::string& text) { parse_skin(text, s.detect, full); });
+                } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
+                    grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
+                } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
+                    PartitionParams& q = s.detect.partition;
+                    if (d == "looseness")
+                        q.looseness = r.positive(dv, full);
+                    else
+                        (d == "max_depth"   ? q.max_depth
+                         : d == "leaf_size" ? q.leaf_size
+                                            : q.levels) = static_cast<int>(r.int_at_least(dv, full, 1));
+                    try {
+                        Detector check(s.detect);
+                    } catch (const Error& e) {
+                        r.fail(&dv, full, e.what());
+                    }
                 }
             }
         } else if (key == "output") {

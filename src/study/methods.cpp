@@ -1,0 +1,158 @@
+// The broad-phase methods side by side (methods.hpp).
+#include "tethash/study/methods.hpp"
+
+#include "value_list.hpp"
+
+#include "tethash/error.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <new>
+
+namespace tethash::study {
+
+void parse_partition_param(const std::string& option, const std::string& text, DetectParams& params)
+{
+    PartitionParams& q = params.partition;
+    const std::string t = trim(text);
+    const bool keep = t == "default";
+    if (option == "--max-depth")
+        q.max_depth = keep ? 0 : static_cast<int>(std::clamp<long long>(parse_integer(t, option), -1, 1000));
+    else if (option == "--leaf-size")
+        q.leaf_size = keep ? 0 : static_cast<int>(std::clamp<long long>(parse_integer(t, option), -1, 1LL << 30));
+    else if (option == "--levels")
+        q.levels = keep ? 0 : static_cast<int>(std::clamp<long long>(parse_integer(t, option), -1, 1000));
+    else if (option == "--looseness")
+        q.looseness = keep ? 0 : parse_number(t, option);
+    else
+        throw Error("unknown partition parameter " + option);
+    // 0 means "the method's default" inside DetectParams; written out it is more likely a mistake.
+    if (!keep && ((option == "--max-depth" && q.max_depth == 0) || (option == "--leaf-size" && q.leaf_size == 0) ||
+                  (option == "--levels" && q.levels == 0)))
+        throw Error(option + " " + t + ": expected ≥ 1 (or 'default' for the method's default)");
+    if (!keep && option == "--looseness" && q.looseness == 0)
+        throw Error(option + " " + t + ": expected 1..16 (or 'default' for the method's default, 2)");
+    try {
+        Detector check(params); // the detector's own validation (no work)
+    } catch (const Error& e) {
+        throw Error(option + " " + t + ": " + e.what());
+    }
+}
+
+std::vector<Method> parse_method_list(const std::string& text, const std::string& option)
+{
+    std::vector<Method> out;
+    for (const std::string& item : items_of({text}, option)) {
+        if (item == "all") {
+            for (Method m : all_methods())
+                out.push_back(m);
+        } else {
+            out.push_back(parse_method(item, option));
+        }
+    }
+    return out;
+}
+
+std::vector<MethodRun> compare_methods(const CompareScene& scene, const DetectParams& params,
+                                       std::span<const Method> methods, int repeat)
+{
+    if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
+    std::vector<MethodRun> runs;
+    for (Method m : methods) {
+        MethodRun run;
+        run.method = m;
+        try {
+            DetectParams p = params;
+            p.method = m;
+            Detector det(p);
+            det.set_topology(scene.tets, static_cast<Index>(scene.positions.rows()), scene.vertex_object,
+                             scene.tet_object, scene.objects);
+            det.detect(scene.positions, &run.first);
+            std::vector<DetectStats> all(static_cast<std::size_t>(repeat));
+            for (DetectStats& s : all) {
+                det.detect(scene.positions, &s);
+                run.run_ms.push_back(s.ms_total);
+            }
+            std::vector<DetectStats> sorted = all;
+            std::sort(sorted.begin(), sorted.end(),
+                      [](const DetectStats& a, const DetectStats& b) { return a.ms_total < b.ms_total; });
+            run.stats = sorted[sorted.size() / 2];
+            run.contacts = det.contacts();
+        } catch (const Error& e) {
+            run.error = e.what();
+        } catch (const std::bad_alloc&) {
+            run.error = "out of memory";
+        }
+        runs.push_back(std::move(run));
+    }
+    return runs;
+}
+
+Agreement check_agreement(const std::vector<MethodRun>& runs)
+{
+    const MethodRun* ref = nullptr;
+    int ran = 0;
+    for (const MethodRun& r : runs) {
+        if (!r.error.empty()) continue;
+        ++ran;
+        if (!ref) {
+            ref = &r;
+            continue;
+        }
+        std::int64_t missed = 0, extra = 0;
+        std::size_t i = 0, j = 0;
+        auto key = [](const Contact& c) { return std::pair<Index, Index>(c.vertex, c.tet); };
+        while (i < r.contacts.size() || j < ref->contacts.size()) {
+            if (j == ref->contacts.size() || (i < r.contacts.size() && key(r.contacts[i]) < key(ref->contacts[j]))) {
+                ++extra;
+                ++i;
+            } else if (i == r.contacts.size() || key(ref->contacts[j]) < key(r.contacts[i])) {
+                ++missed;
+                ++j;
+            } else {
+                ++i;
+                ++j;
+            }
+        }
+        if (missed || extra)
+            return {false, fmt::format("methods disagree: {} returned {} contacts, {} returned {} ({} missing, {} "
+                                       "extra)",
+                                       to_string(r.method), r.contacts.size(), to_string(ref->method),
+                                       ref->contacts.size(), missed, extra)};
+    }
+    const int failed = static_cast<int>(runs.size()) - ran;
+    std::string msg = ran == 0 ? std::string("no method ran")
+                               : fmt::format("all {} methods that ran returned the same {} contacts", ran,
+                                             ref->contacts.size());
+    if (failed) msg += fmt::format(" ({} failed: see their rows)", failed);
+    return {true, msg};
+}
+
+std::string human_bytes(double b)
+{
+    if (b < 1000) return fmt::format("{:.0f} B", b);
+    if (b < 1e6) return fmt::format("{:.1f} kB", b / 1e3);
+    if (b < 1e9) return fmt::format("{:.1f} MB", b / 1e6);
+    return fmt::format("{:.2f} GB", b / 1e9);
+}
+
+std::string method_table(const std::vector<MethodRun>& runs)
+{
+    std::string out = fmt::format("{:<13} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9} {:>9}\n", "method",
+                                  "build ms", "query ms", "exact ms", "sort ms", "total ms", "candidates", "memory",
+                                  "nodes", "contacts");
+    for (const MethodRun& r : runs) {
+        if (!r.error.empty()) {
+            out += fmt::format("{:<13} error: {}\n", to_string(r.method), r.error);
+            continue;
+        }
+        const DetectStats& s = r.stats;
+        out += fmt::format("{:<13} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>12} {:>10} {:>9} {:>9}\n",
+                           to_string(r.method), s.ms_vertices, s.ms_tets, s.ms_inside, s.ms_sort, s.ms_total,
+                           s.candidates, human_bytes(static_cast<double>(s.memory_bytes)), s.nodes, r.contacts.size());
+    }
+    return out;
+}
+
+} // namespace tethash::study
