@@ -1,9 +1,16 @@
 // `tethash detect --method`: every broad phase gives the default's contacts, `--method all` compares them in one
-// table and says whether they agree, bad method and partition options are refused naming the option.
+// table and says whether they agree, bad method and partition options are refused naming the option;
+// `tethash study method`: a row per scene, method and partition value, the same contacts from every method.
 #include "cli_support.hpp"
 #include "core_scenes.hpp"
+#include "study_support.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/study/methods.hpp"
+#include "tethash/study/table.hpp"
+
+#include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -62,10 +69,11 @@ TEST(CliMethod, AllPrintsOneRowPerMethodAndTheAgreement)
     std::vector<std::string> lines;
     for (std::string line; std::getline(in, line);)
         lines.push_back(line);
-    const auto header = std::find_if(lines.begin(), lines.end(),
-                                     [](const std::string& l) { return l.rfind("method ", 0) == 0; });
+    const auto header =
+        std::find_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("method ", 0) == 0; });
     ASSERT_NE(header, lines.end()) << r.out;
-    for (const char* col : {"build ms", "query ms", "exact ms", "total ms", "candidates", "memory", "nodes", "contacts"})
+    for (const char* col :
+         {"build ms", "query ms", "exact ms", "total ms", "candidates", "memory", "nodes", "contacts"})
         EXPECT_NE(header->find(col), std::string::npos) << col;
     int ran = 0;
     std::string contacts;
@@ -101,4 +109,57 @@ TEST(CliMethod, BadMethodAndPartitionOptionsNameTheOption)
     expect_refused(run_tethash("detect " + scene + " --method all --contacts " + quote(dir / "c.csv")),
                    {"--contacts", "--method all"});
     EXPECT_FALSE(std::filesystem::exists(dir / "c.csv"));
+}
+
+TEST(CliMethod, StudyMethodRowPerSceneAndMethodWithTheSameContacts)
+{
+    const auto dir = temp_dir();
+    std::filesystem::create_directories(dir / "one");
+    std::filesystem::create_directories(dir / "two");
+    const std::string one = two_boxes(dir / "one", 2, Eigen::RowVector3d(0.31, 0.17, 0.23));
+    const std::string two = two_boxes(dir / "two", 3, Eigen::RowVector3d(0.2, 0.4, 0.1));
+    const auto r =
+        run_tethash("study method --mesh " + quote(one) + " --mesh " + quote(two) +
+                    " --methods all --max-depth 4,8 --repeat 1 --warmup 0 --no-plot --quiet --out " + quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const study::Table t = study::Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : {"scene", "method", "max_depth", "leaf_size", "looseness", "levels", "candidates", "nodes",
+                            "memory_bytes", "contacts", "missed", "extra", "ms_total", "error"})
+        ASSERT_GE(t.index_of(col), 0) << col;
+    const auto at = [&](const study::Row& row, const char* col) {
+        return row[static_cast<std::size_t>(t.index_of(col))];
+    };
+    std::map<std::string, std::multiset<std::string>> depths; // "scene method" -> its max_depth cells
+    std::map<std::string, std::string> contacts;              // scene -> the contacts of every method that ran
+    int ran = 0;
+    for (const study::Row& row : t.rows) {
+        ASSERT_EQ(at(row, "scene"), "a+b");
+        depths[at(row, "vertices") + " " + at(row, "method")].insert(at(row, "max_depth"));
+        if (!at(row, "error").empty()) continue;
+        ++ran;
+        EXPECT_EQ(at(row, "missed"), "0") << at(row, "scene") << " " << at(row, "method");
+        EXPECT_EQ(at(row, "extra"), "0") << at(row, "scene") << " " << at(row, "method");
+        auto [it, fresh] = contacts.emplace(at(row, "vertices"), at(row, "contacts"));
+        EXPECT_EQ(at(row, "contacts"), it->second) << at(row, "vertices") << " " << at(row, "method");
+    }
+    EXPECT_GE(ran, 4) << "hash and brute force on both scenes";
+    ASSERT_EQ(contacts.size(), 2u);
+    for (const auto& [scene, count] : contacts)
+        for (Method m : all_methods()) {
+            const auto& cells = depths[scene + " " + to_string(m)];
+            if (study::method_uses(m, "--max-depth"))
+                EXPECT_EQ(cells, (std::multiset<std::string>{"4", "8"})) << to_string(m);
+            else
+                EXPECT_EQ(cells, (std::multiset<std::string>{""})) << to_string(m);
+        }
+    for (const auto& [args, message] :
+         std::vector<std::pair<std::string, std::string>>{{"--methods octtree", "--methods"},
+                                                          {"--max-depth 0", "--max-depth"},
+                                                          {"--looseness 0.5", "--looseness"},
+                                                          {"--partition-scenes nowhere", "--partition-scenes"}}) {
+        const auto bad =
+            run_tethash("study method --mesh " + quote(one) + " " + args + " --no-plot --out " + quote(dir / "bad"));
+        expect_refused(bad, {message});
+        EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "study.csv")) << args;
+    }
 }

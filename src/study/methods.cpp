@@ -5,12 +5,28 @@
 
 #include "tethash/error.hpp"
 
-#include <fmt/format.h>
-
 #include <algorithm>
+#include <cstdarg>
+#include <cstdio>
 #include <new>
 
 namespace tethash::study {
+
+namespace {
+
+/// printf into a string (the study layer formats without fmt).
+std::string format(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* f, ...)
+{
+    char buf[512];
+    va_list args;
+    va_start(args, f);
+    std::vsnprintf(buf, sizeof buf, f, args);
+    va_end(args);
+    return buf;
+}
+
+} // namespace
 
 void parse_partition_param(const std::string& option, const std::string& text, DetectParams& params)
 {
@@ -37,6 +53,27 @@ void parse_partition_param(const std::string& option, const std::string& text, D
         Detector check(params); // the detector's own validation (no work)
     } catch (const Error& e) {
         throw Error(option + " " + t + ": " + e.what());
+    }
+}
+
+bool method_uses(Method method, const std::string& option)
+{
+    switch (method) {
+    case Method::octree:
+    case Method::octree_point:
+    case Method::kd_tree:
+    case Method::kd_tree_point:
+    case Method::bsp_tree:
+    case Method::bsp_tree_balanced:
+    case Method::bvh:
+    case Method::bvh_refit:
+        return option == "--max-depth" || option == "--leaf-size";
+    case Method::octree_loose:
+        return option == "--max-depth" || option == "--leaf-size" || option == "--looseness";
+    case Method::hierarchical_grid:
+        return option == "--levels";
+    default:
+        return false;
     }
 }
 
@@ -116,41 +153,41 @@ Agreement check_agreement(const std::vector<MethodRun>& runs)
             }
         }
         if (missed || extra)
-            return {false, fmt::format("methods disagree: {} returned {} contacts, {} returned {} ({} missing, {} "
-                                       "extra)",
-                                       to_string(r.method), r.contacts.size(), to_string(ref->method),
-                                       ref->contacts.size(), missed, extra)};
+            return {false,
+                    format("methods disagree: %s returned %zu contacts, %s returned %zu (%lld missing, %lld extra)",
+                           to_string(r.method), r.contacts.size(), to_string(ref->method), ref->contacts.size(),
+                           static_cast<long long>(missed), static_cast<long long>(extra))};
     }
     const int failed = static_cast<int>(runs.size()) - ran;
-    std::string msg = ran == 0 ? std::string("no method ran")
-                               : fmt::format("all {} methods that ran returned the same {} contacts", ran,
-                                             ref->contacts.size());
-    if (failed) msg += fmt::format(" ({} failed: see their rows)", failed);
+    std::string msg = ran == 0
+                          ? std::string("no method ran")
+                          : format("all %d methods that ran returned the same %zu contacts", ran, ref->contacts.size());
+    if (failed) msg += format(" (%d failed: see their rows)", failed);
     return {true, msg};
 }
 
 std::string human_bytes(double b)
 {
-    if (b < 1000) return fmt::format("{:.0f} B", b);
-    if (b < 1e6) return fmt::format("{:.1f} kB", b / 1e3);
-    if (b < 1e9) return fmt::format("{:.1f} MB", b / 1e6);
-    return fmt::format("{:.2f} GB", b / 1e9);
+    if (b < 1000) return format("%.0f B", b);
+    if (b < 1e6) return format("%.1f kB", b / 1e3);
+    if (b < 1e9) return format("%.1f MB", b / 1e6);
+    return format("%.2f GB", b / 1e9);
 }
 
 std::string method_table(const std::vector<MethodRun>& runs)
 {
-    std::string out = fmt::format("{:<13} {:>9} {:>9} {:>9} {:>9} {:>9} {:>12} {:>10} {:>9} {:>9}\n", "method",
-                                  "build ms", "query ms", "exact ms", "sort ms", "total ms", "candidates", "memory",
-                                  "nodes", "contacts");
+    std::string out = format("%-13s %9s %9s %9s %9s %9s %12s %10s %9s %9s\n", "method", "build ms", "query ms",
+                             "exact ms", "sort ms", "total ms", "candidates", "memory", "nodes", "contacts");
     for (const MethodRun& r : runs) {
         if (!r.error.empty()) {
-            out += fmt::format("{:<13} error: {}\n", to_string(r.method), r.error);
+            out += std::string(format("%-13s error: ", to_string(r.method))) + r.error + "\n";
             continue;
         }
         const DetectStats& s = r.stats;
-        out += fmt::format("{:<13} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>12} {:>10} {:>9} {:>9}\n",
-                           to_string(r.method), s.ms_vertices, s.ms_tets, s.ms_inside, s.ms_sort, s.ms_total,
-                           s.candidates, human_bytes(static_cast<double>(s.memory_bytes)), s.nodes, r.contacts.size());
+        out += format("%-13s %9.3f %9.3f %9.3f %9.3f %9.3f %12lld %10s %9lld %9zu\n", to_string(r.method),
+                      s.ms_vertices, s.ms_tets, s.ms_inside, s.ms_sort, s.ms_total,
+                      static_cast<long long>(s.candidates), human_bytes(static_cast<double>(s.memory_bytes)).c_str(),
+                      static_cast<long long>(s.nodes), r.contacts.size());
     }
     return out;
 }

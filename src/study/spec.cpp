@@ -17,8 +17,9 @@ Sweep parse_sweep(const std::string& name)
     if (name == "grid") return Sweep::grid;
     if (name == "integrator") return Sweep::integrator;
     if (name == "stability") return Sweep::stability;
+    if (name == "method") return Sweep::method;
     throw Error("sweep: unknown sweep '" + name +
-                "' (expected cell-size, table-size, hash, threads, grid, integrator or stability)");
+                "' (expected cell-size, table-size, hash, threads, grid, method, integrator or stability)");
 }
 
 const char* to_string(Sweep s)
@@ -38,6 +39,8 @@ const char* to_string(Sweep s)
         return "integrator";
     case Sweep::stability:
         return "stability";
+    case Sweep::method:
+        return "method";
     }
     return "?";
 }

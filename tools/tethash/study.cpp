@@ -121,7 +121,8 @@ void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool q
 void run(Args& a)
 {
     if (a.positional.empty())
-        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, integrator) or merge");
+        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, method, integrator, stability) "
+                    "or merge");
     const std::string what = a.positional.front();
     if (what == "merge") {
         std::vector<std::string> dirs(a.positional.begin() + 1, a.positional.end());
@@ -207,12 +208,14 @@ void run(Args& a)
 
 Registrar reg{
     {"study",
-     "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, or the "
+     "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, the broad-phase method, or "
+     "the "
      "simulator's integrator x dt x substeps, or its stability matrix; CSV, JSON and figures",
      [](CLI::App& sub) {
          auto a = std::make_shared<Args>();
          sub.add_option("sweep", a->positional,
-                        "cell-size | table-size | hash | threads | grid | integrator | stability, or: merge DIR...")
+                        "cell-size | table-size | hash | threads | grid | method | integrator | stability, or: merge "
+                        "DIR...")
              ->required();
          sub.add_option("--mesh", a->o.meshes,
                         "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
@@ -233,6 +236,17 @@ Registrar reg{
          sub.add_option("--threads", a->o.threads,
                         "thread counts: list or FROM:TO (0 = every hardware thread; default 1; threads sweep: "
                         "1..cores)");
+         sub.add_option(
+                "--partition-scenes", a->o.partition_scenes,
+                "scenes of the space-partition comparison: bars, sizes, corner, thin or all (hash at its worst; "
+                "many objects each touching several)")
+             ->delimiter(',');
+         sub.add_option("--methods", a->o.methods,
+                        "broad phases (detect --method names, or all; default: all in the method sweep, else hash)");
+         sub.add_option("--max-depth", a->o.max_depth, "trees: deepest levels, list (default: the method's)");
+         sub.add_option("--leaf-size", a->o.leaf_size, "trees: items per leaf, list (default: the method's)");
+         sub.add_option("--looseness", a->o.looseness, "loose octree: enlargement factors 1..16, list (default 2)");
+         sub.add_option("--levels", a->o.levels, "hierarchical grid: most levels, list (default: as sizes span)");
          sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
              ->delimiter(',');
          sub.add_option("--from", a->from,

@@ -17,6 +17,10 @@ namespace tethash::study {
 /// with the detector's own validation; throws Error "OPTION: ..." naming the text otherwise.
 void parse_partition_param(const std::string& option, const std::string& text, DetectParams& params);
 
+/// Whether `method` reads the partition parameter of `option` ("--max-depth", "--leaf-size": the trees and BVHs;
+/// "--looseness": the loose octree; "--levels": the hierarchical grid).
+bool method_uses(Method method, const std::string& option);
+
 /// Methods of a comma-separated list: names of the grammar (detect.hpp: parse_method) or "all" (every method
 /// but auto, in all_methods() order). Throws Error naming `option`.
 std::vector<Method> parse_method_list(const std::string& text, const std::string& option = "--methods");
