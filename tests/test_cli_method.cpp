@@ -163,3 +163,17 @@ TEST(CliMethod, StudyMethodRowPerSceneAndMethodWithTheSameContacts)
         EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "study.csv")) << args;
     }
 }
+
+TEST(CliMethod, StudyMethodFigure)
+{
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "matplotlib");
+    const auto dir = temp_dir();
+    const std::string mesh = two_boxes(dir, 2, Eigen::RowVector3d(0.31, 0.17, 0.23));
+    const auto r = run_tethash("study method --mesh " + quote(mesh) + " --methods hash,brute --repeat 1 --out " +
+                               quote(dir / "s"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(std::filesystem::exists(dir / "s" / "methods.svg")) << r.out << r.err;
+    const std::string svg = read_text(dir / "s" / "methods.svg");
+    for (const char* text : {"candidates to the exact test", "brute", "command:"})
+        EXPECT_NE(svg.find(text), std::string::npos) << text;
+}

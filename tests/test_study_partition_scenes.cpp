@@ -38,7 +38,8 @@ TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
         } else if (name == "sizes") {
             double shortest = 1e300, longest = 0;
             for (Index t = 0; t < s.mesh.num_tets(); ++t) {
-                const double e = (s.mesh.positions.row(s.mesh.tets(t, 0)) - s.mesh.positions.row(s.mesh.tets(t, 3))).norm();
+                const double e =
+                    (s.mesh.positions.row(s.mesh.tets(t, 0)) - s.mesh.positions.row(s.mesh.tets(t, 3))).norm();
                 shortest = std::min(shortest, e);
                 longest = std::max(longest, e);
             }
