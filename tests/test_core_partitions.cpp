@@ -2,6 +2,8 @@
 // scenes of the hash's own tests (random, inverted, lattice-aligned, offset, coincident, collapsed, object rules),
 // over each method's parameters, over moving scenes (structures kept across calls: refits, sweep orders, static
 // parts) and over thread counts.
+#include "../src/core/bp_bvh.hpp"
+#include "../src/core/bp_sort_sweep.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
@@ -10,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 
@@ -23,7 +26,8 @@ namespace {
 /// The methods under test.
 std::vector<Method> methods()
 {
-    return {Method::hash, Method::brute_force};
+    return {Method::hash,       Method::brute_force, Method::uniform_grid, Method::hierarchical_grid,
+            Method::sort_sweep, Method::bvh,         Method::bvh_refit,    Method::octree_loose};
 }
 } // namespace
 
@@ -233,4 +237,108 @@ TEST(CorePartitions, NamesAndParameterErrors)
     p = DetectParams{};
     p.method = static_cast<Method>(99);
     expect_error([&] { Detector d(p); }, {"method out of range"});
+}
+
+TEST(CorePartitions, UniformGridRefusesGridsBeyondItsMemoryLimit)
+{
+    // Two unit cubes 1000 apart with cells of 0.001: 10^18 cells. The error names the cells and bytes and the way out.
+    Scene s = test::lattice_object(1, 1, 1, 1.0, Eigen::Vector3d::Zero());
+    test::append_object(s, test::lattice_object(1, 1, 1, 1.0, Eigen::Vector3d(1000, 1000, 1000)));
+    DetectParams p;
+    p.method = Method::uniform_grid;
+    p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+    p.cell_size = 1e-3;
+    Detector det(p);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    expect_error([&] { det.detect(s.positions); },
+                 {"uniform grid", "cells (1001001 × 1001001 × 1001001)", "bytes", "larger cell size", "hash"});
+    // The same scene with cells of 10: 101^3 cells, stated in the statistics.
+    p.cell_size = 10;
+    det.set_params(p);
+    DetectStats st;
+    EXPECT_TRUE(same_contacts(det.detect(s.positions, &st), run_oracle(s)));
+    EXPECT_EQ(st.nodes, 101 * 101 * 101);
+    EXPECT_GT(st.memory_bytes, 101 * 101 * 101 * 4);
+}
+
+namespace {
+
+/// The broad phase's candidate pairs, sorted.
+std::vector<std::pair<Index, Index>> candidates(detail::BroadPhase& bp, const detail::PartitionScene& scene)
+{
+    std::vector<detail::CandidateSink> sinks(1);
+    bp.find(scene, sinks);
+    std::vector<std::pair<Index, Index>> out;
+    for (const detail::CandidatePair& c : sinks[0].pairs)
+        out.emplace_back(c.vertex, c.tet);
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+detail::PartitionScene partition_scene(const Scene& s, const std::vector<unsigned char>& tet_static,
+                                       const std::vector<Index>& moving)
+{
+    detail::PartitionScene scene;
+    scene.positions = s.positions.data();
+    scene.num_vertices = static_cast<Index>(s.positions.rows());
+    scene.tets = s.tets.data();
+    scene.num_tets = static_cast<Index>(s.tets.rows());
+    scene.moving_vertices = moving;
+    scene.tet_static = tet_static.data();
+    return scene;
+}
+
+} // namespace
+
+TEST(CorePartitions, RefittedBvhAndSweepFollowTheMotionAndRebuildWhenDegraded)
+{
+    // Small motions: the refitted tree is kept and the sweep's orders are repaired by insertion sort; the objects
+    // then scatter and turn (strong motion): the refitted tree degrades and is rebuilt. Every step the candidates
+    // equal the rebuilt tree's, and the contacts the oracle's.
+    Scene s = test::random_scene(91, 6, 3, 0.3);
+    const std::vector<unsigned char> tet_static(static_cast<std::size_t>(s.tets.rows()), 0);
+    std::vector<Index> moving(static_cast<std::size_t>(s.positions.rows()));
+    for (std::size_t v = 0; v < moving.size(); ++v)
+        moving[v] = static_cast<Index>(v);
+    detail::Bvh refit(true), rebuilt(false);
+    detail::SortSweep sweep;
+    DetectParams p;
+    p.method = Method::bvh_refit;
+    Detector det(p);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::int64_t builds_after_small = 0;
+    for (int step = 0; step < 30; ++step) {
+        const bool strong = step >= 10;
+        for (Eigen::Index v = 0; v < s.positions.rows(); ++v) {
+            const int o = s.vertex_object[static_cast<std::size_t>(v)];
+            for (int a = 0; a < 3; ++a)
+                s.positions(v, a) += 0.002 * u(rng) + (strong ? 0.15 * std::sin(o + 2.0 * a) : 0.0);
+        }
+        if (strong) // turn every object about its first vertex, each by its own angle
+            for (Eigen::Index v = 0; v < s.positions.rows(); ++v) {
+                const int o = s.vertex_object[static_cast<std::size_t>(v)];
+                const Eigen::Index first =
+                    std::find(s.vertex_object.begin(), s.vertex_object.end(), o) - s.vertex_object.begin();
+                const Eigen::Vector3d c = s.positions.row(first).transpose();
+                const Eigen::Matrix3d r = Eigen::AngleAxisd(0.3 * (o + 1), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+                s.positions.row(v) = (r * (s.positions.row(v).transpose() - c) + c).transpose();
+            }
+        detail::PartitionScene scene = partition_scene(s, tet_static, moving);
+        scene.first = step == 0;
+        const auto want = candidates(rebuilt, scene);
+        EXPECT_EQ(candidates(refit, scene), want) << "step " << step;
+        EXPECT_EQ(candidates(sweep, scene), want) << "step " << step;
+        EXPECT_TRUE(same_contacts(det.detect(s.positions), run_oracle(s))) << "step " << step;
+        if (step == 9) {
+            builds_after_small = refit.builds();
+            EXPECT_EQ(builds_after_small, 1) << "small motions refit the first tree";
+            EXPECT_EQ(sweep.full_sorts(), 1) << "small motions repair the first order";
+            EXPECT_EQ(sweep.incremental_sorts(), 9);
+        }
+    }
+    EXPECT_GT(refit.builds(), builds_after_small) << "strong motion degrades the tree: rebuilt";
+    EXPECT_LT(refit.builds(), 30) << "not rebuilt on every step";
+    EXPECT_EQ(refit.refits(), 29) << "every later call refits first";
 }

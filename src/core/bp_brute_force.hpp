@@ -1,6 +1,6 @@
 #pragma once
 // Brute force as a broad phase (private header): the vertices sorted by x, each tet box against its x-extent.
-#include "broad_phase.hpp"
+#include "bp_common.hpp"
 
 namespace tethash::detail {
 
@@ -11,8 +11,7 @@ class BruteForce final : public BroadPhase {
     std::int64_t nodes() const override { return 0; }
 
   private:
-    std::vector<Index> m_order; // vertices by increasing x (ties by id)
-    std::vector<double> m_xs;   // their x
+    VerticesByX m_sorted;
     std::vector<unsigned char> m_static;
 };
 

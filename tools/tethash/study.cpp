@@ -1,6 +1,7 @@
 // tethash study SWEEP ... : parameter studies (detection sweeps, integrator work-precision), and
 // tethash study merge DIR... --out DIR : joining the shards of a study.
 #include "command.hpp"
+#include "study_spheres.hpp"
 
 #include "tethash/error.hpp"
 #include "tethash/study/study.hpp"
@@ -68,15 +69,15 @@ std::string python_with_matplotlib()
     return "";
 }
 
-/// Runs tools/plot_study.py on `dir`; prints what happened.
-void make_figures(const std::string& dir)
+/// Runs tools/`script` (plot_study.py, plot_spheres.py) on `dir`; prints what happened.
+void make_figures(const std::string& dir, const std::string& script_name = "plot_study.py")
 {
     const std::string py = python_with_matplotlib();
     if (py.empty()) {
         std::printf("figures: skipped (no python3 with matplotlib found; the CSV and JSON are complete)\n");
         return;
     }
-    const std::string script = std::string(TETHASH_SOURCE_DIR) + "/tools/plot_study.py";
+    const std::string script = std::string(TETHASH_SOURCE_DIR) + "/tools/" + script_name;
     if (!std::filesystem::exists(script)) {
         std::printf("figures: skipped (%s not found)\n", script.c_str());
         return;
@@ -97,6 +98,7 @@ struct Args {
     bool no_plot = false, no_oracle = false, no_penetration = false, quiet = false;
     static constexpr int kUnset = std::numeric_limits<int>::min(); ///< option not given
     int repeat = kUnset, warmup = kUnset;
+    SpheresArgs spheres;
 };
 
 void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool quiet)
@@ -121,9 +123,28 @@ void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool q
 void run(Args& a)
 {
     if (a.positional.empty())
-        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, method, integrator, stability) "
-                    "or merge");
+        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, method, integrator, stability, "
+                    "spheres) or merge");
     const std::string what = a.positional.front();
+    if (what == "spheres") {
+        if (a.positional.size() > 1) throw Error("study: unexpected argument '" + a.positional[1] + "'");
+        run_spheres_command(a.spheres, a.out, a.quiet, own_command_line());
+        if (!a.no_plot) make_figures(a.spheres.o.out_dir, "plot_spheres.py");
+        return;
+    }
+    // The options the spheres study shares with the detection sweeps: the broad phases and the leaf size.
+    SpheresArgs spheres_only = a.spheres;
+    std::erase_if(spheres_only.options, [&](const CLI::Option* opt) {
+        const bool shared = opt->get_name() == "--methods" || opt->get_name() == "--leaf-size";
+        if (shared && opt->count() > 0) {
+            if (opt->get_name() == "--methods")
+                a.o.methods = a.spheres.o.methods;
+            else
+                a.o.leaf_size = {std::to_string(a.spheres.o.leaf_size)};
+        }
+        return shared;
+    });
+    reject_spheres_options(spheres_only, what);
     if (what == "merge") {
         std::vector<std::string> dirs(a.positional.begin() + 1, a.positional.end());
         if (dirs.empty()) throw Error("study merge: give the shard folders: tethash study merge DIR... --out DIR");
@@ -209,13 +230,13 @@ void run(Args& a)
 Registrar reg{
     {"study",
      "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, the broad-phase method, or "
-     "the "
-     "simulator's integrator x dt x substeps, or its stability matrix; CSV, JSON and figures",
+     "the simulator's integrator x dt x substeps, or its stability matrix, or the spheres experiment of the octree / "
+     "k-d / BSP comparison; CSV, JSON and figures",
      [](CLI::App& sub) {
          auto a = std::make_shared<Args>();
          sub.add_option("sweep", a->positional,
-                        "cell-size | table-size | hash | threads | grid | method | integrator | stability, or: merge "
-                        "DIR...")
+                        "cell-size | table-size | hash | threads | grid | method | integrator | stability | spheres, "
+                        "or: merge DIR...")
              ->required();
          sub.add_option("--mesh", a->o.meshes,
                         "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
@@ -241,10 +262,8 @@ Registrar reg{
                 "scenes of the space-partition comparison: bars, sizes, corner, thin or all (hash at its worst; "
                 "many objects each touching several)")
              ->delimiter(',');
-         sub.add_option("--methods", a->o.methods,
-                        "broad phases (detect --method names, or all; default: all in the method sweep, else hash)");
+         // --methods and --leaf-size are shared with the spheres study (study_spheres.cpp registers them).
          sub.add_option("--max-depth", a->o.max_depth, "trees: deepest levels, list (default: the method's)");
-         sub.add_option("--leaf-size", a->o.leaf_size, "trees: items per leaf, list (default: the method's)");
          sub.add_option("--looseness", a->o.looseness, "loose octree: enlargement factors 1..16, list (default 2)");
          sub.add_option("--levels", a->o.levels, "hierarchical grid: most levels, list (default: as sizes span)");
          sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
@@ -273,9 +292,10 @@ Registrar reg{
          sub.add_flag("--no-oracle", a->no_oracle, "do not compare with the brute-force oracle");
          sub.add_flag("--no-penetration", a->no_penetration, "do not measure the penetration-depth error");
          sub.add_option("--shard", a->shard, "I/N: run points with index % N == I (0 <= I < N)");
-         sub.add_option("-o,--out", a->out, "output folder, made if missing (default: study)");
+         sub.add_option("-o,--out", a->out, "output folder, made if missing (default: study; spheres: spheres)");
          sub.add_flag("--no-plot", a->no_plot, "do not run tools/plot_study.py");
          sub.add_flag("--quiet", a->quiet, "no progress output");
+         add_spheres_options(sub, a->spheres);
          sub.callback([a]() { run(*a); });
      }}};
 

@@ -1,0 +1,108 @@
+#pragma once
+// Pieces shared by the broad phases (private header): tet boxes of a whole scene, the cell coordinate every grid uses
+// for points and box corners alike, per-vertex static flags, the vertices sorted by x, the parallel loops over
+// vertices and tets that feed the threads' sinks, a timer.
+#include "broad_phase.hpp"
+#include "team.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace tethash::detail {
+
+/// A closed axis-aligned box.
+struct Box {
+    double lo[3], hi[3];
+};
+
+/// boxes[t] = the closed bounding box of tet t, for every tet (parallel over `threads`).
+void tet_boxes(const PartitionScene& s, std::vector<Box>& boxes, int threads);
+
+/// The closed bounding box of the vertices (num_vertices ≥ 1). Every tet box lies in it.
+Box vertex_box(const PartitionScene& s);
+
+/// flags[v] = 1 for the vertices of static objects, 0 otherwise (size num_vertices).
+void static_vertex_flags(const PartitionScene& s, std::vector<unsigned char>& flags);
+
+/// Largest cell coordinate magnitude: coordinates are clamped to ±2^62 (monotone, so still exact; cells merge).
+inline constexpr double max_cell = 4611686018427387904.0; // 2^62
+
+/// Cell coordinate floor((x − origin) · inv) of a point or a box corner, clamped to ±2^62. The grids use this one
+/// expression for points and for box corners: it is monotone in x (each operation rounds monotonically), so a point
+/// p with lo ≤ p ≤ hi has cell(lo) ≤ cell(p) ≤ cell(hi), also on cell borders and far from the origin.
+inline std::int64_t cell_coord(double x, double origin, double inv)
+{
+    double c = std::floor((x - origin) * inv);
+    c = c < -max_cell ? -max_cell : (c > max_cell ? max_cell : c);
+    return static_cast<std::int64_t>(c);
+}
+
+/// The vertices sorted by x (ties by id) with their x: the vertices in a box are in its x-range of the list.
+struct VerticesByX {
+    std::vector<Index> order;
+    std::vector<double> xs;
+    void build(const PartitionScene& s);
+    /// Appends (v, t) for every vertex v in the closed box b, except static vertices when `skip_static`
+    /// (`vertex_static`: per vertex, 1 for static).
+    void find(const PartitionScene& s, const Box& b, Index t, bool skip_static, const unsigned char* vertex_static,
+              std::vector<CandidatePair>& out) const;
+    std::int64_t memory_bytes() const;
+};
+
+/// Appends (v, items[k]) for each k in [first, last) whose box boxes[k] contains p, except static tets when
+/// `vertex_static`: a vertex against the tets of a leaf or cell.
+inline void find_in_boxes(const PartitionScene& s, const double* p, Index v, bool vertex_static, const Index* items,
+                          const Box* boxes, Index first, Index last, std::vector<CandidatePair>& out)
+{
+    for (Index k = first; k < last; ++k) {
+        if (!in_box(p, boxes[k].lo, boxes[k].hi)) continue;
+        const Index t = items[k];
+        if (vertex_static && s.tet_static[t]) continue;
+        out.push_back({v, t});
+    }
+}
+
+/// Calls f(v, p, vertex_static, out) for every vertex v (position p) in parallel over the sinks' threads, out being
+/// the calling thread's sink. Dynamic chunks: which thread finds a pair does not matter (the exact stage sorts).
+template <class F>
+void for_each_vertex(const PartitionScene& s, const std::vector<unsigned char>& vertex_static,
+                     std::vector<CandidateSink>& sinks, F&& f)
+{
+    const int T = static_cast<int>(sinks.size());
+#pragma omp parallel num_threads(T) if (T > 1)
+    {
+        std::vector<CandidatePair>& out = sinks[static_cast<std::size_t>(team_rank())].pairs;
+#pragma omp for schedule(dynamic, 256)
+        for (Index v = 0; v < s.num_vertices; ++v)
+            f(v, s.positions + 3 * static_cast<std::size_t>(v), vertex_static[static_cast<std::size_t>(v)] != 0, out);
+    }
+}
+
+/// Calls f(i, out) for i in [0, count) in parallel over the sinks' threads (dynamic chunks of `chunk`).
+template <class F> void for_each_index(Index count, int chunk, std::vector<CandidateSink>& sinks, F&& f)
+{
+    const int T = static_cast<int>(sinks.size());
+#pragma omp parallel num_threads(T) if (T > 1)
+    {
+        std::vector<CandidatePair>& out = sinks[static_cast<std::size_t>(team_rank())].pairs;
+#pragma omp for schedule(dynamic, chunk)
+        for (Index i = 0; i < count; ++i)
+            f(i, out);
+    }
+}
+
+/// Milliseconds since t0.
+inline double ms_since(std::chrono::steady_clock::time_point t0)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Capacity of a vector in bytes.
+template <class T> std::int64_t bytes_of(const std::vector<T>& v)
+{
+    return static_cast<std::int64_t>(v.capacity() * sizeof(T));
+}
+
+} // namespace tethash::detail

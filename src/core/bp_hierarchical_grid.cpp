@@ -1,0 +1,155 @@
+// The hierarchical hash grid (bp_hierarchical_grid.hpp).
+//
+// Level k has cells of edge l·2^k and the cell coordinates cell_coord(x, o, 2^−k / l) (o: the vertices' min corner).
+// A tet goes to the finest level k < levels where cell(hi) − cell(lo) ≤ 1 on every axis (with hi − lo ≤ l·2^k that
+// holds but for rounding; the test is the exact condition), keyed by (k, cell(lo)). A vertex p in the tet's box has
+// cell(lo) ≤ cell(p) ≤ cell(hi) ≤ cell(lo) + 1 (one monotone expression), so the tet is under one of the 2 × 2 × 2
+// cells cell(p) − {0, 1}^3 of that level; those cells are distinct and a scan accepts only entries of the very cell
+// looked up, so each pair is found once. Tets still spanning more than two cells on the top level (levels capped) are
+// kept apart and matched against the vertices sorted by x (the brute force's layout).
+#include "bp_hierarchical_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tethash::detail {
+
+namespace {
+
+std::uint64_t cell_hash(std::int32_t level, const std::int64_t c[3])
+{
+    std::uint64_t h = static_cast<std::uint64_t>(c[0]) * 0x9e3779b97f4a7c15ULL;
+    h ^= static_cast<std::uint64_t>(c[1]) * 0xc2b2ae3d27d4eb4fULL;
+    h ^= static_cast<std::uint64_t>(c[2]) * 0x165667b19e3779f9ULL;
+    h ^= static_cast<std::uint64_t>(level) * 0x27d4eb2f165667c5ULL;
+    h ^= h >> 31;
+    h *= 0xd6e8feb86659fd93ULL;
+    h ^= h >> 32;
+    return h;
+}
+
+} // namespace
+
+BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    BroadPhaseTimes times;
+    const auto t0 = std::chrono::steady_clock::now();
+    const Index n = s.num_vertices, m = s.num_tets;
+    m_nodes = 0;
+    m_entries.clear();
+    m_big.clear();
+    if (n == 0 || m == 0) return times;
+    const int T = static_cast<int>(sinks.size());
+    const int levels = s.params.levels > 0 ? std::min(s.params.levels, max_levels) : max_levels;
+
+    const Box box = vertex_box(s);
+    const double* origin = box.lo;
+    const double inv0 = 1.0 / s.cell_size;
+    double inv[max_levels];
+    for (int k = 0; k < max_levels; ++k)
+        inv[k] = std::ldexp(inv0, -k);
+
+    // Each tet's level and min-corner cell.
+    tet_boxes(s, m_boxes, T);
+    const std::uint64_t buckets = static_cast<std::uint64_t>(next_power_of_two(2 * static_cast<std::int64_t>(m)));
+    m_level.resize(static_cast<std::size_t>(m));
+    m_bucket.resize(static_cast<std::size_t>(m));
+    m_cell.resize(3 * static_cast<std::size_t>(m));
+#pragma omp parallel for num_threads(T) if (T > 1) schedule(static)
+    for (Index t = 0; t < m; ++t) {
+        const Box& b = m_boxes[static_cast<std::size_t>(t)];
+        const double extent = std::max({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]}) * inv0;
+        int k = extent > 1 ? std::min(std::ilogb(extent), levels - 1) : 0; // 2^k ≤ extent: no finer level fits
+        std::int64_t c[3];
+        for (;; ++k) {
+            if (k == levels) {
+                k = -1;
+                break;
+            }
+            bool fits = true;
+            for (int a = 0; a < 3; ++a) {
+                c[a] = cell_coord(b.lo[a], origin[a], inv[k]);
+                fits = fits && cell_coord(b.hi[a], origin[a], inv[k]) - c[a] <= 1;
+            }
+            if (fits) break;
+        }
+        m_level[static_cast<std::size_t>(t)] = k;
+        if (k < 0) continue;
+        std::copy(c, c + 3, m_cell.begin() + 3 * static_cast<std::ptrdiff_t>(t));
+        m_bucket[static_cast<std::size_t>(t)] = cell_hash(k, c) & (buckets - 1);
+    }
+
+    // Counting sort of the placed tets by bucket.
+    std::uint32_t occupied = 0;
+    m_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
+    for (Index t = 0; t < m; ++t) {
+        const std::int32_t k = m_level[static_cast<std::size_t>(t)];
+        if (k < 0) {
+            m_big.push_back(t);
+            continue;
+        }
+        occupied |= 1u << k;
+        ++m_start[static_cast<std::size_t>(m_bucket[static_cast<std::size_t>(t)]) + 1];
+    }
+    for (std::uint64_t b = 0; b < buckets; ++b)
+        m_start[b + 1] += m_start[b];
+    m_entries.resize(static_cast<std::size_t>(m_start[buckets]));
+    for (Index t = 0; t < m; ++t) {
+        const std::int32_t k = m_level[static_cast<std::size_t>(t)];
+        if (k < 0) continue;
+        Entry& e = m_entries[static_cast<std::size_t>(m_start[m_bucket[static_cast<std::size_t>(t)]]++)];
+        e.box = m_boxes[static_cast<std::size_t>(t)];
+        std::copy(m_cell.begin() + 3 * static_cast<std::ptrdiff_t>(t),
+                  m_cell.begin() + 3 * static_cast<std::ptrdiff_t>(t) + 3, e.cell);
+        e.tet = t;
+        e.level = k;
+    }
+    for (std::uint64_t b = buckets; b > 0; --b)
+        m_start[b] = m_start[b - 1];
+    m_start[0] = 0;
+    int used[max_levels];
+    int num_used = 0;
+    for (int k = 0; k < max_levels; ++k)
+        if (occupied >> k & 1u) used[num_used++] = k;
+    m_nodes = num_used + (m_big.empty() ? 0 : 1);
+
+    static_vertex_flags(s, m_static);
+    if (!m_big.empty()) m_sorted.build(s); // the vertices by x for the tets beyond the top level
+    times.ms_build = ms_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+
+    const std::uint64_t mask = buckets - 1;
+    for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
+        for (int u = 0; u < num_used; ++u) {
+            const int k = used[u];
+            std::int64_t c[3];
+            for (int a = 0; a < 3; ++a)
+                c[a] = cell_coord(p[a], origin[a], inv[k]);
+            for (int d = 0; d < 8; ++d) {
+                const std::int64_t q[3] = {c[0] - (d & 1), c[1] - (d >> 1 & 1), c[2] - (d >> 2 & 1)};
+                const std::uint64_t b = cell_hash(k, q) & mask;
+                for (Index i = m_start[b]; i < m_start[b + 1]; ++i) {
+                    const Entry& e = m_entries[static_cast<std::size_t>(i)];
+                    if (e.level != k || e.cell[0] != q[0] || e.cell[1] != q[1] || e.cell[2] != q[2]) continue;
+                    if (!in_box(p, e.box.lo, e.box.hi)) continue;
+                    if (vertex_static && s.tet_static[e.tet]) continue;
+                    out.push_back({v, e.tet});
+                }
+            }
+        }
+    });
+    for_each_index(static_cast<Index>(m_big.size()), 16, sinks, [&](Index i, std::vector<CandidatePair>& out) {
+        const Index t = m_big[static_cast<std::size_t>(i)];
+        m_sorted.find(s, m_boxes[static_cast<std::size_t>(t)], t, s.tet_static[t] != 0, m_static.data(), out);
+    });
+    times.ms_query = ms_since(t1);
+    return times;
+}
+
+std::int64_t HierarchicalGrid::memory_bytes() const
+{
+    return bytes_of(m_boxes) + bytes_of(m_level) + bytes_of(m_bucket) + bytes_of(m_start) + bytes_of(m_entries) +
+           bytes_of(m_cell) + bytes_of(m_big) + m_sorted.memory_bytes() + bytes_of(m_static);
+}
+
+} // namespace tethash::detail
