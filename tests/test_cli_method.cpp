@@ -174,6 +174,6 @@ TEST(CliMethod, StudyMethodFigure)
     ASSERT_EQ(r.status, 0) << r.err;
     ASSERT_TRUE(std::filesystem::exists(dir / "s" / "methods.svg")) << r.out << r.err;
     const std::string svg = read_text(dir / "s" / "methods.svg");
-    for (const char* text : {"candidates to the exact test", "brute", "command:"})
+    for (const char* text : {"pairs tested (inside tests)", "brute", "command:"})
         EXPECT_NE(svg.find(text), std::string::npos) << text;
 }

@@ -408,8 +408,8 @@ def method_label(p):
 
 
 def plot_methods(pts, meta, args):
-    """The method sweep: per scene, one bar per method (and parameters) for the median total time, the candidates
-    handed to the exact test and the working memory; methods that could not run are left out (their error is in
+    """The method sweep: per scene, one bar per method (and parameters) for the median total time, the pairs the
+    exact test checked (the same for every method when the broad phases agree) and the working memory; methods that could not run are left out (their error is in
     the CSV)."""
     ran = [p for p in pts if not p.get("error")]
     if not ran:
@@ -417,7 +417,7 @@ def plot_methods(pts, meta, args):
         return
     scenes = list(dict.fromkeys(p["scene"] for p in ran))
     labels = list(dict.fromkeys(method_label(p) for p in ran))
-    panels = (("ms_total", "time per detection (ms, median)"), ("candidates", "candidates to the exact test"),
+    panels = (("ms_total", "time per detection (ms, median)"), ("inside_tests", "pairs tested (inside tests)"),
               ("memory_bytes", "working memory (bytes)"))
     fig, axes = plt.subplots(len(panels), 1, figsize=(max(6.0, 0.9 + 0.16 * len(labels) * len(scenes)), 8.5),
                              sharex=True)
