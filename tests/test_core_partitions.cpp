@@ -23,15 +23,6 @@ using tethash::test::same_contacts;
 using tethash::test::Scene;
 
 namespace {
-/// The methods under test.
-std::vector<Method> methods()
-{
-    return {Method::hash,       Method::brute_force, Method::uniform_grid, Method::hierarchical_grid,
-            Method::sort_sweep, Method::bvh,         Method::bvh_refit,    Method::octree_loose};
-}
-} // namespace
-
-namespace {
 
 std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
 {
@@ -77,7 +68,7 @@ std::int64_t check_scene(const Scene& s, std::uint32_t seed, const std::string& 
 {
     OracleStats os;
     const std::vector<Contact> want = run_oracle(s, &os);
-    for (Method method : methods())
+    for (Method method : all_methods())
         for (const DetectParams& p : variants(method, seed)) {
             Detector det(p);
             det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
@@ -159,7 +150,7 @@ TEST(CorePartitions, MovingScenesKeepTheirStructuresExact)
     Scene s = test::random_scene(81, 4, 3, 0.3);
     s.objects.resize(4);
     s.objects[0].is_static = true;
-    for (Method method : methods()) {
+    for (Method method : all_methods()) {
         for (int threads : {1, 2}) {
             DetectParams p;
             p.method = method;
@@ -186,7 +177,7 @@ TEST(CorePartitions, MovingScenesKeepTheirStructuresExact)
 TEST(CorePartitions, DeterministicAcrossThreadCounts)
 {
     const Scene s = test::random_scene(77, 8, 4, 0.4);
-    for (Method method : methods()) {
+    for (Method method : all_methods()) {
         DetectParams p;
         p.method = method;
         p.threads = 1;
@@ -206,7 +197,7 @@ TEST(CorePartitions, DeterministicAcrossThreadCounts)
 TEST(CorePartitions, EmptyAndSingleTetScenes)
 {
     const Scene one = test::lattice_object(1, 1, 1, 1.0, Eigen::Vector3d::Zero());
-    for (Method method : methods()) {
+    for (Method method : all_methods()) {
         DetectParams p;
         p.method = method;
         Detector det(p);
@@ -219,15 +210,15 @@ TEST(CorePartitions, EmptyAndSingleTetScenes)
 
 TEST(CorePartitions, NamesAndParameterErrors)
 {
-    for (Method m : methods())
+    for (Method m : all_methods())
         EXPECT_EQ(parse_method(to_string(m)), m);
     EXPECT_EQ(parse_method("auto"), Method::automatic);
     expect_error([] { parse_method("quadtree"); },
                  {"--method: unknown method 'quadtree' (expected one of hash, brute"});
     expect_error([] { parse_method("kd3", "scene.toml: method"); }, {"scene.toml: method: unknown method 'kd3'"});
     DetectParams p;
-    p.partition.max_depth = 41;
-    expect_error([&] { Detector d(p); }, {"max_depth must be 1..40"});
+    p.partition.max_depth = 31;
+    expect_error([&] { Detector d(p); }, {"max_depth must be 1..30"});
     p = DetectParams{};
     p.partition.looseness = 0.5;
     expect_error([&] { Detector d(p); }, {"looseness must be 1..16"});

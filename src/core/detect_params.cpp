@@ -245,8 +245,8 @@ void validate_params(const DetectParams& p)
     if (std::string(to_string(p.method)) == "?")
         throw Error("method out of range: " + std::to_string(static_cast<int>(p.method)));
     const PartitionParams& q = p.partition;
-    if (q.max_depth < 0 || q.max_depth > 40)
-        throw Error("max_depth must be 1..40 (or 0 for the method's default), got " + std::to_string(q.max_depth));
+    if (q.max_depth < 0 || q.max_depth > 30)
+        throw Error("max_depth must be 1..30 (or 0 for the method's default), got " + std::to_string(q.max_depth));
     if (q.leaf_size < 0)
         throw Error("leaf_size must be ≥ 1 (or 0 for the method's default), got " + std::to_string(q.leaf_size));
     if (!(q.looseness == 0 || (q.looseness >= 1 && q.looseness <= 16))) {

@@ -1,0 +1,56 @@
+// The splitting-plane trees as broad phases: a new tree over the vertices per call (as the comparison of octree,
+// k-d and BSP trees builds them), then every tet box queried in parallel, each thread with its own output and stamp.
+#include "bp_split_tree.hpp"
+
+namespace tethash::detail {
+
+BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    BroadPhaseTimes times;
+    const auto t0 = std::chrono::steady_clock::now();
+    SplitTreeParams params;
+    params.rule = m_rule;
+    params.max_depth = s.params.max_depth > 0 ? s.params.max_depth : -1;
+    params.leaf_size = s.params.leaf_size > 0 ? s.params.leaf_size : 8;
+    m_tree.set_params(params);
+    m_points.resize(static_cast<std::size_t>(s.num_vertices));
+    for (Index v = 0; v < s.num_vertices; ++v) {
+        SplitBox& b = m_points[static_cast<std::size_t>(v)];
+        for (int a = 0; a < 3; ++a)
+            b.lo[static_cast<std::size_t>(a)] = b.hi[static_cast<std::size_t>(a)] =
+                s.positions[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(a)];
+    }
+    m_tree.build(m_points);
+    m_nodes = m_tree.stats().nodes;
+    static_vertex_flags(s, m_static);
+    times.ms_build = ms_since(t0);
+
+    const auto t1 = std::chrono::steady_clock::now();
+    m_found.resize(sinks.size());
+    m_scratch.resize(sinks.size());
+    for_each_index(s.num_tets, 64, sinks, [&](Index t, std::vector<CandidatePair>& out) {
+        const auto r = static_cast<std::size_t>(team_rank());
+        std::vector<std::uint32_t>& found = m_found[r];
+        found.clear();
+        SplitBox q;
+        tet_box(s, t, q.lo.data(), q.hi.data());
+        m_tree.query(q, found, m_scratch[r]);
+        const bool tet_static = s.tet_static[t] != 0;
+        for (std::uint32_t v : found)
+            if (!(tet_static && m_static[v])) out.push_back({static_cast<Index>(v), t});
+    });
+    times.ms_query = ms_since(t1);
+    return times;
+}
+
+std::int64_t SplitTreeBroadPhase::memory_bytes() const
+{
+    std::int64_t m = m_tree.stats().bytes + bytes_of(m_points) + bytes_of(m_static);
+    for (const auto& f : m_found)
+        m += bytes_of(f);
+    for (const SplitTreeScratch& sc : m_scratch)
+        m += bytes_of(sc.stamp);
+    return m;
+}
+
+} // namespace tethash::detail
