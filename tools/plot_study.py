@@ -138,6 +138,7 @@ def series_key(p, keys):
 
 
 def plot_detection(pts, meta, args, sweep):
+    pts = [p for p in pts if not p.get("error")]  # a method that could not run has no statistics
     scenes = by(pts, "scene")
     for scene, sp in scenes.items():
         tag = "" if len(scenes) == 1 else "_" + scene
