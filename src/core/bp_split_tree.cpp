@@ -1,8 +1,28 @@
 // The splitting-plane trees as broad phases: a new tree over the vertices per call (as the comparison of octree,
 // k-d and BSP trees builds them), then every tet box queried in parallel, each thread with its own output and stamp.
-#include "bp_split_tree.hpp"
+#include "bp_common.hpp"
+#include "tethash/split_tree.hpp"
 
 namespace tethash::detail {
+
+namespace {
+
+class SplitTreeBroadPhase final : public BroadPhase {
+  public:
+    explicit SplitTreeBroadPhase(SplitRule rule) : m_rule(rule) {}
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
+    std::int64_t memory_bytes() const override;
+    std::int64_t nodes() const override { return m_nodes; }
+
+  private:
+    SplitRule m_rule;
+    SplitTree m_tree;
+    std::vector<SplitBox> m_points;                  // per vertex: its position as a box
+    std::vector<unsigned char> m_static;             // per vertex: 1 for static objects
+    std::vector<std::vector<std::uint32_t>> m_found; // per thread: query output
+    std::vector<SplitTreeScratch> m_scratch;         // per thread
+    std::int64_t m_nodes = 0;
+};
 
 BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
@@ -51,6 +71,20 @@ std::int64_t SplitTreeBroadPhase::memory_bytes() const
     for (const SplitTreeScratch& sc : m_scratch)
         m += bytes_of(sc.stamp);
     return m;
+}
+
+} // namespace
+
+std::unique_ptr<BroadPhase> make_split_tree_broad_phase(Method method)
+{
+    static constexpr std::pair<Method, SplitRule> rules[] = {
+        {Method::octree, SplitRule::region_octree}, {Method::octree_point, SplitRule::point_octree},
+        {Method::kd_tree, SplitRule::region_kd},    {Method::kd_tree_point, SplitRule::point_kd},
+        {Method::bsp_tree, SplitRule::bsp},         {Method::bsp_tree_balanced, SplitRule::bsp_balanced},
+    };
+    for (const auto& [m, rule] : rules)
+        if (m == method) return std::make_unique<SplitTreeBroadPhase>(rule);
+    return nullptr;
 }
 
 } // namespace tethash::detail

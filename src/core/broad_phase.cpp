@@ -6,7 +6,6 @@
 #include "bp_hierarchical_grid.hpp"
 #include "bp_octree_loose.hpp"
 #include "bp_sort_sweep.hpp"
-#include "bp_split_tree.hpp"
 #include "bp_uniform_grid.hpp"
 #include "tethash/error.hpp"
 
@@ -30,17 +29,12 @@ std::unique_ptr<BroadPhase> make_broad_phase(Method method)
     case Method::octree_loose:
         return std::make_unique<LooseOctree>();
     case Method::octree:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::region_octree);
     case Method::octree_point:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::point_octree);
     case Method::kd_tree:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::region_kd);
     case Method::kd_tree_point:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::point_kd);
     case Method::bsp_tree:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::bsp);
     case Method::bsp_tree_balanced:
-        return std::make_unique<SplitTreeBroadPhase>(SplitRule::bsp_balanced);
+        return make_split_tree_broad_phase(method);
     case Method::hash:
     case Method::automatic:
         break;

@@ -63,6 +63,8 @@ class BroadPhase {
 
 /// The broad phase of `method` (not `hash`, not `automatic`).
 std::unique_ptr<BroadPhase> make_broad_phase(Method method);
+/// The splitting-plane tree of `method` (octrees, k-d trees, BSP trees: bp_split_tree.cpp); nullptr for the others.
+std::unique_ptr<BroadPhase> make_split_tree_broad_phase(Method method);
 
 /// Closed axis-aligned bounding box of tet t (lo[3], hi[3]).
 inline void tet_box(const PartitionScene& s, Index t, double lo[3], double hi[3])
