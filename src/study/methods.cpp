@@ -58,23 +58,20 @@ void parse_partition_param(const std::string& option, const std::string& text, D
 
 bool method_uses(Method method, const std::string& option)
 {
-    switch (method) {
-    case Method::octree:
-    case Method::octree_point:
-    case Method::kd_tree:
-    case Method::kd_tree_point:
-    case Method::bsp_tree:
-    case Method::bsp_tree_balanced:
-    case Method::bvh:
-    case Method::bvh_refit:
-        return option == "--max-depth" || option == "--leaf-size";
-    case Method::octree_loose:
-        return option == "--max-depth" || option == "--leaf-size" || option == "--looseness";
-    case Method::hierarchical_grid:
-        return option == "--levels";
-    default:
-        return false;
-    }
+    // The methods that read each parameter (src/core/bp_*.cpp).
+    static const std::vector<std::pair<std::string, std::vector<Method>>> readers = {
+        {"--max-depth",
+         {Method::octree, Method::octree_point, Method::octree_loose, Method::kd_tree, Method::kd_tree_point,
+          Method::bsp_tree, Method::bsp_tree_balanced, Method::bvh, Method::bvh_refit}},
+        {"--leaf-size",
+         {Method::octree, Method::octree_point, Method::kd_tree, Method::kd_tree_point, Method::bsp_tree,
+          Method::bsp_tree_balanced, Method::bvh, Method::bvh_refit}},
+        {"--looseness", {Method::octree_loose}},
+        {"--levels", {Method::hierarchical_grid}},
+    };
+    for (const auto& [name, methods] : readers)
+        if (name == option) return std::find(methods.begin(), methods.end(), method) != methods.end();
+    return false;
 }
 
 std::vector<Method> parse_method_list(const std::string& text, const std::string& option)

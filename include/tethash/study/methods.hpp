@@ -17,8 +17,9 @@ namespace tethash::study {
 /// with the detector's own validation; throws Error "OPTION: ..." naming the text otherwise.
 void parse_partition_param(const std::string& option, const std::string& text, DetectParams& params);
 
-/// Whether `method` reads the partition parameter of `option` ("--max-depth", "--leaf-size": the trees and BVHs;
-/// "--looseness": the loose octree; "--levels": the hierarchical grid).
+/// Whether `method` reads the partition parameter of `option` ("--max-depth": the trees and BVHs; "--leaf-size": the
+/// same but the loose octree, which keeps each tet in the one cell it fits; "--looseness": the loose octree;
+/// "--levels": the hierarchical grid).
 bool method_uses(Method method, const std::string& option);
 
 /// Methods of a comma-separated list: names of the grammar (detect.hpp: parse_method) or "all" (every method
