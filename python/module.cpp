@@ -18,13 +18,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace py = pybind11;
@@ -436,34 +439,30 @@ py::dict run_study(const std::string& sweep, const py::dict& kw)
     o.repeat = simulates ? 1 : 3;
     o.warmup = simulates ? 0 : 1;
     bool quiet = true;
+    // The arguments that take a list of strings (or one string), each the option of the same name.
+    using Options = tethash::study::StudyOptions;
+    using List = std::vector<std::string> Options::*;
+    static const std::pair<const char*, List> list_options[] = {
+        {"meshes", &Options::meshes},         {"cell_size", &Options::cell_size},
+        {"table_size", &Options::table_size}, {"hash", &Options::hash},
+        {"threads", &Options::threads},       {"grid", &Options::grid},
+        {"integrator", &Options::integrator}, {"dt", &Options::dt},
+        {"substeps", &Options::substeps},
+    };
     for (const auto& item : kw) {
         const std::string key = py::str(item.first).cast<std::string>();
         const py::handle v = item.second;
         if (v.is_none()) continue;
-        if (key == "meshes")
-            o.meshes = strings_of(v, "meshes");
+        if (const auto list = std::find_if(std::begin(list_options), std::end(list_options),
+                                           [&](const auto& l) { return key == l.first; });
+            list != std::end(list_options))
+            o.*(list->second) = strings_of(v, list->first);
         else if (key == "scene")
             o.scene_file = py::str(v).cast<std::string>();
         else if (key == "teschner_scenarios")
             o.teschner = v.cast<bool>();
         else if (key == "scenarios")
             o.scenarios = v.cast<std::vector<int>>();
-        else if (key == "cell_size")
-            o.cell_size = strings_of(v, "cell_size");
-        else if (key == "table_size")
-            o.table_size = strings_of(v, "table_size");
-        else if (key == "hash")
-            o.hash = strings_of(v, "hash");
-        else if (key == "threads")
-            o.threads = strings_of(v, "threads");
-        else if (key == "grid")
-            o.grid = strings_of(v, "grid");
-        else if (key == "integrator")
-            o.integrator = strings_of(v, "integrator");
-        else if (key == "dt")
-            o.dt = strings_of(v, "dt");
-        else if (key == "substeps")
-            o.substeps = strings_of(v, "substeps");
         else if (key == "duration")
             o.duration = v.cast<double>();
         else if (key == "repeat")

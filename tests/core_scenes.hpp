@@ -1,6 +1,8 @@
 #pragma once
 // Small scene generators for the detection tests (independent of meshing::generate): cube lattices split into
 // 6 tets per cube (Kuhn), placed, deformed and combined into multi-object scenes.
+#include "support.hpp"
+
 #include "tethash/detect.hpp"
 
 #include <Eigen/Geometry>
@@ -88,21 +90,12 @@ inline Scene lattice_object(int nx, int ny, int nz, double h, const Eigen::Vecto
         for (int j = 0; j <= ny; ++j)
             for (int i = 0; i <= nx; ++i)
                 s.positions.row(vid(i, j, k)) = origin + h * Eigen::Vector3d(i, j, k);
-    // Kuhn split: the 6 monotone paths from corner 000 to 111.
-    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
     s.tets.resize(6 * nx * ny * nz, 4);
     int t = 0;
     for (int k = 0; k < nz; ++k)
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i)
-                for (const auto& p : perms) {
-                    int c[3] = {i, j, k};
-                    Index ids[4];
-                    ids[0] = vid(c[0], c[1], c[2]);
-                    for (int step = 0; step < 3; ++step) {
-                        ++c[p[step]];
-                        ids[step + 1] = vid(c[0], c[1], c[2]);
-                    }
+                for (const auto& ids : kuhn_tets(i, j, k, vid)) {
                     s.tets.row(t) << ids[0], ids[1], ids[2], ids[3];
                     const Eigen::Vector3d a = s.positions.row(ids[0]), b = s.positions.row(ids[1]),
                                           cc = s.positions.row(ids[2]), d = s.positions.row(ids[3]);

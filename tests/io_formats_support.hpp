@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -37,12 +38,31 @@ inline std::filesystem::path write_edited(const std::filesystem::path& path, std
     return path;
 }
 
-/// `edited(dir, from, to, name)`: writes `good` with its first `from` replaced by `to` to dir/name, returns the path.
-inline auto editor(std::string good)
-{
-    return [good = std::move(good)](const std::filesystem::path& dir, const std::string& from, const std::string& to,
-                                    const std::string& name) { return write_edited(dir / name, good, from, to); };
-}
+/// A hand-made good file of a format, and its variants for the error tests, written into a test's folder.
+class HandMadeFile {
+  public:
+    explicit HandMadeFile(std::string good) : m_good(std::move(good)) {}
+
+    /// Writes the good text with its first `from` replaced by `to` to dir/name; returns the path.
+    std::filesystem::path edited(const std::filesystem::path& dir, const std::string& from, const std::string& to,
+                                 const std::string& name) const
+    {
+        return write_edited(dir / name, m_good, from, to);
+    }
+
+    /// Writes the good text cut `extra` characters after the start of its first `at` to dir/name; returns the path.
+    std::filesystem::path cut(const std::filesystem::path& dir, const std::string& at, std::size_t extra,
+                              const std::string& name) const
+    {
+        const std::size_t end = m_good.find(at);
+        EXPECT_NE(end, std::string::npos) << at;
+        write_text(dir / name, m_good.substr(0, end == std::string::npos ? end : end + extra));
+        return dir / name;
+    }
+
+  private:
+    std::string m_good;
+};
 
 /// 1-based number of the first line of `text` that contains `needle` (0 if none).
 inline int line_of(const std::string& text, const std::string& needle)
@@ -84,30 +104,17 @@ inline TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2, bool two_objects = 
                 m.positions(v, 1) = j * 0.1 / 3.0 + std::cos(0.7 * v) * 1e-3;
                 m.positions(v, 2) = k * std::sqrt(2.0) * 0.1 - 1e-9 * v;
             }
-    // Kuhn subdivision of the cube along the diagonal 0-6.
-    static const int paths[6][3] = {{1, 2, 4}, {1, 4, 2}, {2, 1, 4}, {2, 4, 1}, {4, 1, 2}, {4, 2, 1}};
     std::vector<std::array<Index, 4>> tets;
     for (int k = 0; k < nz; ++k)
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i)
-                for (const auto& p : paths) {
-                    int bits = 0;
-                    std::array<Index, 4> t{};
-                    t[0] = id(i, j, k);
-                    for (int s = 0; s < 3; ++s) {
-                        bits |= p[s];
-                        t[static_cast<std::size_t>(s + 1)] =
-                            id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1));
-                    }
+                for (std::array<Index, 4> t : kuhn_tets(i, j, k, id)) {
                     if (signed_volume(m.positions, t) < 0) std::swap(t[2], t[3]);
                     tets.push_back(t);
                     m.tet_label.push_back(10 + k);
                     if (two_objects) m.tet_object.push_back(k >= nz / 2 ? 1 : 0);
                 }
-    m.tets.resize(static_cast<Index>(tets.size()), 4);
-    for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int c = 0; c < 4; ++c)
-            m.tets(static_cast<Index>(t), c) = tets[t][static_cast<std::size_t>(c)];
+    m.tets = matrix_of<Tets>(tets);
     if (two_objects) {
         m.vertex_object.assign(static_cast<std::size_t>(m.num_vertices()), 0);
         // Not a real two-object mesh (objects share vertices); only the tet-side ids matter to writers.
@@ -280,6 +287,37 @@ inline TetMesh round_trip(const TetMesh& m, const std::filesystem::path& dir, co
     expect_same_geometry(r, m, what);
     EXPECT_EQ(r.tet_label, m.tet_label) << what;
     return r;
+}
+
+/// A mesh of ../shared/meshes and what reading it must give.
+struct SharedMeshCase {
+    const char* name;
+    Index vertices, tets;
+    std::int64_t inverted;                     ///< validate()'s inverted tets
+    std::optional<std::int64_t> skipped_cells; ///< ReadNotes::skipped_cells, when checked
+};
+
+/// Reads the mesh of each case that is present; its counts, notes and validation must be as the case says. Skips
+/// the test when none is present.
+inline void expect_shared_meshes(std::initializer_list<SharedMeshCase> cases)
+{
+    int found = 0;
+    for (const SharedMeshCase& c : cases) {
+        const auto p = shared_mesh(c.name);
+        if (!p) continue;
+        ++found;
+        io::ReadNotes notes;
+        const TetMesh m = io::read_mesh(p->string(), &notes);
+        EXPECT_EQ(m.num_vertices(), c.vertices) << c.name;
+        EXPECT_EQ(m.num_tets(), c.tets) << c.name;
+        if (c.skipped_cells) {
+            EXPECT_EQ(notes.skipped_cells, *c.skipped_cells) << c.name;
+        }
+        const ValidationReport rep = validate(m);
+        EXPECT_TRUE(rep.ok()) << c.name;
+        EXPECT_EQ(rep.inverted_tets, c.inverted) << c.name;
+    }
+    if (!found) GTEST_SKIP() << "no shared meshes";
 }
 
 } // namespace tethash::test

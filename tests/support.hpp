@@ -2,6 +2,7 @@
 // Helpers shared by the tests: running the tethash program, temporary folders, expected errors and refusals,
 // finding a Python interpreter that imports given modules, the shared real meshes.
 #include "tethash/error.hpp"
+#include "tethash/mesh.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,6 +20,32 @@
 #include <vector>
 
 namespace tethash::test {
+
+/// An n × C matrix (Positions, Tets, Triangles) from n rows of C values each (Eigen vectors or std::arrays).
+template <class Matrix, class Row> Matrix matrix_of(const std::vector<Row>& rows)
+{
+    Matrix m(static_cast<Eigen::Index>(rows.size()), Matrix::ColsAtCompileTime);
+    for (std::size_t i = 0; i < rows.size(); ++i)
+        for (int c = 0; c < Matrix::ColsAtCompileTime; ++c)
+            m(static_cast<Eigen::Index>(i), c) = rows[i].data()[c];
+    return m;
+}
+
+/// The 6 tets of the Kuhn split of lattice cube (i, j, k), the monotone paths from its corner (i, j, k) to
+/// (i + 1, j + 1, k + 1), in the vertex ids id(i', j', k') of the lattice points (orientation not fixed).
+template <class Id> std::array<std::array<Index, 4>, 6> kuhn_tets(int i, int j, int k, Id&& id)
+{
+    // Corner b of the cube is at offset (b & 1, b >> 1 & 1, b >> 2 & 1).
+    static constexpr int corners[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                                          {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+    std::array<std::array<Index, 4>, 6> out{};
+    for (std::size_t t = 0; t < 6; ++t)
+        for (std::size_t a = 0; a < 4; ++a) {
+            const int b = corners[t][a];
+            out[t][a] = static_cast<Index>(id(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1)));
+        }
+    return out;
+}
 
 struct RunResult {
     int status = -1; ///< exit status

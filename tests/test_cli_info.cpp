@@ -37,13 +37,19 @@ Tetrahedra
 End
 )";
 
+/// kProblemMesh written as `name` into a fresh folder; the file's path, quoted for the command line.
+std::string problem_mesh(const std::string& name = "problems.mesh")
+{
+    const auto path = temp_dir() / name;
+    write_text(path, kProblemMesh);
+    return quote(path);
+}
+
 } // namespace
 
 TEST(CliInfo, ReportsProblemsInJson)
 {
-    const auto dir = temp_dir();
-    write_text(dir / "problems.mesh", kProblemMesh);
-    const RunResult r = run_tethash("info --json " + quote(dir / "problems.mesh"));
+    const RunResult r = run_tethash("info --json " + problem_mesh());
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(json_int(r.out, "vertices"), 8);
     EXPECT_EQ(json_int(r.out, "tets"), 3);
@@ -55,9 +61,7 @@ TEST(CliInfo, ReportsProblemsInJson)
 
 TEST(CliInfo, TextSummaryNamesProblems)
 {
-    const auto dir = temp_dir();
-    write_text(dir / "problems.mesh", kProblemMesh);
-    const RunResult r = run_tethash("info " + quote(dir / "problems.mesh"));
+    const RunResult r = run_tethash("info " + problem_mesh());
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("vertices 8"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("1 inverted tets"), std::string::npos) << r.out;
@@ -66,9 +70,8 @@ TEST(CliInfo, TextSummaryNamesProblems)
 
 TEST(CliInfo, SeveralFilesAreOneSceneWithObjects)
 {
-    const auto dir = temp_dir();
-    write_text(dir / "a.mesh", kProblemMesh);
-    const RunResult r = run_tethash("info --json " + quote(dir / "a.mesh") + " " + quote(dir / "a.mesh"));
+    const std::string mesh = problem_mesh("a.mesh");
+    const RunResult r = run_tethash("info --json " + mesh + " " + mesh);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(json_int(r.out, "vertices"), 16);
     EXPECT_EQ(json_int(r.out, "tets"), 6);

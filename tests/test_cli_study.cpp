@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <thread>
+#include <vector>
 
 namespace tethash {
 namespace {
@@ -25,55 +27,80 @@ std::string two_boxes(const std::filesystem::path& dir, int resolution = 3)
 
 using test::deterministic;
 
+/// Columns the table of each sweep must have (among others).
+const std::map<std::string, std::vector<const char*>> k_columns = {
+    {"cell-size",
+     {"point",
+      "repeat",
+      "scene",
+      "cell_factor",
+      "cell_size",
+      "table_size",
+      "hash",
+      "threads",
+      "vertices",
+      "tets",
+      "cells_visited",
+      "entries_scanned",
+      "hash_collisions",
+      "box_rejections",
+      "own_vertex_skips",
+      "inside_tests",
+      "exact_fallbacks",
+      "degenerate_tets",
+      "contacts",
+      "table_load",
+      "memory_bytes",
+      "oracle_contacts",
+      "missed",
+      "extra",
+      "ms_total",
+      "ms_vertices",
+      "ms_tets",
+      "ms_inside",
+      "ms_sort"}},
+    {"integrator",
+     {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration", "energy_drift",
+      "wall_s_per_sim_s", "ref_dt"}},
+    {"stability",
+     {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction", "far_self", "ms_per_step"}},
+};
+
+/// Runs `tethash study SWEEP ARGS --out DIR/s`, which must succeed, and returns its DIR/s/study.csv, which must
+/// have the sweep's columns (k_columns) and `rows` rows; an empty table after such a failure (reported).
+/// `err`, when given, receives the run's standard error.
+Table run_study(const std::string& sweep, const std::string& args, const std::filesystem::path& dir, std::size_t rows,
+                std::string* err = nullptr)
+{
+    const auto r = run_tethash("study " + sweep + " " + args + " --out " + quote(dir / "s"));
+    if (err) *err = r.err;
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (r.status != 0) return {};
+    Table t = Table::read_csv((dir / "s" / "study.csv").string());
+    for (const char* col : k_columns.at(sweep)) {
+        EXPECT_GE(t.index_of(col), 0) << col;
+        if (t.index_of(col) < 0) return {};
+    }
+    EXPECT_EQ(t.rows.size(), rows);
+    return t.rows.size() == rows ? t : Table{};
+}
+
 TEST(CliStudy, CellSizeSweepWritesEveryColumnAndRowExactAgainstOracle)
 {
     const auto dir = test::temp_dir();
     const auto mesh = two_boxes(dir);
-    const auto r = run_tethash("study cell-size --mesh " + mesh +
-                               " --from 0.25 --to 4 --points 5 --table-size 1,x1 "
-                               "--repeat 2 --no-plot --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"point",
-                            "repeat",
-                            "scene",
-                            "cell_factor",
-                            "cell_size",
-                            "table_size",
-                            "hash",
-                            "threads",
-                            "vertices",
-                            "tets",
-                            "cells_visited",
-                            "entries_scanned",
-                            "hash_collisions",
-                            "box_rejections",
-                            "own_vertex_skips",
-                            "inside_tests",
-                            "exact_fallbacks",
-                            "degenerate_tets",
-                            "contacts",
-                            "table_load",
-                            "memory_bytes",
-                            "oracle_contacts",
-                            "missed",
-                            "extra",
-                            "ms_total",
-                            "ms_vertices",
-                            "ms_tets",
-                            "ms_inside",
-                            "ms_sort"})
-        EXPECT_GE(t.index_of(col), 0) << col;
-    ASSERT_EQ(t.rows.size(), 5u * 2 * 2); // 5 cell sizes × 2 table sizes × 2 repeats
+    std::string err;
+    const Table t = run_study(
+        "cell-size", "--mesh " + mesh + " --from 0.25 --to 4 --points 5 --table-size 1,x1 --repeat 2 --no-plot", dir,
+        5u * 2 * 2, &err); // 5 cell sizes × 2 table sizes × 2 repeats
     for (const auto& row : t.rows) {
         EXPECT_EQ(row[t.index_of("missed")], "0");
         EXPECT_EQ(row[t.index_of("extra")], "0");
         EXPECT_EQ(row[t.index_of("contacts")], row[t.index_of("oracle_contacts")]);
     }
     const std::string json = test::read_text(dir / "s" / "study.json");
-    EXPECT_NE(json.find("study cell-size"), std::string::npos);             // the command line is recorded
-    EXPECT_NE(r.err.find("study: point 1/10"), std::string::npos) << r.err; // plain progress lines off a terminal
+    EXPECT_NE(json.find("study cell-size"), std::string::npos);         // the command line is recorded
+    EXPECT_NE(err.find("study: point 1/10"), std::string::npos) << err; // plain progress lines off a terminal
 }
 
 TEST(CliStudy, MergedShardsEqualTheUnshardedRun)
@@ -141,16 +168,11 @@ generate = { shape = "box", resolution = 2, size = [0.2, 0.2, 0.2] }
 translate = [0, 0, 0.5]
 material = { density = 500, young = 1e4 }
 )");
-    const auto r = run_tethash("study integrator --scene " + quote(dir / "tiny.toml") +
-                               " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator implicit_euler,symplectic_euler "
-                               "--reference-factor 4 --no-plot --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration",
-                            "energy_drift", "wall_s_per_sim_s", "ref_dt"})
-        EXPECT_GE(t.index_of(col), 0) << col;
-    ASSERT_EQ(t.rows.size(), 6u);
+    const Table t = run_study("integrator",
+                              "--scene " + quote(dir / "tiny.toml") +
+                                  " --duration 0.04 --dt 0.0025,0.005,0.01 --integrator "
+                                  "implicit_euler,symplectic_euler --reference-factor 4 --no-plot",
+                              dir, 6);
     for (std::size_t i = 0; i < t.rows.size(); ++i) {
         const auto& row = t.rows[i];
         EXPECT_EQ(row[t.index_of("status")], "ok");
@@ -171,16 +193,11 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
     p.shape = "box";
     p.resolution = 3;
     io::write_mesh((dir / "box.vtu").string(), meshing::generate(p));
-    const auto r = run_tethash("study stability --mesh " + quote(dir / "box.vtu") +
-                               " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all --duration 0.6 "
-                               "--no-plot --quiet --out " +
-                               quote(dir / "s"));
-    ASSERT_EQ(r.status, 0) << r.err;
-    const Table t = Table::read_csv((dir / "s" / "study.csv").string());
-    for (const char* col : {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction",
-                            "far_self", "ms_per_step"})
-        ASSERT_GE(t.index_of(col), 0) << col;
-    ASSERT_EQ(t.rows.size(), 24u);
+    const Table t = run_study("stability",
+                              "--mesh " + quote(dir / "box.vtu") +
+                                  " --young 1e3,1e9 --dt 1/240,1/60 --mass-ratio 1,1e6 --integrator all "
+                                  "--duration 0.6 --no-plot --quiet",
+                              dir, 24);
     int ok = 0, stopped = 0;
     for (const auto& row : t.rows) {
         const std::string verdict = row[t.index_of("verdict")], status = row[t.index_of("status")];

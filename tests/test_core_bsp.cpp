@@ -1,6 +1,8 @@
 // Solid-leaf BSP trees: exact closed point-in-polyhedron against closed-form and winding-number references on
 // convex, concave and genus-1 polyhedra, points exactly on faces, edges and corners and one ulp off them;
 // depth against brute force; refusal of bad surfaces; the obstacle set.
+#include "support.hpp"
+
 #include "tethash/bsp.hpp"
 #include "tethash/error.hpp"
 #include "tethash/geometry.hpp"
@@ -27,15 +29,7 @@ struct Soup {
 
 Soup make_soup(const std::vector<Vec3>& v, const std::vector<std::array<Index, 3>>& t)
 {
-    Soup s;
-    s.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-    for (std::size_t i = 0; i < v.size(); ++i)
-        s.vertices.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
-    s.triangles.resize(static_cast<Eigen::Index>(t.size()), 3);
-    for (std::size_t i = 0; i < t.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-            s.triangles(static_cast<Eigen::Index>(i), c) = t[i][static_cast<std::size_t>(c)];
-    return s;
+    return {test::matrix_of<Positions>(v), test::matrix_of<Triangles>(t)};
 }
 
 using Voxel = std::array<int, 3>;

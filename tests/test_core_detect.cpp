@@ -43,24 +43,20 @@ std::vector<Contact> run_oracle(const Scene& s, OracleStats* stats = nullptr)
     return brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects, stats);
 }
 
-struct Variant {
-    double cell_factor;
-    std::int64_t table;
-    HashFunction hash;
-    int threads;
-};
-
-std::vector<Variant> variants(std::uint32_t seed)
+/// Parameter sets for one scene (cell size as a factor of the mean edge).
+std::vector<DetectParams> variants(std::uint32_t seed)
 {
     // Every kind appears for every scene: 5 cell sizes, 6 table sizes, both hashes, 1 and 2 threads,
     // combined differently per seed (the full product would be slow at 1/20 cells).
     const double cells[] = {1.0 / 20, 0.3, 1.0, 2.5, 20.0};
     const std::int64_t tables[] = {0, 1, 2, 97, 1024, 1 << 20};
-    std::vector<Variant> out;
+    std::vector<DetectParams> out;
     for (unsigned k = 0; k < 12; ++k)
-        out.push_back({cells[(k + seed) % 5], tables[(k + 3 * seed) % 6],
-                       (k + seed) % 2 ? HashFunction::teschner : HashFunction::column,
-                       1 + static_cast<int>((k / 2) % 2)});
+        out.push_back({.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge,
+                       .cell_size = cells[(k + seed) % 5],
+                       .table_size = tables[(k + 3 * seed) % 6],
+                       .hash = (k + seed) % 2 ? HashFunction::teschner : HashFunction::column,
+                       .threads = 1 + static_cast<int>((k / 2) % 2)});
     return out;
 }
 
@@ -68,17 +64,12 @@ void check_scene(const Scene& s, std::uint32_t seed, const std::string& what)
 {
     OracleStats os;
     const std::vector<Contact> want = run_oracle(s, &os);
-    for (const Variant& v : variants(seed)) {
-        DetectParams p;
-        p.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
-        p.cell_size = v.cell_factor;
-        p.table_size = v.table;
-        p.hash = v.hash;
-        p.threads = v.threads;
+    for (const DetectParams& p : variants(seed)) {
         DetectStats st;
         const std::vector<Contact> got = run_detector(s, p, &st);
-        EXPECT_TRUE(same_contacts(got, want)) << what << " seed " << seed << " cell ×" << v.cell_factor << " table "
-                                              << v.table << " hash " << to_string(v.hash) << " threads " << v.threads;
+        EXPECT_TRUE(same_contacts(got, want))
+            << what << " seed " << seed << " cell ×" << p.cell_size << " table " << p.table_size << " hash "
+            << to_string(p.hash) << " threads " << p.threads;
         EXPECT_EQ(st.degenerate_tets, os.degenerate_tets) << what;
         EXPECT_EQ(st.contacts, static_cast<std::int64_t>(want.size()));
     }
@@ -421,13 +412,8 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
         small_tet({0.5 + 2048, 0.5, z});
         small_tet({0.5, 0.5 - 2048, z});
     }
-    s.positions.resize(static_cast<Eigen::Index>(pts.size()), 3);
-    for (std::size_t i = 0; i < pts.size(); ++i)
-        s.positions.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
-    s.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
-    for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int k = 0; k < 4; ++k)
-            s.tets(static_cast<Eigen::Index>(t), k) = tets[t][static_cast<std::size_t>(k)];
+    s.positions = test::matrix_of<Positions>(pts);
+    s.tets = test::matrix_of<Tets>(tets);
     const std::vector<Contact> want = run_oracle(s);
     ASSERT_GT(want.size(), 80u);
     for (double cell : {1.0, 4.0})

@@ -124,6 +124,18 @@ TEST(CorePartitions, CoincidentVerticesFlatAndCollapsedTets)
     }
 }
 
+TEST(CorePartitions, AllPointsEqualAndFlatScenes)
+{
+    // Zero extents everywhere (one point: every grid one cell, every tree box a point) and zero extent on one axis.
+    // (One point: every candidate is an exact-arithmetic inside test of a flat tet, so a small scene.)
+    Scene s = test::random_scene(60, 2, 1, 0.3);
+    s.positions.rowwise() = Eigen::RowVector3d(-3.5, 1e6, 0.25);
+    check_scene(s, 60, "one point");
+    Scene flat = test::random_scene(61, 3, 2, 0.3);
+    flat.positions.col(2).setConstant(-7.0);
+    check_scene(flat, 61, "flat");
+}
+
 TEST(CorePartitions, SelfCollisionOffAndStaticObjects)
 {
     for (std::uint32_t seed = 50; seed < 54; ++seed) {

@@ -9,10 +9,9 @@ using namespace tethash::test;
 
 namespace {
 
-const char* k_good = "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n1 1 1 0\n"
-                     "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\nEnd\n";
-
-const auto edited = editor(k_good);
+const HandMadeFile
+    good("MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n1 1 1 0\n"
+         "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\nEnd\n");
 
 } // namespace
 
@@ -57,25 +56,21 @@ meshio.write(sys.argv[2], m, file_format="medit")
 TEST(MeditErrors, VersionAndDimension)
 {
     const auto dir = temp_dir();
-    expect_read_error(edited(dir, "MeshVersionFormatted 2", "MeshVersionFormatted 7", "v.mesh"),
+    expect_read_error(good.edited(dir, "MeshVersionFormatted 2", "MeshVersionFormatted 7", "v.mesh"),
                       {at_line(dir / "v.mesh", 1), "expected MeshVersionFormatted 1, 2, 3 or 4, found version 7"});
-    expect_read_error(edited(dir, "Dimension 3", "Dimension 2", "d.mesh"),
+    expect_read_error(good.edited(dir, "Dimension 3", "Dimension 2", "d.mesh"),
                       {at_line(dir / "d.mesh", 2), "expected Dimension 3, found Dimension 2"});
-    expect_read_error(edited(dir, "MeshVersionFormatted 2\n", "", "nov.mesh"),
+    expect_read_error(good.edited(dir, "MeshVersionFormatted 2\n", "", "nov.mesh"),
                       {at_line(dir / "nov.mesh", 1), "expected MeshVersionFormatted, found 'Dimension'"});
 }
 
 TEST(MeditErrors, TruncatedAndWrongCounts)
 {
     const auto dir = temp_dir();
-    {
-        std::string text = k_good;
-        write_text(dir / "cut.mesh", text.substr(0, text.find("2 3 4 5")));
-        expect_read_error(dir / "cut.mesh",
-                          {(dir / "cut.mesh").string() + ":", "vertex 1 of tetrahedron 2", "found end of file"});
-    }
+    const auto cut = good.cut(dir, "2 3 4 5", 0, "cut.mesh");
+    expect_read_error(cut, {cut.string() + ":", "vertex 1 of tetrahedron 2", "found end of file"});
     // The Vertices count is 6 but there are 5 vertices: "Tetrahedra" is read as a coordinate.
-    const auto p = edited(dir, "Vertices\n5\n", "Vertices\n6\n", "count.mesh");
+    const auto p = good.edited(dir, "Vertices\n5\n", "Vertices\n6\n", "count.mesh");
     expect_read_error(p, {at_line(p, 10), "x coordinate of vertex 6", "found 'Tetrahedra'"});
 }
 
@@ -83,38 +78,19 @@ TEST(MeditErrors, IndexPastTheEndNanGarbage)
 {
     const auto dir = temp_dir();
     expect_read_error(
-        edited(dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh"),
+        good.edited(dir, "2 3 4 5 1", "2 3 4 6 1", "i.mesh"),
         {at_line(dir / "i.mesh", 13), "tetrahedron 2: vertex index 6 is past the end (Vertices has 1..5)"});
-    expect_read_error(edited(dir, "2 3 4 5 1", "2 3 0 5 1", "z.mesh"),
+    expect_read_error(good.edited(dir, "2 3 4 5 1", "2 3 0 5 1", "z.mesh"),
                       {at_line(dir / "z.mesh", 13), "tetrahedron 2: vertex index 0"});
-    expect_read_error(edited(dir, "0 0 1 0\n", "0 0 NaN 0\n", "n.mesh"),
+    expect_read_error(good.edited(dir, "0 0 1 0\n", "0 0 NaN 0\n", "n.mesh"),
                       {at_line(dir / "n.mesh", 8), "finite z coordinate of vertex 4", "found 'NaN'"});
-    expect_read_error(edited(dir, "Tetrahedra\n2\n", "Tetrahedra\ntwo\n", "g.mesh"),
+    expect_read_error(good.edited(dir, "Tetrahedra\n2\n", "Tetrahedra\ntwo\n", "g.mesh"),
                       {at_line(dir / "g.mesh", 11), "the number of tetrahedra (an integer)", "found 'two'"});
-    expect_read_error(edited(dir, "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\n", "", "not.mesh"),
+    expect_read_error(good.edited(dir, "Tetrahedra\n2\n1 2 3 4 1\n2 3 4 5 1\n", "", "not.mesh"),
                       {(dir / "not.mesh").string() + ": no Tetrahedra block"});
 }
 
 TEST(MeditShared, ReadsOctopusAndHand)
 {
-    struct Case {
-        const char* name;
-        Index n, m;
-        std::int64_t triangles;
-    };
-    int found = 0;
-    for (const Case& c : {Case{"octopus-low.mesh", 452, 1140, 898}, Case{"hand.mesh", 7234, 29998, 9556}}) {
-        const auto p = shared_mesh(c.name);
-        if (!p) continue;
-        ++found;
-        io::ReadNotes notes;
-        const TetMesh m = io::read_mesh(p->string(), &notes);
-        EXPECT_EQ(m.num_vertices(), c.n) << c.name;
-        EXPECT_EQ(m.num_tets(), c.m) << c.name;
-        EXPECT_EQ(notes.skipped_cells, c.triangles) << c.name;
-        const ValidationReport rep = validate(m);
-        EXPECT_TRUE(rep.ok()) << c.name;
-        EXPECT_EQ(rep.inverted_tets, 0) << c.name;
-    }
-    if (!found) GTEST_SKIP() << "no shared meshes";
+    expect_shared_meshes({{"octopus-low.mesh", 452, 1140, 0, 898}, {"hand.mesh", 7234, 29998, 0, 9556}});
 }

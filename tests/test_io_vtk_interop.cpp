@@ -204,9 +204,7 @@ TEST(IoVtk, MeshioReadsEveryFileWeWrite)
 {
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
     const auto dir = temp_dir();
-    const TetMesh m = grid_mesh();
-    const io::Fields f = sample_fields(m);
-    write_ours_and_reference(dir, m, f);
+    const auto [m, f] = write_ours_and_reference(dir);
     io::write_pvd((dir / "series.pvd").string(), {{0.0, "ours.vtu"}, {0.5, "ours.vtu"}});
     {
         std::ofstream v(dir / "ref_velocity.txt"), s(dir / "ref_stress.txt"), o(dir / "ref_objects.txt");
@@ -315,9 +313,7 @@ TEST(IoVtk, VtkLibraryReadsOursAndWeReadVtkLibraryFiles)
 {
     TETHASH_SKIP_WITHOUT_PYTHON(py, "vtk numpy");
     const auto dir = temp_dir();
-    const TetMesh m = grid_mesh();
-    const io::Fields f = sample_fields(m);
-    write_ours_and_reference(dir, m, f);
+    const auto [m, f] = write_ours_and_reference(dir);
     write_text(dir / "check_with_vtk.py", kVtkScript);
     const RunResult r = run_shell(py + " " + quote(dir / "check_with_vtk.py") + " " + quote(dir));
     ASSERT_EQ(r.status, 0) << r.out << r.err;

@@ -31,24 +31,16 @@ inline TetMesh grid_mesh(int nx = 3, int ny = 2, int nz = 2)
                 m.positions(v, 1) = j * 0.1 + 0.01 * std::cos(2.0 * v);
                 m.positions(v, 2) = k * std::sqrt(2.0) + 1e-7 * v;
             }
-    static const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
     std::vector<std::array<Index, 4>> tets;
     for (int k = 0; k < nz; ++k)
         for (int j = 0; j < ny; ++j)
-            for (int i = 0; i < nx; ++i) {
-                Index c[8];
-                for (int b = 0; b < 8; ++b)
-                    c[b] = id(i + (b & 1), j + ((b >> 1) & 1), k + ((b >> 2) & 1));
-                for (const auto& t : kuhn) {
-                    tets.push_back({c[t[0]], c[t[1]], c[t[2]], c[t[3]]});
+            for (int i = 0; i < nx; ++i)
+                for (const auto& t : kuhn_tets(i, j, k, id)) {
+                    tets.push_back(t);
                     m.tet_object.push_back(i < nx / 2 ? 0 : 1);
                     m.tet_label.push_back(100 + i + 10 * k);
                 }
-            }
-    m.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
-    for (std::size_t t = 0; t < tets.size(); ++t)
-        for (int c = 0; c < 4; ++c)
-            m.tets(static_cast<Eigen::Index>(t), c) = tets[t][c];
+    m.tets = matrix_of<Tets>(tets);
     m.vertex_object.assign(static_cast<std::size_t>(m.num_vertices()), 0);
     for (std::size_t t = 0; t < tets.size(); ++t)
         for (Index v : tets[t])
@@ -121,14 +113,22 @@ inline TetMesh read_reference(const std::filesystem::path& dir)
     return m;
 }
 
-/// `m` with fields `f` in each format and encoding we write (ours.vtu, ours_binary.vtk, ours_ascii.vtk), and
-/// its reference text for the Python checks.
-inline void write_ours_and_reference(const std::filesystem::path& dir, const TetMesh& m, const io::Fields& f)
+struct SampleFiles {
+    TetMesh mesh;
+    io::Fields fields;
+};
+
+/// The grid mesh with its sample fields, written into `dir` in each format and encoding we write (ours.vtu,
+/// ours_binary.vtk, ours_ascii.vtk) with its reference text for the Python checks. Returns what it wrote.
+inline SampleFiles write_ours_and_reference(const std::filesystem::path& dir)
 {
-    io::write_vtu((dir / "ours.vtu").string(), m, f);
-    io::write_vtk((dir / "ours_binary.vtk").string(), m, f, true);
-    io::write_vtk((dir / "ours_ascii.vtk").string(), m, f, false);
-    write_reference(dir, m);
+    SampleFiles s{grid_mesh(), {}};
+    s.fields = sample_fields(s.mesh);
+    io::write_vtu((dir / "ours.vtu").string(), s.mesh, s.fields);
+    io::write_vtk((dir / "ours_binary.vtk").string(), s.mesh, s.fields, true);
+    io::write_vtk((dir / "ours_ascii.vtk").string(), s.mesh, s.fields, false);
+    write_reference(dir, s.mesh);
+    return s;
 }
 
 } // namespace tethash::test

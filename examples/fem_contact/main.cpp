@@ -112,6 +112,25 @@ fem::ContactSettings contact_settings(const Options& o, double stiffness)
     return c;
 }
 
+/// The scenes' material (density 1000 kg/m³, Poisson ratio 0.3) of Young's modulus `young` [Pa].
+fem::Material material(double young)
+{
+    fem::Material m;
+    m.young = young;
+    m.poisson = 0.3;
+    m.density = 1e3;
+    return m;
+}
+
+/// The time step of --dt (0.01 s by default) and a damping α [1/s].
+fem::SimulationSettings settings(const Options& o, double damping)
+{
+    fem::SimulationSettings s;
+    s.dt = o.dt > 0 ? o.dt : 0.01;
+    s.damping = damping;
+    return s;
+}
+
 int block(const Options& o)
 {
     const double gap = 0.005, load = 2000;
@@ -119,15 +138,9 @@ int block(const Options& o)
         4, 4, 2, 0.25, {0, 0, 0}, [](int, int, int) { return true; }, 0);
     fem::append(mesh, fem::lattice(
                           3, 3, 3, 1.0 / 6, {0.25, 0.25, 0.5 + gap}, [](int, int, int) { return true; }, 1));
-    fem::Material mat;
-    mat.young = 1e5;
-    mat.poisson = 0.3;
-    mat.density = 1e3;
-    fem::SimulationSettings ss;
-    ss.dt = o.dt > 0 ? o.dt : 0.01;
-    ss.damping = 20;
+    fem::SimulationSettings ss = settings(o, 20);
     ss.gravity = {0, 0, -9.81};
-    fem::Simulation sim(mesh, mat, contact_settings(o, 1e6), ss);
+    fem::Simulation sim(mesh, material(1e5), contact_settings(o, 1e6), ss);
     Vec f = Vec::Zero(mesh.rest.size());
     std::vector<int> top;
     for (int i = 0; i < mesh.nodes(); ++i) {
@@ -193,14 +206,7 @@ int hairpin(const Options& o)
     // 8 × 2 × 5 cubes minus the slot k = 2, i ≥ 1: lower arm z ∈ [0, 0.2], gap [0.2, 0.3], upper arm [0.3, 0.5].
     fem::Mesh mesh = fem::lattice(
         8, 2, 5, h, {0, 0, 0}, [](int i, int, int k) { return !(k == 2 && i >= 1); }, 0);
-    fem::Material mat;
-    mat.young = 1e6;
-    mat.poisson = 0.3;
-    mat.density = 1e3;
-    fem::SimulationSettings ss;
-    ss.dt = o.dt > 0 ? o.dt : 0.01;
-    ss.damping = 5;
-    fem::Simulation sim(mesh, mat, contact_settings(o, 1e6), ss);
+    fem::Simulation sim(mesh, material(1e6), contact_settings(o, 1e6), settings(o, 5));
     Vec f = Vec::Zero(mesh.rest.size());
     std::vector<int> tip;
     int tip_bottom = -1;

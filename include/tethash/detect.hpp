@@ -111,7 +111,7 @@ struct DetectParams {
     /// The broad phase. Methods other than `hash` ignore `table_size`, `hash` and the skin; the grids use the cell
     /// size (the hierarchical grid as its finest level).
     Method method = Method::hash;
-    PartitionParams partition;
+    PartitionParams partition{};
 };
 
 // ---- the text grammar of the detector's parameters: one parser for every command and scene file ----------

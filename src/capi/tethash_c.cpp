@@ -113,6 +113,20 @@ template <class F> tethash_status set_param(tethash_detector* d, const char* whe
     });
 }
 
+/// The checks of a call that passes positions to a detector: `ready` (a topology, or a detection, per
+/// `not_ready`'s message), then `positions` for the topology's vertices. TETHASH_OK when the call may go on.
+tethash_status check_positions(const char* where, const tethash_detector* d, bool tethash_detector::*ready,
+                               const char* not_ready, const double* positions, int64_t num_vertices)
+{
+    if (!d) return null_argument(where, "detector");
+    if (!(d->*ready)) return fail(TETHASH_ERROR_STATE, std::string(where) + ": " + not_ready);
+    if (num_vertices != d->num_vertices)
+        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
+                                  std::to_string(d->num_vertices));
+    if (!positions && num_vertices > 0) return null_argument(where, "positions");
+    return TETHASH_OK;
+}
+
 } // namespace
 
 extern "C" {
@@ -270,12 +284,10 @@ tethash_status tethash_detector_detect(tethash_detector* detector, const double*
 {
     const char* where = "tethash_detector_detect";
     if (out_count) *out_count = 0;
-    if (!detector) return null_argument(where, "detector");
-    if (!detector->has_topology) return fail(TETHASH_ERROR_STATE, std::string(where) + ": no topology set");
-    if (num_vertices != detector->num_vertices)
-        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
-                                  std::to_string(detector->num_vertices));
-    if (!positions && num_vertices > 0) return null_argument(where, "positions");
+    if (const tethash_status s = check_positions(where, detector, &tethash_detector::has_topology, "no topology set",
+                                                 positions, num_vertices);
+        s != TETHASH_OK)
+        return s;
     return guard(where, [&] {
         detector->detected = false;
         const Eigen::Map<const tethash::Positions> map(positions, static_cast<Eigen::Index>(num_vertices), 3);
@@ -341,12 +353,10 @@ tethash_status tethash_detector_compute_penetration(tethash_detector* detector, 
                                                     int64_t num_vertices)
 {
     const char* where = "tethash_detector_compute_penetration";
-    if (!detector) return null_argument(where, "detector");
-    if (!detector->detected) return fail(TETHASH_ERROR_STATE, std::string(where) + ": no detection to complete");
-    if (num_vertices != detector->num_vertices)
-        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
-                                  std::to_string(detector->num_vertices));
-    if (!positions && num_vertices > 0) return null_argument(where, "positions");
+    if (const tethash_status s = check_positions(where, detector, &tethash_detector::detected,
+                                                 "no detection to complete", positions, num_vertices);
+        s != TETHASH_OK)
+        return s;
     return guard(where, [&] {
         tethash_detector& d = *detector;
         if (!d.penetration_ready) {

@@ -80,8 +80,8 @@ Index Bvh::build_node(Index begin, Index end, int depth)
     Index* items = m_items.data();
     Index mid = begin + count / 2; // coincident centres: the middle of the list
     if (extent > 0) {
-        const double scale = bins / extent;
-        auto bin_of = [&](Index t) { return std::min(bins - 1, static_cast<int>((centre(t) - lo) * scale)); };
+        // (c − lo) / extent ∈ [0, 1] also for tiny extents (bins / extent could overflow).
+        auto bin_of = [&](Index t) { return std::min(bins - 1, static_cast<int>((centre(t) - lo) / extent * bins)); };
         Box bin_box[bins];
         Index bin_count[bins] = {};
         for (Box& b : bin_box)

@@ -19,10 +19,11 @@ class Bvh final : public BroadPhase {
     /// Refitted trees are rebuilt when quality() exceeds this factor times its value after the last build.
     static constexpr double degradation = 2.0;
 
+    /// Builds (the first call's included) and refits since the object was made.
     std::int64_t builds() const { return m_builds; }
     std::int64_t refits() const { return m_refits; }
-    /// Summed surface area of the nodes over the root's (the expected number of nodes a random ray... here: a
-    /// query point spread over the root visits is proportional to it).
+    /// Summed surface area of the nodes over the root's: the surface-area heuristic's measure of the nodes a query
+    /// visits (lower is better; grows as refitted boxes swell and overlap).
     double quality() const;
 
   private:

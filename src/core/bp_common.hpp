@@ -4,6 +4,7 @@
 // vertices and tets that feed the threads' sinks, a timer.
 #include "broad_phase.hpp"
 #include "team.hpp"
+#include "timing.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -91,12 +92,6 @@ template <class F> void for_each_index(Index count, int chunk, std::vector<Candi
         for (Index i = 0; i < count; ++i)
             f(i, out);
     }
-}
-
-/// Milliseconds since t0.
-inline double ms_since(std::chrono::steady_clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /// Capacity of a vector in bytes.

@@ -76,12 +76,12 @@ BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<Candidate
     m_node_of.resize(static_cast<std::size_t>(m));
     for (Index t = 0; t < m; ++t) {
         const Box& b = m_boxes[static_cast<std::size_t>(t)];
+        const double mid[3] = {0.5 * (b.lo[0] + b.hi[0]), 0.5 * (b.lo[1] + b.hi[1]), 0.5 * (b.lo[2] + b.hi[2])};
         Index node = 0;
         for (int depth = 0; depth < max_depth; ++depth) {
-            const Node& cur = m_nodes[static_cast<std::size_t>(node)];
-            int k = 0;
-            for (int a = 0; a < 3; ++a)
-                k |= (0.5 * (b.lo[a] + b.hi[a]) >= cur.centre[a] ? 1 : 0) << a;
+            const Node cur = m_nodes[static_cast<std::size_t>(node)];
+            const int k = (mid[0] >= cur.centre[0] ? 1 : 0) | (mid[1] >= cur.centre[1] ? 2 : 0) |
+                          (mid[2] >= cur.centre[2] ? 4 : 0);
             // The child's loose box before creating the children: creating them for a tet that does not fit
             // would grow the tree where nothing is stored.
             const double h = 0.5 * cur.half;

@@ -1,6 +1,7 @@
 // The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
 #include "detect_checks.hpp"
+#include "enum_names.hpp"
 #include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -144,12 +145,10 @@ void parse_skin(const std::string& text, DetectParams& params, const std::string
 }
 
 namespace {
+constexpr detail::EnumName<HashFunction> k_hash_names[] = {{HashFunction::teschner, "teschner"},
+                                                           {HashFunction::column, "column"}};
 
-struct MethodName {
-    Method method;
-    const char* name;
-};
-constexpr MethodName method_names[] = {
+constexpr detail::EnumName<Method> k_method_names[] = {
     {Method::hash, "hash"},
     {Method::brute_force, "brute"},
     {Method::uniform_grid, "grid"},
@@ -166,13 +165,13 @@ constexpr MethodName method_names[] = {
     {Method::bvh_refit, "bvh-refit"},
     {Method::automatic, "auto"},
 };
-constexpr std::size_t num_methods = sizeof method_names / sizeof method_names[0];
+constexpr std::size_t k_num_methods = sizeof k_method_names / sizeof k_method_names[0];
 
-// The methods in the order of method_names, without `automatic` (the last entry).
-constexpr auto method_list = [] {
-    std::array<Method, num_methods - 1> out{};
-    for (std::size_t k = 0; k + 1 < num_methods; ++k)
-        out[k] = method_names[k].method;
+// The methods in the order of k_method_names, without `automatic` (the last entry).
+constexpr auto k_method_list = [] {
+    std::array<Method, k_num_methods - 1> out{};
+    for (std::size_t k = 0; k + 1 < k_num_methods; ++k)
+        out[k] = k_method_names[k].value;
     return out;
 }();
 
@@ -180,42 +179,32 @@ constexpr auto method_list = [] {
 
 Method parse_method(const std::string& text, const std::string& option)
 {
+    if (const auto m = detail::value_named(k_method_names, text)) return *m;
     std::string names;
-    for (const MethodName& m : method_names) {
-        if (text == m.name) return m.method;
-        names += names.empty() ? m.name : std::string(", ") + m.name;
-    }
+    for (const auto& row : k_method_names)
+        names += names.empty() ? row.name : std::string(", ") + row.name;
     throw Error(option + ": unknown method '" + text + "' (expected one of " + names + ")");
 }
 
 const char* to_string(Method m)
 {
-    for (const MethodName& n : method_names)
-        if (n.method == m) return n.name;
-    return "?";
+    return detail::name_of(k_method_names, m);
 }
 
 std::span<const Method> all_methods()
 {
-    return method_list;
+    return k_method_list;
 }
 
 HashFunction parse_hash_function(const std::string& name)
 {
-    if (name == "teschner") return HashFunction::teschner;
-    if (name == "column") return HashFunction::column;
+    if (const auto h = detail::value_named(k_hash_names, name)) return *h;
     throw Error("unknown hash function '" + name + "' (expected teschner or column)");
 }
 
 const char* to_string(HashFunction h)
 {
-    switch (h) {
-    case HashFunction::teschner:
-        return "teschner";
-    case HashFunction::column:
-        return "column";
-    }
-    return "?";
+    return detail::name_of(k_hash_names, h);
 }
 
 namespace detail {

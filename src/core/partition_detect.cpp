@@ -6,21 +6,11 @@
 
 #include "team.hpp"
 #include "tethash/predicates.hpp"
+#include "timing.hpp"
 
 #include <algorithm>
-#include <chrono>
 
 namespace tethash::detail {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-} // namespace
 
 void PartitionDetector::reset()
 {

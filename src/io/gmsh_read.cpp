@@ -20,6 +20,13 @@ TetMesh MshReader::read()
     m_r.expect("$MeshFormat");
     m_r.skip_rest_of_line();
     read_format();
+    // A section that may stand once, read by the reader of the file's version.
+    const auto read_once = [this](bool& done, const std::string& section, void (MshReader::*read41)(),
+                                  void (MshReader::*read22)()) {
+        if (done) m_r.fail_message("a second $" + section + " section (only one is supported)");
+        (this->*(m_version == 41 ? read41 : read22))();
+        done = true;
+    };
     while (!m_r.at_end()) {
         const std::string_view tok = m_r.next("a section header");
         if (tok.front() != '$') m_r.fail("a section header such as $Nodes", TextReader::describe(tok));
@@ -27,20 +34,10 @@ TetMesh MshReader::read()
         const std::int64_t header_line = m_r.line();
         m_r.skip_rest_of_line();
         if (name == "Nodes") {
-            if (m_have_nodes) m_r.fail_message("a second $Nodes section (only one is supported)");
-            if (m_version == 41)
-                read_nodes41();
-            else
-                read_nodes22();
-            m_have_nodes = true;
+            read_once(m_have_nodes, name, &MshReader::read_nodes41, &MshReader::read_nodes22);
         } else if (name == "Elements") {
             if (!m_have_nodes) m_r.fail("$Nodes before $Elements", "$Elements");
-            if (m_have_elements) m_r.fail_message("a second $Elements section (only one is supported)");
-            if (m_version == 41)
-                read_elements41();
-            else
-                read_elements22();
-            m_have_elements = true;
+            read_once(m_have_elements, name, &MshReader::read_elements41, &MshReader::read_elements22);
         } else if (name == "Entities" && m_version == 41) {
             read_entities41();
         } else if (name == "MeshFormat") {
@@ -138,6 +135,17 @@ double MshReader::read_coord(std::int64_t tag, int axis)
         m_r.fail(std::string("a finite ") + names[axis] + " coordinate of node " + std::to_string(tag),
                  TextReader::describe(tok));
     return *v;
+}
+
+void MshReader::check_block_count(std::int64_t count, std::int64_t seen, std::int64_t total, std::int64_t block,
+                                  const std::string& kind, const std::string& section)
+{
+    if (count <= total - seen) return;
+    const std::string msg = "expected at most " + std::to_string(total - seen) + " " + kind + "s in " + kind +
+                            " block " + std::to_string(block + 1) + " (the $" + section + " header says " +
+                            std::to_string(total) + " in all), found " + std::to_string(count);
+    if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
+    m_r.fail_message(msg);
 }
 
 void MshReader::check_blocks_total(std::int64_t seen, std::int64_t total, std::int64_t blocks, const std::string& items,

@@ -71,13 +71,7 @@ void MshReader::read_nodes41()
             m_r.fail("the parametric flag 0 or 1", std::to_string(parametric));
         }
         const std::int64_t count = read_size("the number of nodes in the block");
-        if (count > total - seen) {
-            const std::string msg = "expected at most " + std::to_string(total - seen) + " nodes in node block " +
-                                    std::to_string(b + 1) + " (the $Nodes header says " + std::to_string(total) +
-                                    " in all), found " + std::to_string(count);
-            if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
-            m_r.fail_message(msg);
-        }
+        check_block_count(count, seen, total, b, "node", "Nodes");
         const int extra = parametric ? static_cast<int>(dim) : 0;
         check_room(count, m_size_t + (3 + static_cast<std::size_t>(extra)) * sizeof(double),
                    4 + static_cast<std::size_t>(extra), "nodes");
@@ -116,13 +110,7 @@ void MshReader::read_elements41()
         const std::size_t type_at = m_r.offset();
         const std::int64_t type = read_int("an element type");
         const std::int64_t count = read_size("the number of elements in the block");
-        if (count > total - seen) {
-            const std::string msg = "expected at most " + std::to_string(total - seen) + " elements in element block " +
-                                    std::to_string(b + 1) + " (the $Elements header says " + std::to_string(total) +
-                                    " in all), found " + std::to_string(count);
-            if (binary()) m_r.fail_at_byte(m_r.offset() - m_size_t, msg);
-            m_r.fail_message(msg);
-        }
+        check_block_count(count, seen, total, b, "element", "Elements");
         const int nn = gmsh_nodes_per_element(type);
         if (is_tet(type)) {
             check_room(count, static_cast<std::size_t>(1 + nn) * m_size_t, static_cast<std::size_t>(1 + nn), "tets");

@@ -98,6 +98,10 @@ class MshReader {
 
     /// Fails unless the blocks of section $`section` held the `total` `items` its header announced (at the
     /// byte offset in a binary file, else at the line of the token that follows).
+    /// Fails unless a block's `count` fits in what the section header leaves, total − seen: block `block`
+    /// (0-based) of the `kind` blocks ("node" or "element") of section $`section`.
+    void check_block_count(std::int64_t count, std::int64_t seen, std::int64_t total, std::int64_t block,
+                           const std::string& kind, const std::string& section);
     void check_blocks_total(std::int64_t seen, std::int64_t total, std::int64_t blocks, const std::string& items,
                             const std::string& section);
     void expect_end(std::string_view marker);

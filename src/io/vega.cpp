@@ -43,6 +43,19 @@ std::int64_t next_number(TextReader& r, const std::string& kind, const std::stri
     return id;
 }
 
+/// Reads a section header "count width ...": the number of `items`, then `width_what`, which must be `width`
+/// (`expected` says so in the error), and skips the rest of the line. Returns the number of items.
+std::int64_t read_header(TextReader& r, const std::string& items, std::string_view width_what, std::int64_t width,
+                         std::string_view expected)
+{
+    const std::int64_t count = r.next_int_in("the number of " + items, 0, k_max_int32);
+    const std::int64_t w = r.next_int(width_what);
+    if (w != width) r.fail(expected, std::to_string(w));
+    r.skip_rest_of_line();
+    r.check_count_fits(count, items);
+    return count;
+}
+
 } // namespace
 
 TetMesh read_veg(const std::string& path, ReadNotes* notes)
@@ -58,11 +71,8 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
         const std::string key = upper(tok);
         if (key == "*VERTICES") {
             if (have_vertices) r.fail_message("a second *VERTICES section");
-            const std::int64_t n = r.next_int_in("the number of vertices", 0, k_max_int32);
-            const std::int64_t dim = r.next_int("the dimension");
-            if (dim != 3) r.fail("dimension 3 in the *VERTICES header", std::to_string(dim));
-            r.skip_rest_of_line();
-            r.check_count_fits(n, "vertices");
+            const std::int64_t n =
+                read_header(r, "vertices", "the dimension", 3, "dimension 3 in the *VERTICES header");
             mesh.positions.resize(static_cast<Index>(n), 3);
             static const char* axis[] = {"x", "y", "z"};
             for (std::int64_t i = 0; i < n; ++i) {
@@ -77,11 +87,8 @@ TetMesh read_veg(const std::string& path, ReadNotes* notes)
             const std::string_view type = r.next("the element type TET");
             if (upper(type) != "TET")
                 r.fail("the element type TET (tethash reads tet meshes only)", TextReader::describe(type));
-            const std::int64_t m = r.next_int_in("the number of elements", 0, k_max_int32);
-            const std::int64_t per = r.next_int("the number of vertices per element");
-            if (per != 4) r.fail("4 vertices per TET element", std::to_string(per));
-            r.skip_rest_of_line();
-            r.check_count_fits(m, "elements");
+            const std::int64_t m =
+                read_header(r, "elements", "the number of vertices per element", 4, "4 vertices per TET element");
             mesh.tets.resize(static_cast<Index>(m), 4);
             tet_lines.resize(static_cast<std::size_t>(m));
             for (std::int64_t t = 0; t < m; ++t) {

@@ -2,13 +2,17 @@
 #include "vtk_detail.hpp"
 
 #include "number.hpp"
+
+#include "core/enum_names.hpp"
 #include "tethash/error.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <type_traits>
 
 static_assert(std::endian::native == std::endian::little, "the VTK readers and writers assume a little-endian host");
 
@@ -44,81 +48,55 @@ bool scalar_is_integer(Scalar t)
     return t != Scalar::Float32 && t != Scalar::Float64;
 }
 
+namespace {
+constexpr tethash::detail::EnumName<Scalar> k_xml_names[] = {
+    {Scalar::Bit, "Bit"},       {Scalar::Int8, "Int8"},       {Scalar::UInt8, "UInt8"},     {Scalar::Int16, "Int16"},
+    {Scalar::UInt16, "UInt16"}, {Scalar::Int32, "Int32"},     {Scalar::UInt32, "UInt32"},   {Scalar::Int64, "Int64"},
+    {Scalar::UInt64, "UInt64"}, {Scalar::Float32, "Float32"}, {Scalar::Float64, "Float64"},
+};
+} // namespace
+
 const char* xml_type_name(Scalar t)
 {
-    switch (t) {
-    case Scalar::Bit:
-        return "Bit";
-    case Scalar::Int8:
-        return "Int8";
-    case Scalar::UInt8:
-        return "UInt8";
-    case Scalar::Int16:
-        return "Int16";
-    case Scalar::UInt16:
-        return "UInt16";
-    case Scalar::Int32:
-        return "Int32";
-    case Scalar::UInt32:
-        return "UInt32";
-    case Scalar::Int64:
-        return "Int64";
-    case Scalar::UInt64:
-        return "UInt64";
-    case Scalar::Float32:
-        return "Float32";
-    case Scalar::Float64:
-        return "Float64";
-    }
-    return "?";
+    return tethash::detail::name_of(k_xml_names, t);
 }
 
 std::optional<Scalar> scalar_from_xml(std::string_view n)
 {
-    static const std::pair<const char*, Scalar> table[] = {
-        {"Int8", Scalar::Int8},       {"UInt8", Scalar::UInt8},   {"Int16", Scalar::Int16},
-        {"UInt16", Scalar::UInt16},   {"Int32", Scalar::Int32},   {"UInt32", Scalar::UInt32},
-        {"Int64", Scalar::Int64},     {"UInt64", Scalar::UInt64}, {"Float32", Scalar::Float32},
-        {"Float64", Scalar::Float64},
-    };
-    for (const auto& [name, t] : table)
-        if (n == name) return t;
-    return std::nullopt;
+    const auto t = tethash::detail::value_named(k_xml_names, n);
+    return t == Scalar::Bit ? std::nullopt : t; // bit arrays are not read
 }
 
 using detail::to_lower;
 
 std::optional<Scalar> scalar_from_legacy(std::string_view name)
 {
-    static const std::pair<const char*, Scalar> table[] = {
-        {"bit", Scalar::Bit},
-        {"char", Scalar::Int8},
-        {"signed_char", Scalar::Int8},
-        {"unsigned_char", Scalar::UInt8},
-        {"short", Scalar::Int16},
-        {"unsigned_short", Scalar::UInt16},
-        {"int", Scalar::Int32},
-        {"unsigned_int", Scalar::UInt32},
-        {"long", Scalar::Int64}, // LP64: VTK writes sizeof(long) bytes
-        {"unsigned_long", Scalar::UInt64},
-        {"vtkidtype", Scalar::Int32}, // the legacy writer stores vtkIdType arrays as int
-        {"float", Scalar::Float32},
-        {"double", Scalar::Float64},
-        {"vtktypeint8", Scalar::Int8},
-        {"vtktypeuint8", Scalar::UInt8},
-        {"vtktypeint16", Scalar::Int16},
-        {"vtktypeuint16", Scalar::UInt16},
-        {"vtktypeint32", Scalar::Int32},
-        {"vtktypeuint32", Scalar::UInt32},
-        {"vtktypeint64", Scalar::Int64},
-        {"vtktypeuint64", Scalar::UInt64},
-        {"vtktypefloat32", Scalar::Float32},
-        {"vtktypefloat64", Scalar::Float64},
+    static constexpr tethash::detail::EnumName<Scalar> table[] = {
+        {Scalar::Bit, "bit"},
+        {Scalar::Int8, "char"},
+        {Scalar::Int8, "signed_char"},
+        {Scalar::UInt8, "unsigned_char"},
+        {Scalar::Int16, "short"},
+        {Scalar::UInt16, "unsigned_short"},
+        {Scalar::Int32, "int"},
+        {Scalar::UInt32, "unsigned_int"},
+        {Scalar::Int64, "long"}, // LP64: VTK writes sizeof(long) bytes
+        {Scalar::UInt64, "unsigned_long"},
+        {Scalar::Int32, "vtkidtype"}, // the legacy writer stores vtkIdType arrays as int
+        {Scalar::Float32, "float"},
+        {Scalar::Float64, "double"},
+        {Scalar::Int8, "vtktypeint8"},
+        {Scalar::UInt8, "vtktypeuint8"},
+        {Scalar::Int16, "vtktypeint16"},
+        {Scalar::UInt16, "vtktypeuint16"},
+        {Scalar::Int32, "vtktypeint32"},
+        {Scalar::UInt32, "vtktypeuint32"},
+        {Scalar::Int64, "vtktypeint64"},
+        {Scalar::UInt64, "vtktypeuint64"},
+        {Scalar::Float32, "vtktypefloat32"},
+        {Scalar::Float64, "vtktypefloat64"},
     };
-    const std::string n = to_lower(name);
-    for (const auto& [key, t] : table)
-        if (n == key) return t;
-    return std::nullopt;
+    return tethash::detail::value_named(table, to_lower(name));
 }
 
 namespace {
@@ -134,56 +112,48 @@ template <class T> T load(const unsigned char* p, bool big_endian)
     return v;
 }
 
+/// One value of type T at `src` as an Out. Integer outputs take -1 for what they cannot hold (uint64 values past
+/// int64, non-finite or huge floating-point values) so that range checks reject it.
+template <class T, class Out> Out load_as(const unsigned char* src, bool big_endian)
+{
+    const T v = load<T>(src, big_endian);
+    if constexpr (std::is_integral_v<Out> && std::is_floating_point_v<T>) {
+        const double d = v;
+        return std::isfinite(d) && std::abs(d) < 9e18 ? static_cast<Out>(d) : Out(-1);
+    } else if constexpr (std::is_integral_v<Out> && std::is_same_v<T, std::uint64_t>) {
+        return v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) ? Out(-1) : static_cast<Out>(v);
+    } else {
+        return static_cast<Out>(v);
+    }
+}
+
+template <class Out> Out load_bit(const unsigned char*, bool)
+{
+    return 0;
+}
+
 template <class Out> void convert(const unsigned char* src, Scalar t, std::size_t count, bool be, Out* out)
 {
+    using Load = Out (*)(const unsigned char*, bool);
+    // In the order of Scalar.
+    static constexpr Load loads[] = {
+        load_bit<Out>,
+        load_as<std::int8_t, Out>,
+        load_as<std::uint8_t, Out>,
+        load_as<std::int16_t, Out>,
+        load_as<std::uint16_t, Out>,
+        load_as<std::int32_t, Out>,
+        load_as<std::uint32_t, Out>,
+        load_as<std::int64_t, Out>,
+        load_as<std::uint64_t, Out>,
+        load_as<float, Out>,
+        load_as<double, Out>,
+    };
+    static_assert(std::size(loads) == static_cast<std::size_t>(Scalar::Float64) + 1);
+    const Load load_one = loads[static_cast<std::size_t>(t)];
     const int s = scalar_size(t);
-    for (std::size_t i = 0; i < count; ++i, src += s) {
-        switch (t) {
-        case Scalar::Bit:
-            out[i] = 0;
-            break;
-        case Scalar::Int8:
-            out[i] = static_cast<Out>(load<std::int8_t>(src, be));
-            break;
-        case Scalar::UInt8:
-            out[i] = static_cast<Out>(load<std::uint8_t>(src, be));
-            break;
-        case Scalar::Int16:
-            out[i] = static_cast<Out>(load<std::int16_t>(src, be));
-            break;
-        case Scalar::UInt16:
-            out[i] = static_cast<Out>(load<std::uint16_t>(src, be));
-            break;
-        case Scalar::Int32:
-            out[i] = static_cast<Out>(load<std::int32_t>(src, be));
-            break;
-        case Scalar::UInt32:
-            out[i] = static_cast<Out>(load<std::uint32_t>(src, be));
-            break;
-        case Scalar::Int64:
-            out[i] = static_cast<Out>(load<std::int64_t>(src, be));
-            break;
-        case Scalar::UInt64: {
-            const std::uint64_t v = load<std::uint64_t>(src, be);
-            // Values past int64 become -1 so that range checks reject them.
-            if constexpr (std::is_integral_v<Out>)
-                out[i] = v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) ? Out(-1)
-                                                                                                  : static_cast<Out>(v);
-            else
-                out[i] = static_cast<Out>(v);
-            break;
-        }
-        case Scalar::Float32:
-        case Scalar::Float64: {
-            const double v = t == Scalar::Float32 ? double(load<float>(src, be)) : load<double>(src, be);
-            if constexpr (std::is_integral_v<Out>)
-                out[i] = std::isfinite(v) && std::abs(v) < 9e18 ? static_cast<Out>(v) : Out(-1);
-            else
-                out[i] = v;
-            break;
-        }
-        }
-    }
+    for (std::size_t i = 0; i < count; ++i, src += s)
+        out[i] = load_one(src, be);
 }
 } // namespace
 

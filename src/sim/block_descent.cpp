@@ -39,6 +39,32 @@ using detail::LaneTerms;
 using detail::SpringLanes;
 using detail::TetLanes;
 
+/// The rows of an index matrix (springs' edges, tets) at each vertex, in compressed form: vertex i's are
+/// entries[start[i] .. start[i + 1]), in row order, each the row or, with `with_column`, cols · row + column.
+struct Incidences {
+    std::vector<std::int32_t> start, entries;
+};
+
+template <class IndexMatrix> Incidences incidences(const IndexMatrix& m, size_t num_vertices, bool with_column)
+{
+    const Index rows = static_cast<Index>(m.rows());
+    const int cols = static_cast<int>(m.cols());
+    Incidences out;
+    out.start.assign(num_vertices + 1, 0);
+    out.entries.resize(static_cast<size_t>(rows * cols));
+    for (Index r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+            ++out.start[static_cast<size_t>(m(r, c)) + 1];
+    for (size_t i = 0; i < num_vertices; ++i)
+        out.start[i + 1] += out.start[i];
+    std::vector<std::int32_t> fill(out.start.begin(), out.start.end() - 1);
+    for (Index r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+            out.entries[static_cast<size_t>(fill[static_cast<size_t>(m(r, c))]++)] =
+                static_cast<std::int32_t>(with_column ? cols * r + c : r);
+    return out;
+}
+
 /// One incidence of a vertex in a contact's stencil.
 struct VertexContact {
     std::int32_t contact;
@@ -131,33 +157,15 @@ void BlockDescent::setup()
     const Model& model = m_ctx.model;
     const Index n = model.num_vertices();
     const size_t un = static_cast<size_t>(n);
-    const Index ne = static_cast<Index>(model.springs.edges.rows());
-    const Index nt = static_cast<Index>(model.volumes.tets.rows());
 
     // Vertex → springs (by id), then a greedy colouring of the free vertices over the edge graph (every pair of
     // vertices of a tet is an edge, so one colour shares no spring and no tet).
-    std::vector<std::int32_t> adj_start(un + 1, 0), adj_spring(static_cast<size_t>(2 * ne));
-    for (Index e = 0; e < ne; ++e)
-        for (int s = 0; s < 2; ++s)
-            ++adj_start[static_cast<size_t>(model.springs.edges(e, s)) + 1];
-    for (size_t i = 0; i < un; ++i)
-        adj_start[i + 1] += adj_start[i];
-    std::vector<std::int32_t> fill(adj_start.begin(), adj_start.end() - 1);
-    for (Index e = 0; e < ne; ++e)
-        for (int s = 0; s < 2; ++s)
-            adj_spring[static_cast<size_t>(fill[static_cast<size_t>(model.springs.edges(e, s))]++)] =
-                static_cast<std::int32_t>(e);
-    std::vector<std::int32_t> tet_adj_start(un + 1, 0), tet_adj(static_cast<size_t>(4 * nt));
-    for (Index t = 0; t < nt; ++t)
-        for (int a = 0; a < 4; ++a)
-            ++tet_adj_start[static_cast<size_t>(model.volumes.tets(t, a)) + 1];
-    for (size_t i = 0; i < un; ++i)
-        tet_adj_start[i + 1] += tet_adj_start[i];
-    fill.assign(tet_adj_start.begin(), tet_adj_start.end() - 1);
-    for (Index t = 0; t < nt; ++t)
-        for (int a = 0; a < 4; ++a)
-            tet_adj[static_cast<size_t>(fill[static_cast<size_t>(model.volumes.tets(t, a))]++)] =
-                static_cast<std::int32_t>(4 * t + a);
+    const Incidences springs_at = incidences(model.springs.edges, un, false);
+    const Incidences tets_at = incidences(model.volumes.tets, un, true);
+    const std::vector<std::int32_t>& adj_start = springs_at.start;
+    const std::vector<std::int32_t>& adj_spring = springs_at.entries;
+    const std::vector<std::int32_t>& tet_adj_start = tets_at.start;
+    const std::vector<std::int32_t>& tet_adj = tets_at.entries;
 
     std::vector<int> colour(un, -1);
     int colours = 0;
@@ -184,7 +192,7 @@ void BlockDescent::setup()
     for (int c = 0; c < colours; ++c)
         colour_start[static_cast<size_t>(c) + 1] += colour_start[static_cast<size_t>(c)];
     m_order.resize(static_cast<size_t>(colour_start.back()));
-    fill.assign(colour_start.begin(), colour_start.end() - 1);
+    std::vector<std::int32_t> fill(colour_start.begin(), colour_start.end() - 1);
     for (Index i = 0; i < n; ++i)
         if (colour[static_cast<size_t>(i)] >= 0)
             m_order[static_cast<size_t>(fill[static_cast<size_t>(colour[static_cast<size_t>(i)])]++)] =

@@ -174,7 +174,7 @@ void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
     }
 }
 
-void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, bool cap) const
+template <class Visit> void ContactResponse::for_each_pushing(Visit&& visit) const
 {
     for (size_t q = 0; q < m_contacts.size(); ++q) {
         const Contact& c = m_contacts[q];
@@ -182,7 +182,15 @@ void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, b
         Index node[5];
         double coef[5];
         stencil(q, node, coef);
-        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+        visit(q, static_cast<const Index*>(node), static_cast<const double*>(coef),
+              Vec3(c.direction[0], c.direction[1], c.direction[2]));
+    }
+}
+
+void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, bool cap) const
+{
+    for_each_pushing([&](size_t q, const Index* node, const double* coef, const Vec3& nrm) {
+        const Contact& c = m_contacts[q];
         Vec3 vrel = Vec3::Zero();
         for (int a = 0; a < 5; ++a)
             vrel += coef[a] * vel.row(node[a]).transpose();
@@ -203,20 +211,14 @@ void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, b
         }
         for (int a = 0; a < 5; ++a)
             f.row(node[a]) += coef[a] * force.transpose();
-    }
+    });
 }
 
 template <class Visit> void ContactResponse::for_each_term(double scale_k, double scale_c, Visit&& visit) const
 {
-    for (size_t q = 0; q < m_contacts.size(); ++q) {
-        const Contact& c = m_contacts[q];
-        if (!(c.depth > 0)) continue;
-        Index node[5];
-        double coef[5];
-        stencil(q, node, coef);
-        const Vec3 nrm(c.direction[0], c.direction[1], c.direction[2]);
+    for_each_pushing([&](size_t q, const Index* node, const double* coef, const Vec3& nrm) {
         visit(node, coef, nrm, m_weight[q] * (scale_k * m_k[q] + scale_c * m_c[q]));
-    }
+    });
 }
 
 void ContactResponse::add_triplets(double scale_k, double scale_c, std::vector<Eigen::Triplet<double>>& out) const

@@ -59,6 +59,8 @@ class ContactResponse {
     std::vector<double> exact_depths(const Positions& x) const;
 
   private:
+    /// Calls visit(q, node, coef, normal) for each contact q with depth > 0: its stencil and direction.
+    template <class Visit> void for_each_pushing(Visit&& visit) const;
     /// Calls visit(node, coef, normal, s) for each contact with depth > 0: its stencil, direction and weighted
     /// scale_k · k + scale_c · c (the matrix terms of the three functions above).
     template <class Visit> void for_each_term(double scale_k, double scale_c, Visit&& visit) const;

@@ -1,5 +1,7 @@
 #include "tethash/sim/scene.hpp"
 
+#include "core/enum_names.hpp"
+
 #include "tethash/error.hpp"
 #include "tethash/io/surface.hpp"
 
@@ -9,16 +11,34 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 namespace tethash::sim {
 
+namespace {
+
+/// The integrators' names, the canonical one first, then the aliases the parser also accepts.
+constexpr tethash::detail::EnumName<Integrator> k_integrator_names[] = {
+    {Integrator::symplectic_euler, "symplectic_euler"},
+    {Integrator::symplectic_euler, "symplectic"},
+    {Integrator::symplectic_euler, "explicit"},
+    {Integrator::implicit_euler, "implicit_euler"},
+    {Integrator::implicit_euler, "implicit"},
+    {Integrator::vbd, "vbd"},
+    {Integrator::vbd, "block_descent"},
+};
+
+constexpr tethash::detail::EnumName<LinearSolver> k_solver_names[] = {{LinearSolver::cg, "cg"},
+                                                                      {LinearSolver::ldlt, "ldlt"}};
+
+} // namespace
+
 Integrator parse_integrator(const std::string& name)
 {
-    if (name == "symplectic_euler" || name == "symplectic" || name == "explicit") return Integrator::symplectic_euler;
-    if (name == "implicit_euler" || name == "implicit") return Integrator::implicit_euler;
-    if (name == "vbd" || name == "block_descent") return Integrator::vbd;
+    if (const auto integrator = tethash::detail::value_named(k_integrator_names, name)) return *integrator;
     if (name == "local_global" || name == "liu" || name == "projective")
         throw Error("integrator '" + name +
                     "' was retired (it blew up on real meshes where implicit Euler held): use 'vbd', the default, "
@@ -28,27 +48,18 @@ Integrator parse_integrator(const std::string& name)
 
 const char* to_string(Integrator integrator)
 {
-    switch (integrator) {
-    case Integrator::symplectic_euler:
-        return "symplectic_euler";
-    case Integrator::implicit_euler:
-        return "implicit_euler";
-    case Integrator::vbd:
-        return "vbd";
-    }
-    return "?";
+    return tethash::detail::name_of(k_integrator_names, integrator);
 }
 
 LinearSolver parse_linear_solver(const std::string& name)
 {
-    if (name == "cg") return LinearSolver::cg;
-    if (name == "ldlt") return LinearSolver::ldlt;
+    if (const auto solver = tethash::detail::value_named(k_solver_names, name)) return *solver;
     throw Error("solver '" + name + "' unknown (cg, ldlt)");
 }
 
 const char* to_string(LinearSolver solver)
 {
-    return solver == LinearSolver::cg ? "cg" : "ldlt";
+    return tethash::detail::name_of(k_solver_names, solver);
 }
 
 namespace {
@@ -70,26 +81,16 @@ class Reader {
 
     static const char* type_name(const toml::node& n)
     {
-        switch (n.type()) {
-        case toml::node_type::table:
-            return "a table";
-        case toml::node_type::array:
-            return "an array";
-        case toml::node_type::string:
-            return "a string";
-        case toml::node_type::integer:
-            return "an integer";
-        case toml::node_type::floating_point:
-            return "a number";
-        case toml::node_type::boolean:
-            return "a boolean";
-        default:
-            return "a date/time";
-        }
+        static constexpr tethash::detail::EnumName<toml::node_type> names[] = {
+            {toml::node_type::table, "a table"},           {toml::node_type::array, "an array"},
+            {toml::node_type::string, "a string"},         {toml::node_type::integer, "an integer"},
+            {toml::node_type::floating_point, "a number"}, {toml::node_type::boolean, "a boolean"},
+        };
+        return tethash::detail::name_of(names, n.type(), "a date/time");
     }
 
     /// Throws for keys of `tbl` not in `known`.
-    void check_keys(const toml::table& tbl, const std::string& prefix, std::initializer_list<const char*> known) const
+    void check_keys(const toml::table& tbl, const std::string& prefix, const std::vector<const char*>& known) const
     {
         for (auto&& [k, v] : tbl) {
             const std::string key(k.str());
@@ -201,22 +202,68 @@ class Reader {
     std::string m_source, m_base;
 };
 
+/// One key of a TOML table and how its value is read into the struct T the table describes (key: the key as
+/// messages name it).
+template <class T> struct Key {
+    const char* name;
+    std::function<void(const Reader& r, const toml::node& value, const std::string& key, T& out)> read;
+};
+
+/// A key whose value one of Reader's checks (positive, non_negative, boolean, vec3, ...) reads into `field`.
+template <class T, class F, class V>
+Key<T> key(const char* name, F T::*field, V (Reader::*check)(const toml::node&, const std::string&) const)
+{
+    return {name, [field, check](const Reader& r, const toml::node& v, const std::string& k, T& out) {
+                out.*field = (r.*check)(v, k);
+            }};
+}
+
+/// A key whose value is an int ≥ lo, read into `field`.
+template <class T> Key<T> int_key(const char* name, int T::*field, int lo)
+{
+    return {name, [field, lo](const Reader& r, const toml::node& v, const std::string& k, T& out) {
+                out.*field = r.int_at_least(v, k, lo);
+            }};
+}
+
+/// Reads table `t` (its keys named `prefix` + key in messages) into `out` by `keys`. `more` are further keys
+/// this table may have, which `other(key, value, prefix + key)` reads; any other key is an error.
+template <class T, class Other>
+void read_table(const Reader& r, const toml::table& t, const std::string& prefix, const std::vector<Key<T>>& keys,
+                T& out, std::initializer_list<const char*> more, Other&& other)
+{
+    std::vector<const char*> known;
+    for (const Key<T>& k : keys)
+        known.push_back(k.name);
+    known.insert(known.end(), more.begin(), more.end());
+    r.check_keys(t, prefix, known);
+    for (auto&& [k, v] : t) {
+        const std::string name(k.str()), full = prefix + name;
+        const auto it = std::find_if(keys.begin(), keys.end(), [&](const Key<T>& entry) { return name == entry.name; });
+        if (it != keys.end())
+            it->read(r, v, full, out);
+        else
+            other(name, v, full);
+    }
+}
+
+template <class T>
+void read_table(const Reader& r, const toml::table& t, const std::string& prefix, const std::vector<Key<T>>& keys,
+                T& out)
+{
+    read_table(r, t, prefix, keys, out, {}, [](const std::string&, const toml::node&, const std::string&) {});
+}
+
 void read_material(const Reader& r, const toml::table& t, const std::string& pre, Material& m)
 {
-    r.check_keys(t, pre, {"density", "stiffness", "young", "damping", "volume_stiffness"});
-    for (auto&& [k, v] : t) {
-        const std::string key(k.str()), full = pre + key;
-        if (key == "density")
-            m.density = r.positive(v, full);
-        else if (key == "stiffness")
-            m.stiffness = r.positive(v, full);
-        else if (key == "young")
-            m.young = r.positive(v, full);
-        else if (key == "damping")
-            m.damping = r.non_negative(v, full);
-        else if (key == "volume_stiffness")
-            m.volume_stiffness = r.non_negative(v, full);
-    }
+    static const std::vector<Key<Material>> keys = {
+        key("density", &Material::density, &Reader::positive),
+        key("stiffness", &Material::stiffness, &Reader::positive),
+        key("young", &Material::young, &Reader::positive),
+        key("damping", &Material::damping, &Reader::non_negative),
+        key("volume_stiffness", &Material::volume_stiffness, &Reader::non_negative),
+    };
+    read_table(r, t, pre, keys, m);
 }
 
 ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string& pre, size_t index)
@@ -321,210 +368,200 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     const Reader r(source_name, base_dir);
     Scene s;
     s.source = source_name;
-    r.check_keys(root, "",
-                 {"dt", "steps", "substeps", "max_substeps", "integrator", "solver", "iterations", "tolerance",
-                  "sweep_tolerance", "acceleration", "gravity", "ground", "contact", "detector", "output", "object",
-                  "pin"});
-    for (auto&& [k, v] : root) {
-        const std::string key(k.str());
-        if (key == "dt")
-            s.dt = r.positive(v, key);
-        else if (key == "steps")
-            s.steps = r.int_at_least(v, key, 0);
-        else if (key == "substeps")
-            s.substeps = r.int_at_least(v, key, 1);
-        else if (key == "max_substeps")
-            s.max_substeps = r.int_at_least(v, key, 0);
-        else if (key == "iterations")
-            s.iterations = r.int_at_least(v, key, 0);
-        else if (key == "tolerance")
-            s.tolerance = r.positive(v, key);
-        else if (key == "acceleration")
-            s.acceleration = r.fraction_below_one(v, key);
-        else if (key == "sweep_tolerance")
-            s.sweep_tolerance = r.non_negative(v, key);
-        else if (key == "gravity")
-            s.gravity = r.vec3(v, key);
-        else if (key == "integrator") {
+    // Errors from the parameters' own grammar (integrator and solver names) name the key's line.
+    const auto named = [](auto parse, auto field) {
+        return [parse, field](const Reader& r, const toml::node& v, const std::string& k, Scene& out) {
             try {
-                s.integrator = parse_integrator(r.string(v, key));
+                out.*field = parse(r.string(v, k));
             } catch (const Error& e) {
-                r.fail(&v, key, e.what());
+                r.fail(&v, k, e.what());
             }
-        } else if (key == "solver") {
-            try {
-                s.solver = parse_linear_solver(r.string(v, key));
-            } catch (const Error& e) {
-                r.fail(&v, key, e.what());
-            }
-        } else if (key == "ground") {
-            const toml::table& t = r.table(v, key);
-            s.ground.enabled = true;
-            r.check_keys(t, "ground.", {"enabled", "height", "normal", "stiffness", "damping", "friction"});
-            for (auto&& [gk, gv] : t) {
-                const std::string g(gk.str()), full = "ground." + g;
-                if (g == "enabled")
-                    s.ground.enabled = r.boolean(gv, full);
-                else if (g == "height")
-                    s.ground.height = r.number(gv, full);
-                else if (g == "normal") {
-                    s.ground.normal = r.vec3(gv, full);
-                    if (!(s.ground.normal.norm() > 0)) r.fail(&gv, full, "must not be the zero vector");
-                    s.ground.normal.normalize();
-                } else if (g == "stiffness")
-                    s.ground.stiffness = r.non_negative(gv, full);
-                else if (g == "damping")
-                    s.ground.damping = r.non_negative(gv, full);
-                else if (g == "friction")
-                    s.ground.friction = r.non_negative(gv, full);
-            }
-        } else if (key == "contact") {
-            const toml::table& t = r.table(v, key);
-            r.check_keys(t, "contact.", {"stiffness", "damping", "friction", "in_matrix"});
-            for (auto&& [ck, cv] : t) {
-                const std::string c(ck.str()), full = "contact." + c;
-                if (c == "stiffness")
-                    s.contact.stiffness = r.non_negative(cv, full);
-                else if (c == "damping")
-                    s.contact.damping = r.non_negative(cv, full);
-                else if (c == "friction")
-                    s.contact.friction = r.non_negative(cv, full);
-                else if (c == "in_matrix")
-                    s.contact.in_matrix = r.boolean(cv, full);
-            }
-        } else if (key == "detector") {
-            const toml::table& t = r.table(v, key);
-            r.check_keys(t, "detector.",
-                         {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size",
-                          "looseness", "levels"});
-            for (auto&& [dk, dv] : t) {
-                const std::string d(dk.str()), full = "detector." + d;
-                // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
-                // a value means here what it means on the command line.
-                const toml::node& node = dv; // (a structured binding cannot be captured before C++20's P1091)
-                const auto grammar = [&r, &node, &full](auto&& parse) {
-                    try {
-                        parse(r.string(node, full));
-                    } catch (const Error& e) {
-                        r.fail(&node, full, e.what());
-                    }
-                };
-                if (d == "cell_size") {
-                    if (dv.is_number()) {
-                        s.detect.cell_size_mode = DetectParams::CellSizeMode::absolute;
-                        s.detect.cell_size = r.positive(dv, full);
-                    } else
-                        grammar([&](const std::string& text) { parse_cell_size(text, s.detect, full); });
-                } else if (d == "table_size") {
-                    if (dv.is_number()) {
-                        s.detect.table_size = r.integer_at_least(dv, full, 1);
-                        s.table_size_of_vertices.clear();
-                    } else
-                        grammar([&](const std::string& text) {
-                            // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
-                            s.detect.table_size = parse_table_size(text, 0, full);
-                            s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
-                        });
-                } else if (d == "hash") {
-                    try {
-                        s.detect.hash = parse_hash_function(r.string(dv, full));
-                    } catch (const Error& e) {
-                        r.fail(&dv, full, e.what());
-                    }
-                } else if (d == "threads") {
-                    const long long threads = r.int_at_least(dv, full, 0);
-                    try {
-                        s.detect.threads = check_threads(threads, full);
-                    } catch (const Error& e) {
-                        r.fail(&dv, full, e.what());
-                    }
-                } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
-                    if (dv.is_number()) {
-                        s.detect.skin_mode = DetectParams::SkinMode::absolute;
-                        s.detect.skin = r.non_negative(dv, full);
-                    } else
-                        grammar([&](const std::string& text) { parse_skin(text, s.detect, full); });
-                } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
-                    grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
-                } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
-                    PartitionParams& q = s.detect.partition;
-                    if (d == "looseness")
-                        q.looseness = r.positive(dv, full);
-                    else
-                        (d == "max_depth"   ? q.max_depth
-                         : d == "leaf_size" ? q.leaf_size
-                                            : q.levels) = static_cast<int>(r.int_at_least(dv, full, 1));
-                    try {
-                        Detector check(s.detect);
-                    } catch (const Error& e) {
-                        r.fail(&dv, full, e.what());
-                    }
-                }
-            }
-        } else if (key == "output") {
-            const toml::table& t = r.table(v, key);
-            r.check_keys(t, "output.", {"every", "fields"});
-            for (auto&& [ok, ov] : t) {
-                const std::string o(ok.str()), full = "output." + o;
-                if (o == "every")
-                    s.output.every = r.int_at_least(ov, full, 0);
-                else if (o == "fields") {
-                    const toml::array* a = ov.as_array();
-                    if (!a)
-                        r.fail(&ov, full, std::string("expected an array of strings, found ") + Reader::type_name(ov));
-                    s.output.fields.clear();
-                    for (const toml::node& e : *a) {
-                        const std::string f = r.string(e, full);
-                        if (f != "velocity" && f != "contact" && f != "depth" && f != "object")
-                            r.fail(&e, full, "unknown field '" + f + "' (velocity, contact, depth, object)");
-                        s.output.fields.push_back(f);
+        };
+    };
+    static const std::vector<Key<Ground>> ground_keys = {
+        key("enabled", &Ground::enabled, &Reader::boolean),
+        key("height", &Ground::height, &Reader::number),
+        {"normal",
+         [](const Reader& r, const toml::node& v, const std::string& k, Ground& g) {
+             g.normal = r.vec3(v, k);
+             if (!(g.normal.norm() > 0)) r.fail(&v, k, "must not be the zero vector");
+             g.normal.normalize();
+         }},
+        key("stiffness", &Ground::stiffness, &Reader::non_negative),
+        key("damping", &Ground::damping, &Reader::non_negative),
+        key("friction", &Ground::friction, &Reader::non_negative),
+    };
+    static const std::vector<Key<ContactParams>> contact_keys = {
+        key("stiffness", &ContactParams::stiffness, &Reader::non_negative),
+        key("damping", &ContactParams::damping, &Reader::non_negative),
+        key("friction", &ContactParams::friction, &Reader::non_negative),
+        key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
+    };
+    const std::vector<Key<Scene>> keys = {
+        key("dt", &Scene::dt, &Reader::positive),
+        int_key("steps", &Scene::steps, 0),
+        int_key("substeps", &Scene::substeps, 1),
+        int_key("max_substeps", &Scene::max_substeps, 0),
+        {"integrator", named(parse_integrator, &Scene::integrator)},
+        {"solver", named(parse_linear_solver, &Scene::solver)},
+        int_key("iterations", &Scene::iterations, 0),
+        key("tolerance", &Scene::tolerance, &Reader::positive),
+        key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
+        key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
+        key("gravity", &Scene::gravity, &Reader::vec3),
+    };
+    read_table(
+        r, root, "", keys, s, {"ground", "contact", "detector", "output", "object", "pin"},
+        [&](const std::string& key, const toml::node& v, const std::string&) {
+            if (key == "ground") {
+                s.ground.enabled = true;
+                read_table(r, r.table(v, key), "ground.", ground_keys, s.ground);
+            } else if (key == "contact") {
+                read_table(r, r.table(v, key), "contact.", contact_keys, s.contact);
+            } else if (key == "detector") {
+                const toml::table& t = r.table(v, key);
+                r.check_keys(t, "detector.",
+                             {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size",
+                              "looseness", "levels"});
+                for (auto&& [dk, dv] : t) {
+                    const std::string d(dk.str()), full = "detector." + d;
+                    // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
+                    // a value means here what it means on the command line.
+                    const toml::node& node = dv; // (a structured binding cannot be captured before C++20's P1091)
+                    const auto grammar = [&r, &node, &full](auto&& parse) {
+                        try {
+                            parse(r.string(node, full));
+                        } catch (const Error& e) {
+                            r.fail(&node, full, e.what());
+                        }
+                    };
+                    // A number (where a length or count is meant) is read by `number`, text by `parse`.
+                    const auto number_or_grammar = [&](auto&& number, auto&& parse) {
+                        if (node.is_number())
+                            number();
+                        else
+                            grammar(parse);
+                    };
+                    // The cell size and the skin: a number is an absolute length, text may give a factor instead.
+                    const auto length = [&](auto& mode, auto absolute, double& value,
+                                            double (Reader::*check)(const toml::node&, const std::string&) const,
+                                            void (*parse)(const std::string&, DetectParams&, const std::string&)) {
+                        number_or_grammar(
+                            [&] {
+                                mode = absolute;
+                                value = (r.*check)(node, full);
+                            },
+                            [&](const std::string& text) { parse(text, s.detect, full); });
+                    };
+                    if (d == "cell_size") {
+                        length(s.detect.cell_size_mode, DetectParams::CellSizeMode::absolute, s.detect.cell_size,
+                               &Reader::positive, parse_cell_size);
+                    } else if (d == "table_size") {
+                        number_or_grammar(
+                            [&] {
+                                s.detect.table_size = r.integer_at_least(node, full, 1);
+                                s.table_size_of_vertices.clear();
+                            },
+                            [&](const std::string& text) {
+                                // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
+                                s.detect.table_size = parse_table_size(text, 0, full);
+                                s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
+                            });
+                    } else if (d == "hash") {
+                        grammar([&](const std::string& text) { s.detect.hash = parse_hash_function(text); });
+                    } else if (d == "threads") {
+                        const long long threads = r.int_at_least(dv, full, 0);
+                        try {
+                            s.detect.threads = check_threads(threads, full);
+                        } catch (const Error& e) {
+                            r.fail(&dv, full, e.what());
+                        }
+                    } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
+                        length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin,
+                               &Reader::non_negative, parse_skin);
+                    } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
+                        grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
+                    } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
+                        PartitionParams& q = s.detect.partition;
+                        if (d == "looseness")
+                            q.looseness = r.positive(dv, full);
+                        else
+                            (d == "max_depth"   ? q.max_depth
+                             : d == "leaf_size" ? q.leaf_size
+                                                : q.levels) = static_cast<int>(r.int_at_least(dv, full, 1));
+                        try {
+                            Detector check(s.detect);
+                        } catch (const Error& e) {
+                            r.fail(&dv, full, e.what());
+                        }
                     }
                 }
-            }
-        } else if (key == "object" || key == "pin") {
-            const toml::array* a = v.as_array();
-            if (!a)
-                r.fail(&v, key,
-                       std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
-            for (size_t i = 0; i < a->size(); ++i) {
-                const toml::node& e = *a->get(i);
-                const std::string pre = key + "[" + std::to_string(i) + "].";
-                const toml::table& t = r.table(e, key + "[" + std::to_string(i) + "]");
-                if (key == "object") {
-                    s.objects.push_back(read_object(r, t, pre, i));
-                    continue;
-                }
-                PinRegion p;
-                r.check_keys(t, pre, {"object", "vertices", "box_min", "box_max"});
-                bool has_min = false, has_max = false;
-                for (auto&& [pk, pv] : t) {
-                    const std::string pkey(pk.str()), full = pre + pkey;
-                    if (pkey == "object")
-                        p.object = r.int_at_least(pv, full, 0);
-                    else if (pkey == "vertices") {
-                        const toml::array* va = pv.as_array();
-                        if (!va)
-                            r.fail(&pv, full,
-                                   std::string("expected an array of integers, found ") + Reader::type_name(pv));
-                        for (const toml::node& id : *va)
-                            p.vertices.push_back(r.int_at_least(id, full, 0));
-                    } else if (pkey == "box_min") {
-                        p.box_min = r.vec3(pv, full);
-                        has_min = true;
-                    } else if (pkey == "box_max") {
-                        p.box_max = r.vec3(pv, full);
-                        has_max = true;
+            } else if (key == "output") {
+                const toml::table& t = r.table(v, key);
+                r.check_keys(t, "output.", {"every", "fields"});
+                for (auto&& [ok, ov] : t) {
+                    const std::string o(ok.str()), full = "output." + o;
+                    if (o == "every")
+                        s.output.every = r.int_at_least(ov, full, 0);
+                    else if (o == "fields") {
+                        const toml::array* a = ov.as_array();
+                        if (!a)
+                            r.fail(&ov, full,
+                                   std::string("expected an array of strings, found ") + Reader::type_name(ov));
+                        s.output.fields.clear();
+                        for (const toml::node& e : *a) {
+                            const std::string f = r.string(e, full);
+                            if (f != "velocity" && f != "contact" && f != "depth" && f != "object")
+                                r.fail(&e, full, "unknown field '" + f + "' (velocity, contact, depth, object)");
+                            s.output.fields.push_back(f);
+                        }
                     }
                 }
-                if (has_min != has_max)
-                    r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
-                p.has_box = has_min;
-                if (!p.has_box && p.vertices.empty())
-                    r.fail(&e, key + "[" + std::to_string(i) + "]", "a pin needs 'vertices' or 'box_min'/'box_max'");
-                s.pins.push_back(std::move(p));
+            } else if (key == "object" || key == "pin") {
+                const toml::array* a = v.as_array();
+                if (!a)
+                    r.fail(&v, key,
+                           std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
+                for (size_t i = 0; i < a->size(); ++i) {
+                    const toml::node& e = *a->get(i);
+                    const std::string pre = key + "[" + std::to_string(i) + "].";
+                    const toml::table& t = r.table(e, key + "[" + std::to_string(i) + "]");
+                    if (key == "object") {
+                        s.objects.push_back(read_object(r, t, pre, i));
+                        continue;
+                    }
+                    PinRegion p;
+                    r.check_keys(t, pre, {"object", "vertices", "box_min", "box_max"});
+                    bool has_min = false, has_max = false;
+                    for (auto&& [pk, pv] : t) {
+                        const std::string pkey(pk.str()), full = pre + pkey;
+                        if (pkey == "object")
+                            p.object = r.int_at_least(pv, full, 0);
+                        else if (pkey == "vertices") {
+                            const toml::array* va = pv.as_array();
+                            if (!va)
+                                r.fail(&pv, full,
+                                       std::string("expected an array of integers, found ") + Reader::type_name(pv));
+                            for (const toml::node& id : *va)
+                                p.vertices.push_back(r.int_at_least(id, full, 0));
+                        } else if (pkey == "box_min") {
+                            p.box_min = r.vec3(pv, full);
+                            has_min = true;
+                        } else if (pkey == "box_max") {
+                            p.box_max = r.vec3(pv, full);
+                            has_max = true;
+                        }
+                    }
+                    if (has_min != has_max)
+                        r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
+                    p.has_box = has_min;
+                    if (!p.has_box && p.vertices.empty())
+                        r.fail(&e, key + "[" + std::to_string(i) + "]",
+                               "a pin needs 'vertices' or 'box_min'/'box_max'");
+                    s.pins.push_back(std::move(p));
+                }
             }
-        }
-    }
+        });
     for (size_t i = 0; i < s.pins.size(); ++i)
         if (s.pins[i].object >= static_cast<int>(s.objects.size()))
             throw Error(source_name + ": key 'pin[" + std::to_string(i) + "].object': object " +

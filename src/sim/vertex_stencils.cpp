@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -16,6 +17,21 @@
 
 namespace tethash::sim::detail {
 namespace {
+
+/// Lane l of a volume entry at vertex position (px, py, pz): W = (a − p) · N with N = (b − a) × (c − a), the
+/// opposite face's corners a, b, c read from x. Sets n to N.
+inline double volume_term(const TetLanes& t, int l, const double* x, double px, double py, double pz, double n[3])
+{
+    const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
+    const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
+    const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
+    const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
+    const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
+    n[0] = bay * caz - baz * cay;
+    n[1] = baz * cax - bax * caz;
+    n[2] = bax * cay - bay * cax;
+    return (a[0] - px) * n[0] + (a[1] - py) * n[1] + (a[2] - pz) * n[2];
+}
 
 void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLanes* tets, const double* x, double inv_h,
                    LaneTerms& out)
@@ -58,13 +74,9 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         const TetLanes& t = tets[s];
         for (int l = 0; l < 4; ++l) {
-            const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
-            const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
-            const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
-            const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-            const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-            const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-            const double w = (a[0] - xi[l]) * nx + (a[1] - yi[l]) * ny + (a[2] - zi[l]) * nz;
+            double n[3];
+            const double w = volume_term(t, l, x, xi[l], yi[l], zi[l], n);
+            const double nx = n[0], ny = n[1], nz = n[2];
             const double fs = t.k36[l] * ((w - t.w0[l]) + dh[l] * (w - t.wt[l]));
             f[0][l] += fs * nx;
             f[1][l] += fs * ny;
@@ -97,13 +109,8 @@ void start_scalar(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, cons
         TetLanes& t = tets[s];
         for (int l = 0; l < 4; ++l) {
             const double* xi = x + 4 * static_cast<std::size_t>(g.vertex[l]);
-            const double* a = x + 4 * static_cast<std::size_t>(t.a[l]);
-            const double* b = x + 4 * static_cast<std::size_t>(t.b[l]);
-            const double* c = x + 4 * static_cast<std::size_t>(t.c[l]);
-            const double bax = b[0] - a[0], bay = b[1] - a[1], baz = b[2] - a[2];
-            const double cax = c[0] - a[0], cay = c[1] - a[1], caz = c[2] - a[2];
-            const double nx = bay * caz - baz * cay, ny = baz * cax - bax * caz, nz = bax * cay - bay * cax;
-            t.wt[l] = (a[0] - xi[0]) * nx + (a[1] - xi[1]) * ny + (a[2] - xi[2]) * nz;
+            double n[3];
+            t.wt[l] = volume_term(t, l, x, xi[0], xi[1], xi[2], n);
         }
     }
 }
@@ -294,24 +301,38 @@ __attribute__((target("avx2,fma"))) int solve_avx2(const LaneTerms& t, double d[
 }
 #endif
 
+/// The kernels that go together, the scalar ones last (what an unknown gather is matched with).
+struct KernelSet {
+    GatherFn gather;
+    StartFn start;
+    SolveFn solve;
+    const char* name;
+};
+
+constexpr KernelSet k_kernel_sets[] = {
+#ifdef TETHASH_X86
+    {gather_avx2, start_avx2, solve_avx2, "avx2"},
+#endif
+    {gather_scalar, start_scalar, solve_scalar, "scalar"},
+};
+
+const KernelSet& kernels_of(GatherFn gather)
+{
+    for (const KernelSet& k : k_kernel_sets)
+        if (k.gather == gather) return k;
+    return k_kernel_sets[std::size(k_kernel_sets) - 1];
+}
+
 } // namespace
 
 SolveFn choose_solve(GatherFn gather)
 {
-#ifdef TETHASH_X86
-    if (gather == gather_avx2) return solve_avx2;
-#endif
-    (void)gather;
-    return solve_scalar;
+    return kernels_of(gather).solve;
 }
 
 StartFn choose_start(GatherFn gather)
 {
-#ifdef TETHASH_X86
-    if (gather == gather_avx2) return start_avx2;
-#endif
-    (void)gather;
-    return start_scalar;
+    return kernels_of(gather).start;
 }
 
 GatherFn choose_gather()
@@ -327,7 +348,7 @@ GatherFn choose_gather()
 
 const char* gather_kernel_name(GatherFn fn)
 {
-    return fn == gather_scalar ? "scalar" : "avx2";
+    return kernels_of(fn).name;
 }
 
 } // namespace tethash::sim::detail

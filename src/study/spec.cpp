@@ -3,46 +3,32 @@
 
 #include "value_list.hpp"
 
+#include "core/enum_names.hpp"
+
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 
 namespace tethash::study {
 
+namespace {
+constexpr tethash::detail::EnumName<Sweep> k_sweep_names[] = {
+    {Sweep::cell_size, "cell-size"}, {Sweep::table_size, "table-size"},
+    {Sweep::hash, "hash"},           {Sweep::threads, "threads"},
+    {Sweep::grid, "grid"},           {Sweep::integrator, "integrator"},
+    {Sweep::stability, "stability"}, {Sweep::method, "method"},
+};
+} // namespace
+
 Sweep parse_sweep(const std::string& name)
 {
-    if (name == "cell-size") return Sweep::cell_size;
-    if (name == "table-size") return Sweep::table_size;
-    if (name == "hash") return Sweep::hash;
-    if (name == "threads") return Sweep::threads;
-    if (name == "grid") return Sweep::grid;
-    if (name == "integrator") return Sweep::integrator;
-    if (name == "stability") return Sweep::stability;
-    if (name == "method") return Sweep::method;
+    if (const auto s = tethash::detail::value_named(k_sweep_names, name)) return *s;
     throw Error("sweep: unknown sweep '" + name +
                 "' (expected cell-size, table-size, hash, threads, grid, method, integrator or stability)");
 }
 
 const char* to_string(Sweep s)
 {
-    switch (s) {
-    case Sweep::cell_size:
-        return "cell-size";
-    case Sweep::table_size:
-        return "table-size";
-    case Sweep::hash:
-        return "hash";
-    case Sweep::threads:
-        return "threads";
-    case Sweep::grid:
-        return "grid";
-    case Sweep::integrator:
-        return "integrator";
-    case Sweep::stability:
-        return "stability";
-    case Sweep::method:
-        return "method";
-    }
-    return "?";
+    return tethash::detail::name_of(k_sweep_names, s);
 }
 
 void parse_shard(const std::string& spec, int& index, int& count)

@@ -23,6 +23,7 @@ enum StatUse : unsigned {
     in_study = 1,  ///< a column of the study's CSV (study.csv)
     in_detect = 2, ///< a key of `tethash detect --stats` JSON
     in_bench = 4,  ///< on tethash_bench's work line, as `bench_label`
+    everywhere = in_study | in_detect | in_bench,
 };
 
 struct StatField {
@@ -35,59 +36,48 @@ struct StatField {
     bool derived = false;    ///< computed from other fields, not a member of DetectStats
 };
 
+/// Member M of DetectStats as a double (StatField::get of the fields that are members).
+template <auto M> double member(const DetectStats& s)
+{
+    return static_cast<double>(s.*M);
+}
+
 /// Every field of DetectStats once (tests/test_study_stats_table.cpp checks it), plus derived ratios.
 /// Order: the parameters used, the scene, the work counters, the result and memory, candidate reuse, the timings.
 inline constexpr std::array<StatField, 28> k_detect_stats = {{
-    {"cell_size", "length", StatKind::real, [](const DetectStats& s) { return s.cell_size; },
-     in_study | in_detect | in_bench, "cell"},
-    {"table_size", "buckets", StatKind::count, [](const DetectStats& s) { return double(s.table_size); },
-     in_study | in_detect | in_bench, "table"},
-    {"threads", "", StatKind::count, [](const DetectStats& s) { return double(s.threads); }, in_study | in_detect,
-     nullptr},
-    {"vertices", "", StatKind::count, [](const DetectStats& s) { return double(s.vertices); }, in_study, nullptr},
-    {"tets", "", StatKind::count, [](const DetectStats& s) { return double(s.tets); }, in_study, nullptr},
-    {"cells_visited", "", StatKind::count, [](const DetectStats& s) { return double(s.cells_visited); },
-     in_study | in_detect | in_bench, "cells"},
-    {"entries_scanned", "", StatKind::count, [](const DetectStats& s) { return double(s.entries_scanned); },
-     in_study | in_detect | in_bench, "scanned"},
-    {"hash_collisions", "", StatKind::count, [](const DetectStats& s) { return double(s.hash_collisions); },
-     in_study | in_detect | in_bench, "collisions"},
+    {"cell_size", "length", StatKind::real, member<&DetectStats::cell_size>, everywhere, "cell"},
+    {"table_size", "buckets", StatKind::count, member<&DetectStats::table_size>, everywhere, "table"},
+    {"threads", "", StatKind::count, member<&DetectStats::threads>, in_study | in_detect, nullptr},
+    {"vertices", "", StatKind::count, member<&DetectStats::vertices>, in_study, nullptr},
+    {"tets", "", StatKind::count, member<&DetectStats::tets>, in_study, nullptr},
+    {"cells_visited", "", StatKind::count, member<&DetectStats::cells_visited>, everywhere, "cells"},
+    {"entries_scanned", "", StatKind::count, member<&DetectStats::entries_scanned>, everywhere, "scanned"},
+    {"hash_collisions", "", StatKind::count, member<&DetectStats::hash_collisions>, everywhere, "collisions"},
     {"collision_rate", "", StatKind::real,
      [](const DetectStats& s) {
          return s.entries_scanned ? static_cast<double>(s.hash_collisions) / static_cast<double>(s.entries_scanned)
                                   : 0.0;
      },
      in_study, nullptr, true},
-    {"box_rejections", "", StatKind::count, [](const DetectStats& s) { return double(s.box_rejections); },
-     in_study | in_detect | in_bench, "box-rejected"},
-    {"own_vertex_skips", "", StatKind::count, [](const DetectStats& s) { return double(s.own_vertex_skips); },
-     in_study | in_detect | in_bench, "own"},
-    {"candidates", "", StatKind::count, [](const DetectStats& s) { return double(s.candidates); }, in_study | in_detect,
-     nullptr},
-    {"nodes", "", StatKind::count, [](const DetectStats& s) { return double(s.nodes); }, in_study | in_detect, nullptr},
-    {"inside_tests", "", StatKind::count, [](const DetectStats& s) { return double(s.inside_tests); },
-     in_study | in_detect | in_bench, "inside tests"},
-    {"exact_fallbacks", "", StatKind::count, [](const DetectStats& s) { return double(s.exact_fallbacks); },
-     in_study | in_detect | in_bench, "exact"},
-    {"degenerate_tets", "", StatKind::count, [](const DetectStats& s) { return double(s.degenerate_tets); },
-     in_study | in_detect | in_bench, "degenerate"},
-    {"contacts", "", StatKind::count, [](const DetectStats& s) { return double(s.contacts); }, in_study, nullptr},
-    {"table_load", "", StatKind::real, [](const DetectStats& s) { return s.table_load; }, in_study | in_detect,
-     nullptr},
-    {"memory_bytes", "bytes", StatKind::count, [](const DetectStats& s) { return double(s.memory_bytes); },
-     in_study | in_detect, nullptr},
-    {"skin", "length", StatKind::real, [](const DetectStats& s) { return s.skin; }, in_detect, nullptr},
-    {"reused", "", StatKind::count, [](const DetectStats& s) { return double(s.reused); }, in_detect, nullptr},
-    {"cached_candidates", "", StatKind::count, [](const DetectStats& s) { return double(s.cached_candidates); },
-     in_detect, nullptr},
-    {"ms_total", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_total; }, in_study, nullptr},
-    {"ms_setup", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_setup; }, in_detect, nullptr},
-    {"ms_vertices", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_vertices; }, in_study | in_detect,
-     nullptr},
-    {"ms_tets", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_tets; }, in_study | in_detect, nullptr},
-    {"ms_inside", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_inside; }, in_study | in_detect,
-     nullptr},
-    {"ms_sort", "ms", StatKind::timing, [](const DetectStats& s) { return s.ms_sort; }, in_study | in_detect, nullptr},
+    {"box_rejections", "", StatKind::count, member<&DetectStats::box_rejections>, everywhere, "box-rejected"},
+    {"own_vertex_skips", "", StatKind::count, member<&DetectStats::own_vertex_skips>, everywhere, "own"},
+    {"candidates", "", StatKind::count, member<&DetectStats::candidates>, in_study | in_detect, nullptr},
+    {"nodes", "", StatKind::count, member<&DetectStats::nodes>, in_study | in_detect, nullptr},
+    {"inside_tests", "", StatKind::count, member<&DetectStats::inside_tests>, everywhere, "inside tests"},
+    {"exact_fallbacks", "", StatKind::count, member<&DetectStats::exact_fallbacks>, everywhere, "exact"},
+    {"degenerate_tets", "", StatKind::count, member<&DetectStats::degenerate_tets>, everywhere, "degenerate"},
+    {"contacts", "", StatKind::count, member<&DetectStats::contacts>, in_study, nullptr},
+    {"table_load", "", StatKind::real, member<&DetectStats::table_load>, in_study | in_detect, nullptr},
+    {"memory_bytes", "bytes", StatKind::count, member<&DetectStats::memory_bytes>, in_study | in_detect, nullptr},
+    {"skin", "length", StatKind::real, member<&DetectStats::skin>, in_detect, nullptr},
+    {"reused", "", StatKind::count, member<&DetectStats::reused>, in_detect, nullptr},
+    {"cached_candidates", "", StatKind::count, member<&DetectStats::cached_candidates>, in_detect, nullptr},
+    {"ms_total", "ms", StatKind::timing, member<&DetectStats::ms_total>, in_study, nullptr},
+    {"ms_setup", "ms", StatKind::timing, member<&DetectStats::ms_setup>, in_detect, nullptr},
+    {"ms_vertices", "ms", StatKind::timing, member<&DetectStats::ms_vertices>, in_study | in_detect, nullptr},
+    {"ms_tets", "ms", StatKind::timing, member<&DetectStats::ms_tets>, in_study | in_detect, nullptr},
+    {"ms_inside", "ms", StatKind::timing, member<&DetectStats::ms_inside>, in_study | in_detect, nullptr},
+    {"ms_sort", "ms", StatKind::timing, member<&DetectStats::ms_sort>, in_study | in_detect, nullptr},
 }};
 
 /// The value as CSV/table text: an integer for counts, up to 10 significant digits otherwise (table.hpp: fmt_double).
