@@ -140,6 +140,12 @@ TEST(SimScene, WrongTypesAndValuesNameKeyAndLine)
         {"[detector]\nthreads = 100000\n" + kObject, "detector.threads", "s.toml:2"},
         {"[detector]\ntable_size = \"x0\"\n" + kObject, "detector.table_size", "s.toml:2"},
         {"[detector]\nskin = \"x-1\"\n" + kObject, "detector.skin", "s.toml:2"},
+        {"[detector]\nmethod = \"octtree\"\n" + kObject, "detector.method", "s.toml:2"},
+        {"[detector]\nmethod = 3\n" + kObject, "detector.method", "s.toml:2"},
+        {"[detector]\nmax_depth = 99\n" + kObject, "detector.max_depth", "s.toml:2"},
+        {"[detector]\nmax_depth = 0\n" + kObject, "detector.max_depth", "s.toml:2"},
+        {"[detector]\nlooseness = 0.5\n" + kObject, "detector.looseness", "s.toml:2"},
+        {"[detector]\nlevels = 33\n" + kObject, "detector.levels", "s.toml:2"},
     };
     for (const Case& c : cases) {
         const std::string e = error_of(c.text);
@@ -174,6 +180,20 @@ TEST(SimScene, DetectorKeysUseTheCommandLineGrammar)
     EXPECT_EQ(s.detect.table_size, 0);
     EXPECT_TRUE(s.table_size_of_vertices.empty());
     EXPECT_EQ(s.detect.threads, 0);
+}
+
+TEST(SimScene, DetectorMethodKeys)
+{
+    // The broad phase and its parameters, in the grammar of `detect --method` (detect.hpp: parse_method).
+    Scene s = parse_scene(
+        "[detector]\nmethod = \"brute\"\nmax_depth = 7\nleaf_size = 3\nlooseness = 1.5\nlevels = 4\n" + kObject,
+        "s.toml", ".");
+    EXPECT_EQ(s.detect.method, Method::brute_force);
+    EXPECT_EQ(s.detect.partition.max_depth, 7);
+    EXPECT_EQ(s.detect.partition.leaf_size, 3);
+    EXPECT_DOUBLE_EQ(s.detect.partition.looseness, 1.5);
+    EXPECT_EQ(s.detect.partition.levels, 4);
+    EXPECT_EQ(parse_scene("[detector]\nmethod = \"auto\"\n" + kObject, "s.toml", ".").detect.method, Method::automatic);
 }
 
 TEST(SimScene, ShippedScenesAndDefaultParse)

@@ -138,6 +138,7 @@ def series_key(p, keys):
 
 
 def plot_detection(pts, meta, args, sweep):
+    pts = [p for p in pts if not p.get("error")]  # a method that could not run has no statistics
     scenes = by(pts, "scene")
     for scene, sp in scenes.items():
         tag = "" if len(scenes) == 1 else "_" + scene
@@ -397,6 +398,53 @@ def plot_integrator(pts, meta, args):
     finish(fig, meta, scene, "work_precision", args)
 
 
+def method_label(p):
+    """The method and the partition parameters it was given ("octree depth 8")."""
+    parts = [p["method"]]
+    for col, short in (("max_depth", "depth"), ("leaf_size", "leaf"), ("looseness", "loose"), ("levels", "levels")):
+        v = p.get(col, "")
+        if v not in ("", "default"):
+            parts.append("%s %s" % (short, v))
+    return " ".join(parts)
+
+
+def plot_methods(pts, meta, args):
+    """The method sweep: per scene, one bar per method (and parameters) for the median total time, the pairs the
+    exact test checked (the same for every method when the broad phases agree) and the working memory; methods that could not run are left out (their error is in
+    the CSV)."""
+    ran = [p for p in pts if not p.get("error")]
+    if not ran:
+        print("figures: no method ran (see the error column)")
+        return
+    scenes = list(dict.fromkeys(p["scene"] for p in ran))
+    labels = list(dict.fromkeys(method_label(p) for p in ran))
+    panels = (("ms_total", "time per detection (ms, median)"), ("inside_tests", "pairs tested (inside tests)"),
+              ("memory_bytes", "working memory (bytes)"))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(max(6.0, 0.9 + 0.16 * len(labels) * len(scenes)), 8.5),
+                             sharex=True)
+    width = 0.8 / max(1, len(labels))
+    cmap = plt.get_cmap("tab20")
+    for ax, (col, title) in zip(axes, panels):
+        ys = []
+        for k, lab in enumerate(labels):
+            xs, y = [], []
+            for i, sc in enumerate(scenes):
+                v = [num(p[col]) for p in ran if p["scene"] == sc and method_label(p) == lab]
+                if v:
+                    xs.append(i - 0.4 + width * (k + 0.5))
+                    y.append(v[0])
+            ax.bar(xs, positive(y), width=width, color=cmap(k % 20), label=lab if ax is axes[0] else None)
+            ys += y
+        ax.set_ylabel(title)
+        if spans_decades(ys, 10):
+            ax.set_yscale("log")
+    axes[-1].set_xticks(range(len(scenes)))
+    axes[-1].set_xticklabels(scenes, rotation=20, ha="right")
+    axes[0].legend(fontsize=6, ncol=min(5, len(labels)), loc="lower left", bbox_to_anchor=(0, 1.02))
+    fig.suptitle("Broad-phase methods side by side (threads %s)" % ",".join(sorted({p["threads"] for p in ran})))
+    finish(fig, meta, ", ".join(scenes), "methods", args)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("dir")
@@ -430,6 +478,8 @@ def main():
             plot_integrator(pts, meta, args)
         elif sweep == "stability":
             plot_stability(pts, meta, args)
+        elif sweep == "method":
+            plot_methods(pts, meta, args)
         else:
             plot_detection(pts, meta, args, sweep)
     except OSError as e:

@@ -15,7 +15,6 @@ std::string edge_text(Index a, Index b)
     return s;
 }
 
-
 /// In-plane orientation of (x, y, z) seen from the lift point w (off their plane).
 int orient2(const Vec3& x, const Vec3& y, const Vec3& z, const Vec3& w)
 {

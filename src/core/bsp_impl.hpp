@@ -69,11 +69,11 @@ bool triangles_meet_beyond_vertex(const Vec3& v, const Vec3& a, const Vec3& b, c
 namespace tethash {
 
 using bsp_detail::Fragment;
+using bsp_detail::Group;
 using bsp_detail::leaf_in;
 using bsp_detail::leaf_out;
-using bsp_detail::orient;
-using bsp_detail::Group;
 using bsp_detail::Node;
+using bsp_detail::orient;
 using bsp_detail::Vec3;
 
 class BspImpl {

@@ -420,7 +420,9 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                 read_table(r, r.table(v, key), "contact.", contact_keys, s.contact);
             } else if (key == "detector") {
                 const toml::table& t = r.table(v, key);
-                r.check_keys(t, "detector.", {"cell_size", "table_size", "hash", "threads", "skin"});
+                r.check_keys(t, "detector.",
+                             {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size",
+                              "looseness", "levels"});
                 for (auto&& [dk, dv] : t) {
                     const std::string d(dk.str()), full = "detector." + d;
                     // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
@@ -477,6 +479,21 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                     } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
                         length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin,
                                &Reader::non_negative, parse_skin);
+                    } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
+                        grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
+                    } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
+                        PartitionParams& q = s.detect.partition;
+                        if (d == "looseness")
+                            q.looseness = r.positive(dv, full);
+                        else
+                            (d == "max_depth"   ? q.max_depth
+                             : d == "leaf_size" ? q.leaf_size
+                                                : q.levels) = static_cast<int>(r.int_at_least(dv, full, 1));
+                        try {
+                            Detector check(s.detect);
+                        } catch (const Error& e) {
+                            r.fail(&dv, full, e.what());
+                        }
                     }
                 }
             } else if (key == "output") {

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <new>
 
 namespace tethash::study {
 
@@ -32,8 +33,10 @@ double elapsed_ms(std::int64_t start_ns)
 
 std::vector<std::string> detect_columns()
 {
-    std::vector<std::string> c = {"point",       "repeat",        "scene",      "sweep", "objects",
-                                  "cell_factor", "table_request", "table_kind", "hash",  "threads_request"};
+    std::vector<std::string> c = {"point",         "repeat",     "scene", "sweep",           "objects", "cell_factor",
+                                  "table_request", "table_kind", "hash",  "threads_request", "method"};
+    for (const auto& [name, option] : partition_columns())
+        c.push_back(name);
     for (const StatField& f : k_detect_stats)
         if ((f.use & in_study) && f.kind != StatKind::timing) c.emplace_back(f.name);
     for (const char* name :
@@ -43,6 +46,7 @@ std::vector<std::string> detect_columns()
         if ((f.use & in_study) && f.kind == StatKind::timing) c.emplace_back(f.name);
     c.emplace_back("ms_wall");
     c.emplace_back("ms_penetration");
+    c.emplace_back("error"); // a method that could not run (not built, refused its memory): its message
     return c;
 }
 
@@ -103,72 +107,100 @@ std::vector<Row> run_detect_point(StudyPlan& plan, std::int64_t index, const Run
     dp.table_size = p.table_size;
     dp.hash = p.hash;
     dp.threads = p.threads;
+    dp.method = p.method;
+    dp.partition = p.partition;
     Detector det(dp);
     det.set_topology(mesh);
-    for (int w = 0; w < o.warmup; ++w)
-        det.detect(mesh.positions);
+    Row head = {std::to_string(index),
+                "",
+                scene.name,
+                to_string(o.sweep),
+                std::to_string(mesh.num_objects()),
+                fmt_double(p.cell_factor),
+                p.table_request,
+                p.table_kind,
+                to_string(p.hash),
+                std::to_string(p.threads),
+                to_string(p.method)};
+    for (const std::string& v : p.partition_text)
+        head.push_back(v);
+    try {
+        for (int w = 0; w < o.warmup; ++w)
+            det.detect(mesh.positions);
 
-    // Penetration depth error (Heidelberger et al. 2004 against the exact distance), once per point.
-    PenetrationResult pen;
-    if (o.penetration) {
-        std::vector<Contact> contacts = det.detect(mesh.positions);
-        Penetration pn;
-        pn.set_topology(mesh);
-        PenetrationStats ps;
-        const auto t0 = now_ns();
-        pn.compute(mesh.positions, contacts, &ps);
-        pen.ms = elapsed_ms(t0);
-        const auto exact = pn.exact_depths(mesh.positions, contacts);
-        double sum = 0;
-        for (std::size_t i = 0; i < contacts.size(); ++i) {
-            const double e = std::abs(contacts[i].depth - exact[i]);
-            sum += e * e;
-            pen.err_max = std::max(pen.err_max, e);
-            pen.exact_max = std::max(pen.exact_max, exact[i]);
+        // Penetration depth error (Heidelberger et al. 2004 against the exact distance), once per point.
+        PenetrationResult pen;
+        if (o.penetration) {
+            std::vector<Contact> contacts = det.detect(mesh.positions);
+            Penetration pn;
+            pn.set_topology(mesh);
+            PenetrationStats ps;
+            const auto t0 = now_ns();
+            pn.compute(mesh.positions, contacts, &ps);
+            pen.ms = elapsed_ms(t0);
+            const auto exact = pn.exact_depths(mesh.positions, contacts);
+            double sum = 0;
+            for (std::size_t i = 0; i < contacts.size(); ++i) {
+                const double e = std::abs(contacts[i].depth - exact[i]);
+                sum += e * e;
+                pen.err_max = std::max(pen.err_max, e);
+                pen.exact_max = std::max(pen.exact_max, exact[i]);
+            }
+            pen.err_rms = contacts.empty() ? 0 : std::sqrt(sum / static_cast<double>(contacts.size()));
+            pen.pairs = ps.pairs;
+            pen.available = true;
         }
-        pen.err_rms = contacts.empty() ? 0 : std::sqrt(sum / static_cast<double>(contacts.size()));
-        pen.pairs = ps.pairs;
-        pen.available = true;
-    }
 
-    std::vector<Row> rows;
-    for (int r = 0; r < o.repeat; ++r) {
-        if (hooks.stop && hooks.stop->load()) break;
-        DetectStats st;
-        const auto t0 = now_ns();
-        const std::vector<Contact>& got = det.detect(mesh.positions, &st);
-        const double wall = elapsed_ms(t0);
-        std::string oc, missed, extra;
-        if (scene.oracle) {
-            const auto [m, x] = compare_contacts(got, *scene.oracle);
-            oc = std::to_string(scene.oracle->size());
-            missed = std::to_string(m);
-            extra = std::to_string(x);
+        std::vector<Row> rows;
+        for (int r = 0; r < o.repeat; ++r) {
+            if (hooks.stop && hooks.stop->load()) break;
+            DetectStats st;
+            const auto t0 = now_ns();
+            const std::vector<Contact>& got = det.detect(mesh.positions, &st);
+            const double wall = elapsed_ms(t0);
+            std::string oc, missed, extra;
+            if (scene.oracle) {
+                const auto [m, x] = compare_contacts(got, *scene.oracle);
+                oc = std::to_string(scene.oracle->size());
+                missed = std::to_string(m);
+                extra = std::to_string(x);
+            }
+            Row row = head;
+            row[1] = std::to_string(r);
+            for (const StatField& f : k_detect_stats)
+                if ((f.use & in_study) && f.kind != StatKind::timing) row.push_back(stat_text(f, st));
+            for (std::string v : {oc, missed, extra})
+                row.push_back(std::move(v));
+            row.push_back(pen.available ? std::to_string(pen.pairs) : "");
+            for (double v : {pen.err_rms, pen.err_max, pen.exact_max})
+                row.push_back(pen.available ? fmt_double(v) : "");
+            for (const StatField& f : k_detect_stats)
+                if ((f.use & in_study) && f.kind == StatKind::timing) row.push_back(stat_text(f, st));
+            row.push_back(fmt_double(wall));
+            row.push_back(pen.available ? fmt_double(pen.ms) : "");
+            row.emplace_back(); // no error
+            rows.push_back(std::move(row));
         }
-        Row row = {std::to_string(index),
-                   std::to_string(r),
-                   scene.name,
-                   to_string(o.sweep),
-                   std::to_string(mesh.num_objects()),
-                   fmt_double(p.cell_factor),
-                   p.table_request,
-                   p.table_kind,
-                   to_string(p.hash),
-                   std::to_string(p.threads)};
-        for (const StatField& f : k_detect_stats)
-            if ((f.use & in_study) && f.kind != StatKind::timing) row.push_back(stat_text(f, st));
-        for (std::string v : {oc, missed, extra})
-            row.push_back(std::move(v));
-        row.push_back(pen.available ? std::to_string(pen.pairs) : "");
-        for (double v : {pen.err_rms, pen.err_max, pen.exact_max})
-            row.push_back(pen.available ? fmt_double(v) : "");
-        for (const StatField& f : k_detect_stats)
-            if ((f.use & in_study) && f.kind == StatKind::timing) row.push_back(stat_text(f, st));
-        row.push_back(fmt_double(wall));
-        row.push_back(pen.available ? fmt_double(pen.ms) : "");
-        rows.push_back(std::move(row));
+        return rows;
+    } catch (const std::exception& e) { // Error, or bad_alloc: the method cannot run on this scene
+        const std::string what = dynamic_cast<const std::bad_alloc*>(&e) ? "out of memory" : e.what();
+        const std::string note = scene.name + " " + to_string(p.method) + ": " + what;
+        notes.push_back(note);
+        if (hooks.on_note) hooks.on_note(note);
+        std::vector<Row> rows;
+        for (int r = 0; r < o.repeat; ++r) {
+            Row row = head;
+            row[1] = std::to_string(r);
+            const std::vector<std::string> cols = detect_columns();
+            row.resize(cols.size());
+            row.back() = what;
+            for (std::size_t c = 0; c < cols.size(); ++c) // the scene's size, as the rows of the methods that ran
+                if (cols[c] == "vertices" || cols[c] == "tets")
+                    row[c] = std::to_string(cols[c] == "vertices" ? mesh.num_vertices() : mesh.num_tets());
+            rows.push_back(std::move(row));
+        }
+        return rows;
     }
-    return rows;
 }
 
 StudyResult run_study(StudyPlan& plan, const RunHooks& hooks)

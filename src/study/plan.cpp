@@ -8,6 +8,7 @@
 
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/study/methods.hpp"
 #include "tethash/study/scenarios.hpp"
 
 #include <algorithm>
@@ -56,6 +57,7 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
             name += fs::path(file).stem().string();
         }
         s.name = name;
+        s.kind = "mesh";
         scenes.push_back(std::move(s));
     }
     std::vector<int> which = o.scenarios;
@@ -71,8 +73,31 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
             s.source = "teschner scenario: " + std::to_string(sc.spec.objects) + " × generate " + sc.shape +
                        " resolution " + std::to_string(sc.resolution);
             s.mesh = std::move(sc.mesh);
+            s.kind = "teschner";
             scenes.push_back(std::move(s));
         }
+    }
+    std::vector<std::string> partition_names;
+    for (const auto& it :
+         o.partition_scenes.empty() ? std::vector<std::string>{} : items_of(o.partition_scenes, "--partition-scenes")) {
+        if (it == "all") {
+            for (const auto& n : partition_scene_names())
+                partition_names.push_back(n);
+        } else if (std::find(partition_scene_names().begin(), partition_scene_names().end(), it) ==
+                   partition_scene_names().end()) {
+            throw Error("--partition-scenes: unknown scene '" + it + "' (expected bars, sizes, corner, thin or all)");
+        } else {
+            partition_names.push_back(it);
+        }
+    }
+    for (const auto& n : partition_names) {
+        NamedScene ps = partition_scene(n);
+        SceneData s;
+        s.name = ps.name;
+        s.source = "partition scene: " + ps.description;
+        s.mesh = std::move(ps.mesh);
+        s.kind = "partition";
+        scenes.push_back(std::move(s));
     }
     for (auto& s : scenes) {
         if (s.mesh.num_tets() == 0) throw Error("--mesh: " + s.source + " has no tetrahedra");
@@ -190,7 +215,62 @@ std::vector<HashFunction> hash_choices(const std::vector<std::string>& specs)
     return out;
 }
 
+/// The methods of the study and, per partition parameter, its values ("default" or a number; checked).
+std::vector<Method> method_choices(const std::vector<std::string>& specs)
+{
+    std::vector<Method> out;
+    for (const auto& it : items_of(specs, "--methods"))
+        for (Method m : parse_method_list(it, "--methods"))
+            if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+    return out;
+}
+
+std::vector<std::string> partition_choices(const std::vector<std::string>& specs, const std::string& option)
+{
+    if (specs.empty()) return {"default"};
+    std::vector<std::string> out;
+    for (const auto& it : items_of(specs, option)) {
+        DetectParams p;
+        parse_partition_param(option, it, p); // throws naming the option and the text
+        out.push_back(it);
+    }
+    return out;
+}
+
+/// Every combination of the partition values that `m` reads (one empty combination for the others).
+std::vector<std::vector<std::string>> partition_combinations(Method m,
+                                                             const std::vector<std::vector<std::string>>& values)
+{
+    std::vector<std::vector<std::string>> combos = {{}};
+    const auto& cols = partition_columns();
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+        std::vector<std::vector<std::string>> next;
+        for (const auto& c : combos) {
+            if (!method_uses(m, cols[k].second)) {
+                next.push_back(c);
+                next.back().push_back("");
+                continue;
+            }
+            for (const auto& v : values[k]) {
+                next.push_back(c);
+                next.back().push_back(v);
+            }
+        }
+        combos = std::move(next);
+    }
+    return combos;
+}
+
 } // namespace
+
+const std::vector<std::pair<std::string, std::string>>& partition_columns()
+{
+    static const std::vector<std::pair<std::string, std::string>> c = {{"max_depth", "--max-depth"},
+                                                                       {"leaf_size", "--leaf-size"},
+                                                                       {"looseness", "--looseness"},
+                                                                       {"levels", "--levels"}};
+    return c;
+}
 
 void plan_detection_study(StudyPlan& plan)
 {
@@ -217,6 +297,9 @@ void plan_detection_study(StudyPlan& plan)
     const auto hash_specs = !o.hash.empty() ? o.hash
                             : swept("hash") ? std::vector<std::string>{"all"}
                                             : std::vector<std::string>{"default"};
+    const auto method_specs = !o.methods.empty() ? o.methods
+                              : swept("method")  ? std::vector<std::string>{"all"}
+                                                 : std::vector<std::string>{to_string(DetectParams{}.method)};
     const auto thread_specs = !o.threads.empty() ? o.threads
                               : swept("threads") ? std::vector<std::string>{"1:" + std::to_string(hw)}
                                                  : std::vector<std::string>{"1"};
@@ -225,11 +308,16 @@ void plan_detection_study(StudyPlan& plan)
     const auto cells = cell_choices(cell_specs);
     const auto hashes = hash_choices(hash_specs);
     const auto threads = thread_choices(thread_specs);
+    const auto methods = method_choices(method_specs);
+    const std::vector<std::vector<std::string>> partition_values = {
+        partition_choices(o.max_depth, "--max-depth"), partition_choices(o.leaf_size, "--leaf-size"),
+        partition_choices(o.looseness, "--looseness"), partition_choices(o.levels, "--levels")};
     (void)table_choices(table_specs, 0); // syntax and value checks
 
     plan.scenes = load_scenes(o);
     if (plan.scenes.empty())
-        throw Error("no scene: give --mesh FILE, --teschner-scenarios (or --scene FILE for the integrator sweep)");
+        throw Error("no scene: give --mesh FILE, --teschner-scenarios, --partition-scenes (or --scene FILE for the "
+                    "integrator sweep)");
 
     plan.columns = detect_columns();
     for (std::size_t s = 0; s < plan.scenes.size(); ++s) {
@@ -237,21 +325,33 @@ void plan_detection_study(StudyPlan& plan)
         for (const auto& t : tables)
             for (HashFunction h : hashes)
                 for (int th : threads)
-                    for (const CellChoice& cc : cells) {
-                        const double mean_edge = plan.scenes[s].mean_edge;
-                        const double c = cc.factor ? cc.value : cc.value / (mean_edge > 0 ? mean_edge : 1.0);
-                        DetectPoint p{s, c, t.size, t.kind, t.request, h, th};
-                        PointInfo info;
-                        info.index = static_cast<std::int64_t>(plan.points.size());
-                        info.scene = plan.scenes[s].name;
-                        info.params = {{"cell_factor", fmt_double(c)},
-                                       {"table_request", t.request},
-                                       {"table_size", t.size ? std::to_string(t.size) : "auto"},
-                                       {"hash", to_string(h)},
-                                       {"threads", std::to_string(th)}};
-                        plan.points.push_back(std::move(info));
-                        plan.detect_points.push_back(p);
-                    }
+                    for (const CellChoice& cc : cells)
+                        for (Method m : methods)
+                            for (const auto& combo : partition_combinations(m, partition_values)) {
+                                const double mean_edge = plan.scenes[s].mean_edge;
+                                const double c = cc.factor ? cc.value : cc.value / (mean_edge > 0 ? mean_edge : 1.0);
+                                DetectPoint p{s, c, t.size, t.kind, t.request, h, th, m, {}, combo};
+                                PointInfo info;
+                                info.index = static_cast<std::int64_t>(plan.points.size());
+                                info.scene = plan.scenes[s].name;
+                                info.params = {{"cell_factor", fmt_double(c)},
+                                               {"table_request", t.request},
+                                               {"table_size", t.size ? std::to_string(t.size) : "auto"},
+                                               {"hash", to_string(h)},
+                                               {"threads", std::to_string(th)},
+                                               {"method", to_string(m)}};
+                                const auto& cols = partition_columns();
+                                for (std::size_t k = 0; k < cols.size(); ++k) {
+                                    if (combo[k].empty()) continue;
+                                    DetectParams dp;
+                                    dp.partition = p.partition;
+                                    parse_partition_param(cols[k].second, combo[k], dp);
+                                    p.partition = dp.partition;
+                                    info.params.emplace_back(cols[k].first, combo[k]);
+                                }
+                                plan.points.push_back(std::move(info));
+                                plan.detect_points.push_back(p);
+                            }
     }
 }
 

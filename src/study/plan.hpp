@@ -14,6 +14,7 @@
 namespace tethash::study {
 
 struct SceneData {
+    std::string kind; ///< "mesh", "teschner" or "partition" (the space-partition comparison's scenes)
     std::string name;
     std::string source; ///< files or generator description
     TetMesh mesh;
@@ -29,7 +30,16 @@ struct DetectPoint {
     std::string table_request;   ///< the spec item it came from
     HashFunction hash = HashFunction::column;
     int threads = 1;
+    Method method = Method::hash;
+    PartitionParams partition;
+    /// The partition parameters as the CSV shows them ("max_depth", ... in partition_columns() order): the value,
+    /// "default", or "" where the method does not read it.
+    std::vector<std::string> partition_text;
 };
+
+/// The columns of the partition parameters and their options: max_depth --max-depth, leaf_size --leaf-size,
+/// looseness --looseness, levels --levels.
+const std::vector<std::pair<std::string, std::string>>& partition_columns();
 
 struct SimPlan; // sim_study.cpp
 struct SimPlanDeleter {

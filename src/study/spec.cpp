@@ -15,7 +15,7 @@ constexpr tethash::detail::EnumName<Sweep> k_sweep_names[] = {
     {Sweep::cell_size, "cell-size"}, {Sweep::table_size, "table-size"},
     {Sweep::hash, "hash"},           {Sweep::threads, "threads"},
     {Sweep::grid, "grid"},           {Sweep::integrator, "integrator"},
-    {Sweep::stability, "stability"},
+    {Sweep::stability, "stability"}, {Sweep::method, "method"},
 };
 } // namespace
 
@@ -23,7 +23,7 @@ Sweep parse_sweep(const std::string& name)
 {
     if (const auto s = tethash::detail::value_named(k_sweep_names, name)) return *s;
     throw Error("sweep: unknown sweep '" + name +
-                "' (expected cell-size, table-size, hash, threads, grid, integrator or stability)");
+                "' (expected cell-size, table-size, hash, threads, grid, method, integrator or stability)");
 }
 
 const char* to_string(Sweep s)

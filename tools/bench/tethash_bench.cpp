@@ -6,9 +6,12 @@
 //   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--no-baseline] [--cell-factor F]
 //                 [--hash column|teschner] [--table-factor F]
 //   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
+//   tethash_bench --methods hash,bvh,kd [--partition-scenes bars,sizes]: the other broad phases on every scene, in the
+//                 same run as the hash and the baseline (medians at 1 thread)
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/study/methods.hpp"
 #include "tethash/study/scenarios.hpp"
 #include "tethash/study/stats_table.hpp"
 
@@ -130,7 +133,7 @@ __attribute__((noinline)) std::size_t profile_detects(Detector& det, const TetMe
 /// One scene: tethash at 1 and all threads, its statistics, and the baseline. `table_factor` > 0: the table size
 /// is the power of two nearest to table_factor × vertices (0: automatic).
 void report(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat, bool baseline,
-            double table_factor)
+            double table_factor, const std::vector<Method>& methods)
 {
     DetectParams p1 = base;
     if (table_factor > 0) {
@@ -168,13 +171,34 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
         }
     std::printf(" memory %.1f B/tet\n", double(s.memory_bytes) / std::max(1, m.num_tets()));
     if (all.stats.contacts != one.stats.contacts) std::printf("  ERROR: contact counts differ between thread counts\n");
+    double baseline_cpu = 0;
     if (baseline) {
         std::size_t bc = 0;
-        double bcpu = 0;
-        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), bc, bcpu);
+        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), bc, baseline_cpu);
         std::printf("  baseline 2003  %8.3f ms (1 thread, cpu %.3f ms, %zu contacts)   ratio: %.1fx at 1 thread "
                     "(cpu %.1fx), %.1fx at %d threads\n",
-                    bms, bcpu, bc, bms / one.ms, bcpu / one.cpu_ms, bms / all.ms, all.stats.threads);
+                    bms, baseline_cpu, bc, bms / one.ms, baseline_cpu / one.cpu_ms, bms / all.ms, all.stats.threads);
+    }
+    // The other broad phases at 1 thread, same scene and parameters (DetectStats::candidates: the pairs handed to
+    // the exact test; nodes: cells, nodes or levels of the structure).
+    for (Method method : methods) {
+        DetectParams pm = p1;
+        pm.method = method;
+        try {
+            const Measured r = measure(m, pm, std::max(3, repeat / 3));
+            std::printf("  %-14s %8.3f ms (cpu %.3f)  %7.1f ns/tet  candidates %lld  nodes %lld  memory %.1f B/tet  "
+                        "contacts %lld%s",
+                        to_string(method), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / std::max(1, m.num_tets()),
+                        static_cast<long long>(r.stats.candidates), static_cast<long long>(r.stats.nodes),
+                        double(r.stats.memory_bytes) / std::max(1, m.num_tets()),
+                        static_cast<long long>(r.stats.contacts),
+                        r.stats.contacts == s.contacts ? "" : "  ERROR: contacts differ from the hash");
+            if (baseline) std::printf("  baseline/this %.2fx (cpu)", baseline_cpu / r.cpu_ms);
+            std::printf("\n");
+        } catch (const std::exception& e) {
+            std::printf("  %-14s error: %s\n", to_string(method), e.what());
+        }
+        std::fflush(stdout);
     }
     std::fflush(stdout);
 }
@@ -263,7 +287,7 @@ int main(int argc, char** argv)
     int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100;
     bool sweep = false, no_meshes = false, no_baseline = false, moving = false;
     double speed = 0.01, cell_factor = 1.0, table_factor = 0;
-    std::string hash = "column";
+    std::string hash = "column", methods_text, partition_scenes = "all";
     CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
                  "threads for the five scenarios of Teschner et al. 2003 and ../shared/meshes, against a plain "
                  "implementation of the 2003 algorithm"};
@@ -283,6 +307,12 @@ int main(int argc, char** argv)
     app.add_option("--cell-factor", cell_factor, "cell size as a factor of the mean edge length")
         ->capture_default_str();
     app.add_option("--hash", hash, "hash function: column or teschner")->capture_default_str();
+    app.add_option("--methods", methods_text,
+                   "other broad phases to measure on every scene at 1 thread (detect --method names, or all)");
+    app.add_option("--partition-scenes", partition_scenes,
+                   "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, all "
+                   "or none")
+        ->capture_default_str();
     app.add_flag("--moving", moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
     app.add_option("--steps", steps, "--moving: steps (at least 2)")->capture_default_str();
     app.add_option("--speed", speed, "--moving: fastest vertex per step, as a factor of the mean edge")
@@ -293,6 +323,31 @@ int main(int argc, char** argv)
         return app.exit(e) == 0 ? 0 : 2;
     }
     repeat = std::max(1, repeat);
+    std::vector<Method> methods;
+    std::vector<std::string> scene_names;
+    try {
+        if (!methods_text.empty()) methods = study::parse_method_list(methods_text, "--methods");
+        const auto& known = study::partition_scene_names();
+        if (partition_scenes == "all") {
+            scene_names = known;
+        } else if (partition_scenes != "none") {
+            std::string item;
+            for (std::size_t i = 0; i <= partition_scenes.size(); ++i) {
+                if (i < partition_scenes.size() && partition_scenes[i] != ',') {
+                    item += partition_scenes[i];
+                    continue;
+                }
+                if (std::find(known.begin(), known.end(), item) == known.end())
+                    throw Error("--partition-scenes: unknown scene '" + item +
+                                "' (expected bars, sizes, corner, thin, all or none)");
+                scene_names.push_back(item);
+                item.clear();
+            }
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "tethash_bench: error: %s\n", e.what());
+        return 2;
+    }
     steps = std::max(2, steps);
     const bool meshes = !no_meshes, baseline = !no_baseline;
 #ifdef _OPENMP
@@ -361,8 +416,16 @@ int main(int argc, char** argv)
         char name[96];
         std::snprintf(name, sizeof name, "scenario %d (%s r%d; paper %d/%d/%d)", k + 1, sc.shape.c_str(), sc.resolution,
                       sc.spec.objects, sc.spec.tets, sc.spec.vertices);
-        report(name, sc.mesh, base, threads_all, repeat, baseline, table_factor);
+        report(name, sc.mesh, base, threads_all, repeat, baseline, table_factor, methods);
     }
+    // Scenes unlike scenario 5 (study/scenarios.hpp: partition_scene): many objects each touching several at
+    // V/T 0.5, and the scenes where the hash is at its worst.
+    if (only < 0)
+        for (const std::string& n : scene_names) {
+            const study::NamedScene ps = study::partition_scene(n);
+            std::printf("%s: %s\n", n.c_str(), ps.description.c_str());
+            report(n.c_str(), ps.mesh, base, threads_all, std::max(3, repeat / 3), baseline, table_factor, methods);
+        }
     if (meshes && only < 0) {
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;
         if (std::filesystem::exists(dir)) {
@@ -384,7 +447,7 @@ int main(int argc, char** argv)
                     two.positions.rowwise() += 0.2 * (hi - lo);
                     one.append(two);
                     report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), baseline,
-                           table_factor);
+                           table_factor, methods);
                 } catch (const std::exception& e) {
                     std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
                 }

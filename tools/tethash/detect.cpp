@@ -1,5 +1,5 @@
-// tethash detect MESH... : one scene (each file an object), three-stage spatial-hash detection, summary,
-// optional contacts CSV and statistics JSON.
+// tethash detect MESH... : one scene (each file an object), collision detection by the spatial hash or another
+// broad phase (--method; --method all compares them), summary, optional contacts CSV and statistics JSON.
 #include "command.hpp"
 
 #include "tethash/bsp.hpp"
@@ -9,6 +9,7 @@
 #include "tethash/io/surface.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/study/json.hpp"
+#include "tethash/study/methods.hpp"
 #include "tethash/study/stats_table.hpp"
 
 #include <fmt/format.h>
@@ -32,7 +33,10 @@ struct DetectOptions {
     std::string skin = "0";
     std::string hash = "column";
     std::string threads = "0";
+    std::string method = to_string(DetectParams{}.method);
+    std::string max_depth = "default", leaf_size = "default", looseness = "default", levels = "default";
     int repeat = 1;
+    bool repeat_given = false; ///< --repeat given (else 1, or 3 with --method all)
     std::string contacts_path, stats_path;
     bool no_self = false;
     std::vector<int> static_objects;
@@ -153,6 +157,23 @@ void write_contacts_vtu(const std::string& path, const TetMesh& scene, std::vect
     io::write_mesh(path, scene, f);
 }
 
+/// `--method all`: every method on the scene, the comparison table and whether they agree (exit 1 if not).
+void compare_all_methods(const TetMesh& scene, Index nv, Index nt, Index num_objects, const std::vector<Index>& vobj,
+                         const std::vector<Index>& tobj, const std::vector<ObjectOptions>& objects,
+                         const DetectParams& params, int repeat)
+{
+    fmt::print("scene: {} objects, {} vertices, {} tets\n", num_objects, nv, nt);
+    fmt::print("every method, threads {}, time: median of {} calls after the first\n",
+               params.threads == 0 ? std::string("all") : std::to_string(params.threads), repeat);
+    std::fflush(stdout);
+    const auto runs =
+        study::compare_methods({scene.positions, scene.tets, vobj, tobj, objects}, params, all_methods(), repeat);
+    fmt::print("{}", study::method_table(runs));
+    const study::Agreement a = study::check_agreement(runs);
+    if (!a.same) throw RunFailure(a.message);
+    fmt::print("agreement: {}\n", a.message);
+}
+
 void run(const DetectOptions& o)
 {
     DetectParams params;
@@ -160,7 +181,18 @@ void run(const DetectOptions& o)
     parse_table_size(o.table_size, 0); // the syntax now; the value once the vertices are counted
     parse_skin(o.skin, params);
     params.hash = parse_hash_function(o.hash);
-    if (o.repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(o.repeat));
+    const bool side_by_side = o.method == "all"; // every method side by side
+    if (!side_by_side) params.method = parse_method(o.method, "--method");
+    for (const auto& [option, text] : {std::pair{"--max-depth", &o.max_depth}, std::pair{"--leaf-size", &o.leaf_size},
+                                       std::pair{"--looseness", &o.looseness}, std::pair{"--levels", &o.levels}})
+        study::parse_partition_param(option, *text, params);
+    const int repeat = o.repeat_given ? o.repeat : side_by_side ? 3 : 1;
+    if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
+    if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty()))
+        throw Error(std::string(!o.contacts_path.empty() ? "--contacts"
+                                : !o.stats_path.empty()  ? "--stats"
+                                                         : "--obstacle") +
+                    ": not with --method all, which prints the comparison table (give one --method NAME)");
     params.threads = set_threads(parse_threads(o.threads));
     check_objects_from_labels_value(o.objects_from_labels);
     // Output files are checked before the work, so that a typo does not cost a long run.
@@ -245,13 +277,17 @@ void run(const DetectOptions& o)
     }
 
     params.table_size = parse_table_size(o.table_size, nv);
+    if (side_by_side) {
+        compare_all_methods(scene, nv, nt, num_objects, vobj, tobj, objects, params, repeat);
+        return;
+    }
     Detector det(params);
     det.set_topology(scene.tets, nv, vobj, tobj, objects);
     // The first call does the one-off set-up (automatic cell size, static vertices) and warms caches: it is
     // reported apart, and the K timed calls follow it. The stages printed are those of the median call.
     DetectStats first;
     det.detect(scene.positions, &first);
-    std::vector<DetectStats> runs(static_cast<std::size_t>(o.repeat));
+    std::vector<DetectStats> runs(static_cast<std::size_t>(repeat));
     std::vector<double> ms;
     for (DetectStats& run : runs) {
         det.detect(scene.positions, &run);
@@ -273,12 +309,14 @@ void run(const DetectOptions& o)
                first.ms_total, first.ms_setup);
     fmt::print("time: {:.3f} ms per detection (median of {} after the first): vertices {:.3f}, tets {:.3f}, inside "
                "{:.3f}, sort {:.3f}, other {:.3f}\n",
-               median_ms, o.repeat, stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort,
+               median_ms, repeat, stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort,
                std::max(0.0, median_ms - stages));
     fmt::print("work: {} cells, {} entries scanned ({} hash collisions, {} box rejections, {} own vertices), "
                "{} inside tests, {} exact fallbacks, {} degenerate tets\n",
                stats.cells_visited, stats.entries_scanned, stats.hash_collisions, stats.box_rejections,
                stats.own_vertex_skips, stats.inside_tests, stats.exact_fallbacks, stats.degenerate_tets);
+    fmt::print("broad phase: {}, {} candidates, {} nodes, memory {}\n", to_string(params.method), stats.candidates,
+               stats.nodes, study::human_bytes(static_cast<double>(stats.memory_bytes)));
     fmt::print("contacts: {}\n", contacts.size());
     std::vector<ObstacleContact> inside;
     if (obstacles.size() > 0) {
@@ -321,7 +359,8 @@ void run(const DetectOptions& o)
             .member("contacts", contacts.size())
             .member("obstacle_contacts", inside.size())
             .member("hash", to_string(params.hash))
-            .member("repeat", o.repeat)
+            .member("method", to_string(params.method))
+            .member("repeat", repeat)
             .member("median_ms", median_ms)
             .member("first_call_ms", first.ms_total)
             .member("setup_ms", first.ms_setup);
@@ -354,9 +393,21 @@ Registrar reg{
          sub.add_option("--hash", o->hash, "Hash function: column or teschner")->capture_default_str();
          sub.add_option("--threads", o->threads, "Threads: 0 = every hardware thread, or 1..256")
              ->capture_default_str();
-         sub.add_option("--repeat", o->repeat,
-                        "Time K calls after the first (which does the set-up and is reported apart); report the "
-                        "median")
+         CLI::Option* repeat = sub.add_option("--repeat", o->repeat,
+                                              "Time K calls after the first (which does the set-up and is reported "
+                                              "apart); report the median (default 1; 3 with --method all)");
+         sub.add_option("--method", o->method,
+                        "Broad phase: hash, brute, grid, hgrid, octree, octree-point, octree-loose, kd, kd-point, bsp, "
+                        "bsp-balanced, sort-sweep, bvh, bvh-refit, auto; or all: every method side by side (a table "
+                        "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
+             ->capture_default_str();
+         sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..40 (default: the method's)")
+             ->capture_default_str();
+         sub.add_option("--leaf-size", o->leaf_size, "Trees: items a node holds before it splits, >= 1")
+             ->capture_default_str();
+         sub.add_option("--looseness", o->looseness, "Loose octree: cell enlargement factor, 1..16 (default 2)")
+             ->capture_default_str();
+         sub.add_option("--levels", o->levels, "Hierarchical grid: most levels, 1..32 (default: as the tet sizes span)")
              ->capture_default_str();
          sub.add_option("--contacts", o->contacts_path,
                         "Write the contacts: FILE.csv (scene ids, objects, each side's file and id in that file's "
@@ -375,7 +426,10 @@ Registrar reg{
              ->allow_extra_args(false);
          add_objects_from_labels_option(sub, o->objects_from_labels);
          add_linearize_option(sub, o->linearize);
-         sub.callback([o] { run(*o); });
+         sub.callback([o, repeat] {
+             o->repeat_given = repeat->count() > 0;
+             run(*o);
+         });
      }}};
 
 } // namespace

@@ -123,7 +123,7 @@ void progress(std::int64_t k, std::int64_t of, const study::PointInfo& p, bool q
 void run(Args& a)
 {
     if (a.positional.empty())
-        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, integrator, stability, "
+        throw Error("study: missing SWEEP (cell-size, table-size, hash, threads, grid, method, integrator, stability, "
                     "spheres) or merge");
     const std::string what = a.positional.front();
     if (what == "spheres") {
@@ -132,7 +132,19 @@ void run(Args& a)
         if (!a.no_plot) make_figures(a.spheres.o.out_dir, "plot_spheres.py");
         return;
     }
-    reject_spheres_options(a.spheres, what);
+    // The options the spheres study shares with the detection sweeps: the broad phases and the leaf size.
+    SpheresArgs spheres_only = a.spheres;
+    std::erase_if(spheres_only.options, [&](const CLI::Option* opt) {
+        const bool shared = opt->get_name() == "--methods" || opt->get_name() == "--leaf-size";
+        if (shared && opt->count() > 0) {
+            if (opt->get_name() == "--methods")
+                a.o.methods = a.spheres.o.methods;
+            else
+                a.o.leaf_size = {std::to_string(a.spheres.o.leaf_size)};
+        }
+        return shared;
+    });
+    reject_spheres_options(spheres_only, what);
     if (what == "merge") {
         std::vector<std::string> dirs(a.positional.begin() + 1, a.positional.end());
         if (dirs.empty()) throw Error("study merge: give the shard folders: tethash study merge DIR... --out DIR");
@@ -217,15 +229,14 @@ void run(Args& a)
 
 Registrar reg{
     {"study",
-     "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, or the "
-     "simulator's integrator x dt x substeps, or its stability matrix, or the spheres experiment of the octree / k-d / "
-     "BSP comparison; CSV, JSON and "
-     "figures",
+     "Parameter studies: sweeps of cell size, table size, hash, threads, a grid of two, the broad-phase method, or "
+     "the simulator's integrator x dt x substeps, or its stability matrix, or the spheres experiment of the octree / "
+     "k-d / BSP comparison; CSV, JSON and figures",
      [](CLI::App& sub) {
          auto a = std::make_shared<Args>();
-         sub.add_option(
-                "sweep", a->positional,
-                "cell-size | table-size | hash | threads | grid | integrator | stability | spheres, or: merge DIR...")
+         sub.add_option("sweep", a->positional,
+                        "cell-size | table-size | hash | threads | grid | method | integrator | stability | spheres, "
+                        "or: merge DIR...")
              ->required();
          sub.add_option("--mesh", a->o.meshes,
                         "tet mesh files, one scene each ('a.vtu+b.vtu' joins files into one scene)");
@@ -246,6 +257,15 @@ Registrar reg{
          sub.add_option("--threads", a->o.threads,
                         "thread counts: list or FROM:TO (0 = every hardware thread; default 1; threads sweep: "
                         "1..cores)");
+         sub.add_option(
+                "--partition-scenes", a->o.partition_scenes,
+                "scenes of the space-partition comparison: bars, sizes, corner, thin or all (hash at its worst; "
+                "many objects each touching several)")
+             ->delimiter(',');
+         // --methods and --leaf-size are shared with the spheres study (study_spheres.cpp registers them).
+         sub.add_option("--max-depth", a->o.max_depth, "trees: deepest levels, list (default: the method's)");
+         sub.add_option("--looseness", a->o.looseness, "loose octree: enlargement factors 1..16, list (default 2)");
+         sub.add_option("--levels", a->o.levels, "hierarchical grid: most levels, list (default: as sizes span)");
          sub.add_option("--grid", a->o.grid, "grid sweep: the two parameters (cell-size, table-size, hash, threads)")
              ->delimiter(',');
          sub.add_option("--from", a->from,

@@ -29,12 +29,15 @@ void add_spheres_options(CLI::App& sub, SpheresArgs& a)
         sub.add_option("--depths", o.depths, "spheres: maximum tree depths (default 3,7)")->delimiter(','),
         sub.add_option("--methods", o.methods,
                        "spheres: brute, octree, octree-point, kd, kd-point, bsp, bsp-balanced "
-                       "(default: all but bsp-balanced)")
+                       "(default: all but bsp-balanced); detection sweeps: broad phases (detect --method names, or "
+                       "all; default: all in the method sweep, else hash)")
             ->delimiter(','),
         sub.add_option("--radius", o.radius, "spheres: sphere radius (the box is the unit cube)")
             ->capture_default_str(),
         sub.add_option("--seed", o.seed, "spheres: seed of the drop positions")->capture_default_str(),
-        sub.add_option("--leaf-size", o.leaf_size, "spheres: nodes with at most this many spheres are leaves")
+        sub.add_option("--leaf-size", o.leaf_size,
+                       "spheres: nodes with at most this many spheres are leaves; detection sweeps: the trees' leaf "
+                       "size (one value; default: the method's)")
             ->capture_default_str(),
     };
 }

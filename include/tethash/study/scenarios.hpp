@@ -8,6 +8,8 @@
 
 #include "tethash/mesh.hpp"
 
+#include <Eigen/Core>
+
 #include <string>
 #include <vector>
 
@@ -39,5 +41,29 @@ struct Scenario {
 Scenario teschner_scenario(int index);
 /// All five.
 std::vector<Scenario> teschner_scenarios();
+
+/// Scenes of the space-partition comparison (`tethash study method --partition-scenes`, tethash_bench): where the
+/// spatial hash is at its worst, and many small objects each touching several. Objects are cut from cube lattices
+/// at six tets per cube (Kuhn's subdivision, positively oriented). Deterministic.
+///  - "bars": 100 bars of 1 × 2 × 42 cubes (50,400 tets, 25,800 vertices, V/T 0.51) in random directions, their
+///    centres in a box 30 long so that every bar crosses several others: unlike scenario 5, long thin objects.
+///  - "sizes": tet sizes spanning three decades: a 4³-cube object of edge 1 and, overlapping it, 3 of edge 0.1, 10
+///    of edge 0.01 and 60 of edge 0.001 (the mean edge, the hash's cell, is far below the big tets and far above
+///    the small ones).
+///  - "corner": 60 overlapping 4³-cube objects clustered in a corner (0.7 wide) of a domain 16 wide, whose far
+///    corner holds one more small object (the scene's box is mostly empty).
+///  - "thin": 12 objects of 2 × 20 × 20 cubes of 1 × 0.1 × 0.1 (tets ten times longer than wide), randomly rotated
+///    and packed so that neighbours overlap.
+struct NamedScene {
+    std::string name;
+    std::string description;
+    TetMesh mesh; ///< vertex_object / tet_object set
+};
+/// The names above, in that order.
+const std::vector<std::string>& partition_scene_names();
+/// The scene `name`; throws Error naming the list for an unknown name.
+NamedScene partition_scene(const std::string& name);
+/// An nx × ny × nz lattice of boxes of size h (corner at the origin), six tets per box: one object.
+TetMesh cube_lattice(int nx, int ny, int nz, const Eigen::Vector3d& h);
 
 } // namespace tethash::study

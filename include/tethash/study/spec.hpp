@@ -12,6 +12,9 @@
 ///    for each log-spaced value v, both the next power of two ≥ v and the next prime ≥ v. 0 is invalid.
 ///  - hash: names of detect.hpp's hash functions ("teschner,column") or "all".
 ///  - threads: counts ("1,2"; 0 = every hardware thread) or "FROM:TO" (every count in between).
+///  - methods: names of detect.hpp's broad phases ("hash,bvh,kd"; parse_method) or "all" (every one but auto).
+///  - max depth, leaf size, levels: counts ≥ 1 or "default"; looseness: factors 1..16 or "default". Each applies
+///    only to the methods that use it (the others are measured once, the column empty).
 ///  - integrator: names of the simulator's integrators or "all"; dt: seconds, list or log range
 ///    "FROM:TO:POINTS"; substeps: counts ≥ 1.
 
@@ -20,8 +23,9 @@
 
 namespace tethash::study {
 
-enum class Sweep { cell_size, table_size, hash, threads, grid, integrator, stability };
-/// "cell-size", "table-size", "hash", "threads", "grid", "integrator", "stability"; throws Error for anything else.
+enum class Sweep { cell_size, table_size, hash, threads, grid, integrator, stability, method };
+/// "cell-size", "table-size", "hash", "threads", "grid", "integrator", "stability", "method"; throws Error for
+/// anything else.
 Sweep parse_sweep(const std::string& name);
 const char* to_string(Sweep s);
 
@@ -40,6 +44,13 @@ struct StudyOptions {
     std::vector<std::string> hash;
     std::vector<std::string> threads;
     std::vector<std::string> grid; ///< for Sweep::grid: the two swept parameters (cell-size, table-size, hash, threads)
+    std::vector<std::string> methods;   ///< broad phases (default: hash; all when the method sweep)
+    std::vector<std::string> max_depth; ///< partition parameters (default: the method's)
+    std::vector<std::string> leaf_size;
+    std::vector<std::string> looseness;
+    std::vector<std::string> levels;
+    /// Scenes of the space-partition comparison (scenarios.hpp: partition_scene): names or "all".
+    std::vector<std::string> partition_scenes;
 
     std::vector<std::string> integrator; ///< simulator sweep
     std::vector<std::string> dt;

@@ -1,0 +1,58 @@
+// The scenes of the space-partition comparison (study/scenarios.hpp: partition_scene): their stated sizes and
+// properties, positively oriented tets, deterministic, an unknown name refused.
+#include "support.hpp"
+
+#include "tethash/error.hpp"
+#include "tethash/study/scenarios.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace tethash;
+using namespace tethash::study;
+
+TEST(StudyPartitionScenes, CubeLatticeHasSixPositiveTetsPerBox)
+{
+    const TetMesh m = cube_lattice(2, 3, 4, Eigen::Vector3d(1, 0.5, 0.25));
+    EXPECT_EQ(m.num_vertices(), 3 * 4 * 5);
+    EXPECT_EQ(m.num_tets(), 6 * 2 * 3 * 4);
+    const VolumeStats v = volume_stats(m.positions, m.tets);
+    EXPECT_GT(v.min, 0);
+    EXPECT_NEAR(v.total, 2 * 1.5 * 1.0, 1e-12); // the boxes are filled exactly
+}
+
+TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
+{
+    for (const std::string& name : partition_scene_names()) {
+        const NamedScene s = partition_scene(name);
+        EXPECT_FALSE(s.description.empty());
+        EXPECT_NO_THROW(s.mesh.check_consistency(name));
+        EXPECT_GT(volume_stats(s.mesh.positions, s.mesh.tets).min, 0) << name;
+        EXPECT_TRUE(partition_scene(name).mesh.positions.isApprox(s.mesh.positions)) << name << ": not deterministic";
+        const auto [lo, hi] = bounding_box(s.mesh.positions);
+        if (name == "bars") {
+            EXPECT_EQ(s.mesh.num_objects(), 100);
+            EXPECT_EQ(s.mesh.num_tets(), 50400);
+            EXPECT_EQ(s.mesh.num_vertices(), 25800); // V/T 0.51
+        } else if (name == "sizes") {
+            double shortest = 1e300, longest = 0;
+            for (Index t = 0; t < s.mesh.num_tets(); ++t) {
+                const double e =
+                    (s.mesh.positions.row(s.mesh.tets(t, 0)) - s.mesh.positions.row(s.mesh.tets(t, 3))).norm();
+                shortest = std::min(shortest, e);
+                longest = std::max(longest, e);
+            }
+            EXPECT_NEAR(longest / shortest, 1000, 1e-6); // three decades (each tet's main diagonal)
+        } else if (name == "corner") {
+            EXPECT_GT((hi - lo).minCoeff(), 15.0); // the domain
+            Index near = 0;                        // vertices in the corner 0.7 wide
+            for (Index v = 0; v < s.mesh.num_vertices(); ++v)
+                near += (s.mesh.positions.row(v).array() < 0.8).all();
+            EXPECT_EQ(near, 60 * 125);
+        } else if (name == "thin") {
+            EXPECT_EQ(s.mesh.num_objects(), 12);
+        }
+    }
+    EXPECT_THROW(partition_scene("nowhere"), Error);
+}
