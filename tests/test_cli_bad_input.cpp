@@ -96,7 +96,7 @@ TEST(CliBadInput, UsageErrorsAreOneLineNamingTheOption)
     EXPECT_EQ(help.status, 0);
     EXPECT_NE(help.out.find("Usage: tethash detect"), std::string::npos) << help.out;
     EXPECT_NE(help.out.find("--cell-size TEXT=auto"), std::string::npos) << help.out;
-    EXPECT_NE(help.out.find("--repeat INT=1"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("--method TEXT=hash"), std::string::npos) << help.out;
 }
 
 TEST(CliBadInput, InputThatIsMissingADirectoryOrEmpty)

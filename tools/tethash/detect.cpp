@@ -401,7 +401,7 @@ Registrar reg{
                         "bsp-balanced, sort-sweep, bvh, bvh-refit, auto; or all: every method side by side (a table "
                         "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
              ->capture_default_str();
-         sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..40 (default: the method's)")
+         sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..30 (default: the method's)")
              ->capture_default_str();
          sub.add_option("--leaf-size", o->leaf_size, "Trees: items a node holds before it splits, >= 1")
              ->capture_default_str();
