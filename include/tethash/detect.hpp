@@ -174,9 +174,8 @@ struct DetectStats {
     double skin = 0;                    ///< skin actually used (length; 0 = no candidate reuse, or paused)
     int reused = 0;                     ///< 1: stages 1-2 skipped, the kept candidates were tested (skin > 0)
     std::int64_t cached_candidates = 0; ///< candidates kept for reuse (skin > 0; 0 otherwise)
-    /// Candidate pairs handed to the exact stage: for the hash the vertices its scan kept (a tet's own vertices are
-    /// dropped by the scan), for the other methods every pair their broad phase found (own vertices included, the
-    /// exact stage skips them).
+    /// Candidate pairs handed to the exact stage: the vertices in a tet's box that are not its own (for the hash:
+    /// the vertices its scan kept).
     std::int64_t candidates = 0;
     std::int64_t nodes = 0; ///< other methods: cells, nodes or levels of the structure (0 for the hash)
 };

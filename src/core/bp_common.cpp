@@ -59,7 +59,7 @@ void VerticesByX::find(const PartitionScene& s, const Box& b, Index t, bool skip
         const Index v = order[static_cast<std::size_t>(i)];
         const double* p = s.positions + 3 * static_cast<std::size_t>(v);
         if (p[1] < b.lo[1] || p[1] > b.hi[1] || p[2] < b.lo[2] || p[2] > b.hi[2]) continue;
-        add_candidate(v, t, skip_static, vertex_static, out);
+        add_candidate(s, v, t, skip_static, vertex_static, out);
     }
 }
 

@@ -52,23 +52,31 @@ struct VerticesByX {
     std::int64_t memory_bytes() const;
 };
 
-/// Appends the candidate (v, t) unless both are static (`tet_static`: tet t's flag; `vertex_static`: per vertex, 1
-/// for static).
-inline void add_candidate(Index v, Index t, bool tet_static, const unsigned char* vertex_static,
-                          std::vector<CandidatePair>& out)
+/// Whether v is one of tet t's own four vertices: never a contact, so no broad phase hands it on (a tet box holds its
+/// own corners: left in, they would be most of the candidates).
+inline bool own_vertex(const PartitionScene& s, Index v, Index t)
 {
-    if (!(tet_static && vertex_static[v])) out.push_back({v, t});
+    const Index* tv = s.tets + 4 * static_cast<std::size_t>(t);
+    return v == tv[0] || v == tv[1] || v == tv[2] || v == tv[3];
+}
+
+/// Appends the candidate (v, t) unless both are static (`tet_static`: tet t's flag; `vertex_static`: per vertex, 1
+/// for static) or v is one of t's own vertices.
+inline void add_candidate(const PartitionScene& s, Index v, Index t, bool tet_static,
+                          const unsigned char* vertex_static, std::vector<CandidatePair>& out)
+{
+    if (!(tet_static && vertex_static[v]) && !own_vertex(s, v, t)) out.push_back({v, t});
 }
 
 /// Appends (v, items[k]) for each k in [first, last) whose box boxes[k] contains p, except static tets when
-/// `vertex_static`: a vertex against the tets of a leaf or cell.
+/// `vertex_static`, and the tets v belongs to: a vertex against the tets of a leaf or cell.
 inline void find_in_boxes(const PartitionScene& s, const double* p, Index v, bool vertex_static, const Index* items,
                           const Box* boxes, Index first, Index last, std::vector<CandidatePair>& out)
 {
     for (Index k = first; k < last; ++k) {
         if (!in_box(p, boxes[k].lo, boxes[k].hi)) continue;
         const Index t = items[k];
-        if (vertex_static && s.tet_static[t]) continue;
+        if ((vertex_static && s.tet_static[t]) || own_vertex(s, v, t)) continue;
         out.push_back({v, t});
     }
 }

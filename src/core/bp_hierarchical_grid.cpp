@@ -167,7 +167,7 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
                     const Entry& e = m_entries[static_cast<std::size_t>(i)];
                     if (e.level != k || e.cell[0] != q[0] || e.cell[1] != q[1] || e.cell[2] != q[2]) continue;
                     if (!in_box(p, e.box.lo, e.box.hi)) continue;
-                    if (vertex_static && s.tet_static[e.tet]) continue;
+                    if ((vertex_static && s.tet_static[e.tet]) || own_vertex(s, v, e.tet)) continue;
                     out.push_back({v, e.tet});
                 }
             }

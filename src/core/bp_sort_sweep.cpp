@@ -154,7 +154,7 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
                 const double* p = m_xyz.data() + 3 * static_cast<std::size_t>(j);
                 if (p[axis] > box.hi[axis]) break;
                 if (p[b] < box.lo[b] || p[b] > box.hi[b] || p[c] < box.lo[c] || p[c] > box.hi[c]) continue;
-                add_candidate(m_points[static_cast<std::size_t>(j)].id, t, tet_static, m_static.data(), out);
+                add_candidate(s, m_points[static_cast<std::size_t>(j)].id, t, tet_static, m_static.data(), out);
             }
         }
     });

@@ -55,7 +55,7 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
         m_tree.query(q, found, m_scratch[r]);
         const bool tet_static = s.tet_static[t] != 0;
         for (std::uint32_t v : found)
-            add_candidate(static_cast<Index>(v), t, tet_static, m_static.data(), out);
+            add_candidate(s, static_cast<Index>(v), t, tet_static, m_static.data(), out);
     });
     return timer.end_query();
 }

@@ -111,7 +111,7 @@ BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<Candidate
                 const Index last = m_start[column + static_cast<std::size_t>(c1[2]) + 1];
                 for (Index i = first; i < last; ++i) {
                     if (!in_box(m_xyz.data() + 3 * static_cast<std::size_t>(i), blo, bhi)) continue;
-                    add_candidate(m_ids[static_cast<std::size_t>(i)], t, tet_static, m_static.data(), out);
+                    add_candidate(s, m_ids[static_cast<std::size_t>(i)], t, tet_static, m_static.data(), out);
                 }
             }
     });

@@ -2,8 +2,8 @@
 // The broad phases other than the spatial hash (private header; docs/partitions.md). Each one finds candidate
 // (vertex, tet) pairs for the exact stage that every method shares (partition_detect.cpp): a candidate set that
 // contains every pair whose vertex lies in the tet's closed bounding box. The exact stage applies the object rules,
-// skips a tet's own vertices and degenerate tets, runs the closed inside test and sorts, so every method returns the
-// oracle's contacts bit for bit, whatever its structure and thread count.
+// skips degenerate tets (the broad phases leave out a tet's own vertices), runs the closed inside test and sorts, so
+// every method returns the oracle's contacts bit for bit, whatever its structure and thread count.
 #include "tethash/detect.hpp"
 
 #include <cstdint>
@@ -56,10 +56,11 @@ class BroadPhase {
   public:
     virtual ~BroadPhase() = default;
     /// Appends to sinks[r] (r < sinks.size() == scene.threads) every pair (v, t) with vertex v inside the closed
-    /// bounding box of tet t, except pairs where v and t both belong to static objects (those may be left out).
-    /// More pairs are allowed (the exact stage rejects them), but each pair at most once over all sinks. May open
-    /// its own parallel region of scene.threads threads; must not depend on the thread count for which pairs it
-    /// emits. Throws Error when the structure cannot be built (naming why, e.g. the dense grid's memory).
+    /// bounding box of tet t, except a tet's own four vertices (never handed on: bp_common.hpp's own_vertex) and
+    /// pairs where v and t both belong to static objects (those may be left out). More pairs are allowed (the exact
+    /// stage rejects them), but each pair at most once over all sinks. May open its own parallel region of
+    /// scene.threads threads; must not depend on the thread count for which pairs it emits. Throws Error when the
+    /// structure cannot be built (naming why, e.g. the dense grid's memory).
     virtual BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) = 0;
     /// Working memory of the structure in bytes (not counting the sinks).
     virtual std::int64_t memory_bytes() const = 0;

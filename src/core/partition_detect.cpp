@@ -1,4 +1,4 @@
-// The exact stage every broad phase other than the hash feeds (docs/partitions.md): object rules, own vertices,
+// The exact stage every broad phase other than the hash feeds (docs/partitions.md): object rules,
 // the closed exact inside test (predicates.hpp, the oracle's), then one sort by (vertex, tet). Which thread found a
 // pair and in which order does not matter: the barycentric coordinates depend on the point and the tet only, and the
 // sort fixes the order, so the output is bit for bit the same for every method and thread count.
@@ -9,6 +9,7 @@
 #include "timing.hpp"
 
 #include <algorithm>
+#include <cassert>
 
 namespace tethash::detail {
 
@@ -58,7 +59,8 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
         Counts& counts = m_counts[static_cast<std::size_t>(r)];
         for (const CandidatePair& c : m_sinks[static_cast<std::size_t>(r)].pairs) {
             const Index* tv = scene.tets + 4 * static_cast<std::size_t>(c.tet);
-            if (c.vertex == tv[0] || c.vertex == tv[1] || c.vertex == tv[2] || c.vertex == tv[3]) continue;
+            // A tet's own vertices are left out by the broad phases (broad_phase.hpp).
+            assert(c.vertex != tv[0] && c.vertex != tv[1] && c.vertex != tv[2] && c.vertex != tv[3]);
             const Index vo = vertex_object[c.vertex], to = tet_object[c.tet];
             if (vo == to && !flags.self_collision[static_cast<std::size_t>(to)]) continue;
             if (flags.is_static[static_cast<std::size_t>(to)] && flags.is_static[static_cast<std::size_t>(vo)])
