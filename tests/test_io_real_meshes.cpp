@@ -65,6 +65,8 @@ void check_mesh(const std::string& name)
     std::fill(tobj.begin() + m, tobj.end(), 1);
     const std::vector<Contact> want = brute_force_contacts(p, t, vobj, tobj);
     EXPECT_FALSE(want.empty());
+    // The hash with three parameter sets, then every other broad phase (2 threads): the oracle's contacts.
+    std::vector<DetectParams> variants;
     for (int variant = 0; variant < 3; ++variant) {
         DetectParams params;
         params.threads = 1 + variant % 2;
@@ -72,13 +74,24 @@ void check_mesh(const std::string& name)
         params.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
         params.cell_size = variant == 2 ? 0.4 : 1.3;
         params.table_size = variant == 2 ? 1009 : 0;
+        variants.push_back(params);
+    }
+    for (Method method : all_methods()) {
+        if (method == Method::hash) continue;
+        DetectParams params;
+        params.method = method;
+        params.threads = 2;
+        variants.push_back(params);
+    }
+    for (const DetectParams& params : variants) {
         Detector det(params);
         det.set_topology(t, 2 * n, vobj, tobj);
         const std::vector<Contact>& got = det.detect(p);
-        ASSERT_EQ(got.size(), want.size()) << name << " variant " << variant;
+        const std::string what = name + " method " + to_string(params.method);
+        ASSERT_EQ(got.size(), want.size()) << what;
         for (std::size_t i = 0; i < got.size(); ++i) {
-            ASSERT_EQ(got[i].vertex, want[i].vertex) << name << " contact " << i;
-            ASSERT_EQ(got[i].tet, want[i].tet) << name << " contact " << i;
+            ASSERT_EQ(got[i].vertex, want[i].vertex) << what << " contact " << i;
+            ASSERT_EQ(got[i].tet, want[i].tet) << what << " contact " << i;
         }
     }
 }
