@@ -6,15 +6,14 @@ namespace tethash::detail {
 
 namespace {
 
-class BruteForce final : public BroadPhase {
+class BruteForce final : public BroadPhaseBase {
   public:
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override { return m_sorted.memory_bytes() + bytes_of(m_static); }
-    std::int64_t nodes() const override { return 0; }
 
   private:
+    std::int64_t structure_bytes() const override { return m_sorted.memory_bytes(); }
+
     VerticesByX m_sorted;
-    std::vector<unsigned char> m_static;
 };
 
 BroadPhaseTimes BruteForce::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)

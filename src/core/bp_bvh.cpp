@@ -20,15 +20,10 @@ namespace tethash::detail {
 
 namespace {
 
-class Bvh final : public BroadPhase {
+class Bvh final : public BroadPhaseBase {
   public:
     explicit Bvh(bool refit) : m_refit(refit) {}
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override
-    {
-        return bytes_of(m_nodes) + bytes_of(m_items) + bytes_of(m_boxes) + bytes_of(m_item_boxes) +
-               bytes_of(m_centroids) + bytes_of(m_static);
-    }
     std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
 
     static constexpr int default_leaf_size = 4;
@@ -52,6 +47,10 @@ class Bvh final : public BroadPhase {
     void build(const PartitionScene& s);
     Index build_node(Index begin, Index end, int depth);
     void refit();
+    std::int64_t structure_bytes() const override
+    {
+        return bytes_of(m_nodes, m_items, m_boxes, m_item_boxes, m_centroids);
+    }
 
     bool m_refit;
     int m_leaf_size = default_leaf_size, m_max_depth = default_max_depth;
@@ -62,7 +61,6 @@ class Bvh final : public BroadPhase {
     std::vector<Box> m_boxes;        // per tet
     std::vector<Box> m_item_boxes;   // per item (leaf order)
     std::vector<double> m_centroids; // per tet (3), during the build
-    std::vector<unsigned char> m_static;
 };
 
 constexpr int bins = 16;

@@ -130,10 +130,23 @@ class PhaseTimer {
     BroadPhaseTimes m_times;
 };
 
-/// Capacity of a vector in bytes.
-template <class T> std::int64_t bytes_of(const std::vector<T>& v)
+/// Capacities of vectors in bytes, summed.
+template <class... T> std::int64_t bytes_of(const std::vector<T>&... v)
 {
-    return static_cast<std::int64_t>(v.capacity() * sizeof(T));
+    return (std::int64_t{0} + ... + static_cast<std::int64_t>(v.capacity() * sizeof(T)));
 }
+
+/// What every broad phase keeps besides its structure: the per-vertex static flags of the last call (filled by
+/// static_vertex_flags at the end of the build), counted by memory_bytes() with the structure's own bytes.
+class BroadPhaseBase : public BroadPhase {
+  public:
+    std::int64_t memory_bytes() const final { return structure_bytes() + bytes_of(m_static); }
+
+  protected:
+    /// Working memory of the structure itself.
+    virtual std::int64_t structure_bytes() const = 0;
+
+    std::vector<unsigned char> m_static; ///< per vertex: 1 for the vertices of static objects
+};
 
 } // namespace tethash::detail

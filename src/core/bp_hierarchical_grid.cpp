@@ -22,14 +22,9 @@ namespace tethash::detail {
 
 namespace {
 
-class HierarchicalGrid final : public BroadPhase {
+class HierarchicalGrid final : public BroadPhaseBase {
   public:
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override
-    {
-        return bytes_of(m_boxes) + bytes_of(m_level) + bytes_of(m_bucket) + bytes_of(m_start) + bytes_of(m_entries) +
-               bytes_of(m_cell) + bytes_of(m_big) + m_sorted.memory_bytes() + bytes_of(m_static);
-    }
     /// Occupied levels (plus one when some tets exceed the top level).
     std::int64_t nodes() const override { return m_nodes; }
 
@@ -43,6 +38,11 @@ class HierarchicalGrid final : public BroadPhase {
         Index tet;
         std::int32_t level;
     };
+    std::int64_t structure_bytes() const override
+    {
+        return bytes_of(m_boxes, m_level, m_bucket, m_start, m_entries, m_cell, m_big) + m_sorted.memory_bytes();
+    }
+
     std::int64_t m_nodes = 0;
     std::vector<Box> m_boxes;
     std::vector<std::int32_t> m_level;   // per tet: its level, or -1 when it exceeds the top level
@@ -52,7 +52,6 @@ class HierarchicalGrid final : public BroadPhase {
     std::vector<Entry> m_entries;        // by bucket
     std::vector<Index> m_big;            // tets exceeding the top level
     VerticesByX m_sorted;                // with tets beyond the top level: the vertices by x
-    std::vector<unsigned char> m_static;
 };
 
 std::uint64_t cell_hash(std::int32_t level, const std::int64_t c[3])

@@ -19,14 +19,9 @@ namespace tethash::detail {
 
 namespace {
 
-class LooseOctree final : public BroadPhase {
+class LooseOctree final : public BroadPhaseBase {
   public:
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override
-    {
-        return bytes_of(m_nodes) + bytes_of(m_boxes) + bytes_of(m_node_of) + bytes_of(m_items) +
-               bytes_of(m_item_boxes) + bytes_of(m_static);
-    }
     std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
 
     static constexpr int default_max_depth = 10;
@@ -42,13 +37,16 @@ class LooseOctree final : public BroadPhase {
     };
     /// Appends the 8 children of node i.
     void split(Index i, double looseness);
+    std::int64_t structure_bytes() const override
+    {
+        return bytes_of(m_nodes, m_boxes, m_node_of, m_items, m_item_boxes);
+    }
 
     std::vector<Node> m_nodes;
     std::vector<Box> m_boxes;      // per tet
     std::vector<Index> m_node_of;  // per tet: its node
     std::vector<Index> m_items;    // tets by node
     std::vector<Box> m_item_boxes; // their boxes
-    std::vector<unsigned char> m_static;
 };
 
 bool contains(const Box& outer, const Box& inner)

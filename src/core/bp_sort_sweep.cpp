@@ -17,14 +17,9 @@ namespace tethash::detail {
 
 namespace {
 
-class SortSweep final : public BroadPhase {
+class SortSweep final : public BroadPhaseBase {
   public:
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override
-    {
-        return bytes_of(m_points) + bytes_of(m_tets) + bytes_of(m_boxes) + bytes_of(m_xyz) + bytes_of(m_static);
-    }
-    std::int64_t nodes() const override { return 0; }
 
     /// Calls whose orders were repaired by insertion sort, and calls that sorted from scratch (first call, new
     /// axis, or an insertion sort that exceeded its budget of moves).
@@ -35,13 +30,14 @@ class SortSweep final : public BroadPhase {
         double x;
         Index id;
     };
+    std::int64_t structure_bytes() const override { return bytes_of(m_points, m_tets, m_boxes, m_xyz); }
+
     int m_axis = -1;
     std::int64_t m_incremental = 0, m_full = 0;
     std::vector<Key> m_points; // vertices by their coordinate on the axis
     std::vector<Key> m_tets;   // tets by their box's low end on the axis
     std::vector<Box> m_boxes;
     std::vector<double> m_xyz; // the vertices' positions in the sorted order
-    std::vector<unsigned char> m_static;
 };
 
 bool key_less(double xa, Index a, double xb, Index b)

@@ -7,18 +7,18 @@ namespace tethash::detail {
 
 namespace {
 
-class SplitTreeBroadPhase final : public BroadPhase {
+class SplitTreeBroadPhase final : public BroadPhaseBase {
   public:
     explicit SplitTreeBroadPhase(SplitRule rule) : m_rule(rule) {}
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override;
     std::int64_t nodes() const override { return m_nodes; }
 
   private:
+    std::int64_t structure_bytes() const override;
+
     SplitRule m_rule;
     SplitTree m_tree;
     std::vector<SplitBox> m_points;                  // per vertex: its position as a box
-    std::vector<unsigned char> m_static;             // per vertex: 1 for static objects
     std::vector<std::vector<std::uint32_t>> m_found; // per thread: query output
     std::vector<SplitTreeScratch> m_scratch;         // per thread
     std::int64_t m_nodes = 0;
@@ -60,9 +60,9 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
     return timer.end_query();
 }
 
-std::int64_t SplitTreeBroadPhase::memory_bytes() const
+std::int64_t SplitTreeBroadPhase::structure_bytes() const
 {
-    std::int64_t m = m_tree.stats().bytes + bytes_of(m_points) + bytes_of(m_static);
+    std::int64_t m = m_tree.stats().bytes + bytes_of(m_points);
     for (const auto& f : m_found)
         m += bytes_of(f);
     for (const SplitTreeScratch& sc : m_scratch)

@@ -17,27 +17,24 @@ namespace tethash::detail {
 
 namespace {
 
-class UniformGrid final : public BroadPhase {
+class UniformGrid final : public BroadPhaseBase {
   public:
     /// Throws Error when the grid would need more than max_cells cells or max_bytes bytes.
     BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-    std::int64_t memory_bytes() const override
-    {
-        return bytes_of(m_start) + bytes_of(m_ids) + bytes_of(m_xyz) + bytes_of(m_cell) + bytes_of(m_static);
-    }
     std::int64_t nodes() const override { return m_cells; }
 
     static constexpr std::int64_t max_cells = std::int64_t{1} << 28;
     static constexpr std::int64_t max_bytes = std::int64_t{1} << 31;
 
   private:
+    std::int64_t structure_bytes() const override { return bytes_of(m_start, m_ids, m_xyz, m_cell); }
+
     std::int64_t m_cells = 0;
     std::int64_t m_dims[3] = {0, 0, 0};
     std::vector<Index> m_start;       // cells + 1: the vertices of cell c are m_ids[m_start[c], m_start[c + 1])
     std::vector<Index> m_ids;         // vertices by cell (z fastest, then y, then x)
     std::vector<double> m_xyz;        // their positions in that order (3 per vertex)
     std::vector<std::int32_t> m_cell; // per vertex: its cell
-    std::vector<unsigned char> m_static;
 };
 
 BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)

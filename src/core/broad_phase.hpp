@@ -64,8 +64,9 @@ class BroadPhase {
     virtual BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) = 0;
     /// Working memory of the structure in bytes (not counting the sinks).
     virtual std::int64_t memory_bytes() const = 0;
-    /// Cells, nodes or levels of the structure after the last call (what `DetectStats::nodes` reports).
-    virtual std::int64_t nodes() const = 0;
+    /// Cells, nodes or levels of the structure after the last call (what `DetectStats::nodes` reports; zero for the
+    /// methods without any).
+    virtual std::int64_t nodes() const { return 0; }
     /// Builds and updates so far (the refitted BVH's builds and refits, sort and sweep's full and repaired sorts).
     virtual BroadPhaseCounts counts() const { return {}; }
 };
