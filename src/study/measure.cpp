@@ -101,14 +101,13 @@ std::vector<Row> run_detect_point(StudyPlan& plan, std::int64_t index, const Run
         if (hooks.on_note) hooks.on_note(note);
     }
 
-    DetectParams dp;
-    dp.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
-    dp.cell_size = p.cell_factor;
-    dp.table_size = p.table_size;
-    dp.hash = p.hash;
-    dp.threads = p.threads;
-    dp.method = p.method;
-    dp.partition = p.partition;
+    const DetectParams dp{.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge,
+                          .cell_size = p.cell_factor,
+                          .table_size = p.table_size,
+                          .hash = p.hash,
+                          .threads = p.threads,
+                          .method = p.method,
+                          .partition = p.partition};
     Detector det(dp);
     det.set_topology(mesh);
     Row head = {std::to_string(index),
