@@ -306,13 +306,15 @@ void BlockDescent::gather_contacts()
 {
     const ContactResponse& cr = m_ctx.contacts;
     const Model& model = m_ctx.model;
-    const std::vector<Contact>& contacts = cr.contacts();
+    const std::vector<Contact>& contacts = cr.active();
     m_contacts.clear();
     const size_t un = model.mass.size();
     m_vc_start.assign(un + 1, 0);
     for (size_t q = 0; q < contacts.size(); ++q) {
         const Contact& c = contacts[q];
-        if (!(c.depth > 0)) continue;
+        // Speculative margin contacts (depth ≤ 0, proximity.hpp) come in too: they push only if the gap closes
+        // within the substep's iterations.
+        if (!(c.depth > 0) && !cr.is_margin(q)) continue;
         ActiveContact a;
         a.depth = c.depth;
         for (int r = 0; r < 3; ++r) {

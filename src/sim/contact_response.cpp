@@ -58,6 +58,9 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         m_detector.set_params(params);
         m_detector.set_topology(mesh, options);
         m_penetration.set_topology(mesh);
+        if (scene.contact.margin > 0 || scene.contact.speculative)
+            m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
+                              local_contact_edges);
     }
 }
 
@@ -74,9 +77,11 @@ double ContactResponse::pair_stiffness(Index a, Index b) const
     return 10 * 2 * ka * kb / (ka + kb);
 }
 
-void ContactResponse::update(const Positions& x, StepStats& stats)
+void ContactResponse::update(const Positions& x, const Positions& v, double h, StepStats& stats)
 {
     m_contacts.clear();
+    m_near.clear();
+    m_active.clear();
     m_weight.clear();
     m_k.clear();
     m_c.clear();
@@ -110,6 +115,12 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
     t0 = Clock::now();
     m_penetration.compute(x, m_contacts);
     stats.ms_depth += ms_since(t0);
+    if (m_proximity.enabled()) {
+        t0 = Clock::now();
+        m_proximity.update(x, v, h, m_contacts, m_near);
+        stats.ms_proximity += ms_since(t0);
+        stats.near_contacts = static_cast<std::int64_t>(m_near.size());
+    }
     if (m_obstacles) { // inside test, depth and direction together
         t0 = Clock::now();
         m_obstacles->add_contacts(x, model.fixed, model.vertex_object, m_contacts);
@@ -117,13 +128,21 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
     }
 
     t0 = Clock::now();
-    const size_t nc = m_contacts.size();
+    // The response's contacts: penetrated vertices pushed by their depth plus the margin, then the margin ones.
+    m_active.reserve(m_contacts.size() + m_near.size());
+    for (const Contact& c : m_contacts) {
+        m_active.push_back(c);
+        if (m_params.margin > 0 && c.tet >= 0 && c.depth > 0) m_active.back().depth += m_proximity.margin(c.vertex);
+    }
+    m_active.insert(m_active.end(), m_near.begin(), m_near.end());
+    const std::vector<Contact>& active = m_active;
+    const size_t nc = active.size();
     m_k.resize(nc);
     m_c.resize(nc);
     m_mred.resize(nc);
     m_weight.assign(nc, 1.0);
     for (size_t q = 0; q < nc; ++q) {
-        const Contact& c = m_contacts[q];
+        const Contact& c = active[q];
         m_k[q] = pair_stiffness(c.vertex_object, c.tet_object);
         // Reduced mass of the vertex and the penetrated tet's point (fixed vertices have infinite mass).
         const double inv_v =
@@ -143,12 +162,12 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
     // Weight: a vertex inside k tets of one object (on shared faces) gets 1/k of the response from each.
     for (size_t a = 0; a < nc;) {
         size_t b = a;
-        while (b < nc && m_contacts[b].vertex == m_contacts[a].vertex)
+        while (b < nc && active[b].vertex == active[a].vertex)
             ++b;
         for (size_t i = a; i < b; ++i) {
             int same = 0;
             for (size_t j = a; j < b; ++j)
-                same += m_contacts[j].tet_object == m_contacts[i].tet_object ? 1 : 0;
+                same += active[j].tet_object == active[i].tet_object ? 1 : 0;
             m_weight[i] = 1.0 / same;
         }
         a = b;
@@ -158,7 +177,7 @@ void ContactResponse::update(const Positions& x, StepStats& stats)
 
 void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
 {
-    const Contact& c = m_contacts[q];
+    const Contact& c = m_active[q];
     node[0] = c.vertex;
     coef[0] = 1.0;
     if (c.tet < 0) { // an obstacle: fixed, only the vertex moves
@@ -176,8 +195,8 @@ void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
 
 template <class Visit> void ContactResponse::for_each_pushing(Visit&& visit) const
 {
-    for (size_t q = 0; q < m_contacts.size(); ++q) {
-        const Contact& c = m_contacts[q];
+    for (size_t q = 0; q < m_active.size(); ++q) {
+        const Contact& c = m_active[q];
         if (!(c.depth > 0)) continue;
         Index node[5];
         double coef[5];
@@ -190,7 +209,7 @@ template <class Visit> void ContactResponse::for_each_pushing(Visit&& visit) con
 void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, bool cap) const
 {
     for_each_pushing([&](size_t q, const Index* node, const double* coef, const Vec3& nrm) {
-        const Contact& c = m_contacts[q];
+        const Contact& c = m_active[q];
         Vec3 vrel = Vec3::Zero();
         for (int a = 0; a < 5; ++a)
             vrel += coef[a] * vel.row(node[a]).transpose();
@@ -265,8 +284,8 @@ void ContactResponse::add_diagonal(double scale_k, double scale_c, Eigen::Vector
 double ContactResponse::energy() const
 {
     double e = 0;
-    for (size_t q = 0; q < m_contacts.size(); ++q)
-        if (m_contacts[q].depth > 0) e += 0.5 * m_weight[q] * m_k[q] * m_contacts[q].depth * m_contacts[q].depth;
+    for (size_t q = 0; q < m_active.size(); ++q)
+        if (m_active[q].depth > 0) e += 0.5 * m_weight[q] * m_k[q] * m_active[q].depth * m_active[q].depth;
     return e;
 }
 

@@ -4,6 +4,7 @@
 // damping and weights, and the forces and matrix terms every integrator uses.
 
 #include "obstacles.hpp"
+#include "proximity.hpp"
 
 #include "tethash/detect.hpp"
 #include "tethash/penetration.hpp"
@@ -26,15 +27,25 @@ class ContactResponse {
                const SceneObstacles* obstacles = nullptr);
     bool enabled() const { return m_enabled; }
 
-    /// Detects at `x`, drops the local self-contacts, fills depth/direction and the coefficients. Adds its times
+    /// Detects at `x`, drops the local self-contacts, fills depth/direction, adds the margin contacts for a
+    /// substep h at velocities v (proximity.hpp), and the coefficients. Adds its times
     /// to `stats` (ms_detect, ms_depth, ms_response).
-    void update(const Positions& x, StepStats& stats);
+    void update(const Positions& x, const Positions& v, double h, StepStats& stats);
 
     /// Contact penalty stiffness between a vertex of object a and a tet of object b (see simulation.hpp).
     double pair_stiffness(Index a, Index b) const;
 
-    /// The contacts the response uses (sorted by vertex, tet), with depth and direction.
+    /// The vertices inside tets (sorted by vertex, tet; then the obstacles'), with their penetration depth and
+    /// direction.
     const std::vector<Contact>& contacts() const { return m_contacts; }
+    /// The contacts the response pushes: those above with their depth plus the margin, then the margin contacts
+    /// (depth = margin − distance, negative for a speculative one). The coefficients below and `stencil` are
+    /// indexed by these.
+    const std::vector<Contact>& active() const { return m_active; }
+    /// The margin contacts (proximity.hpp): depth = the vertex's margin − its distance to the face (< 0: speculative).
+    const std::vector<Contact>& margin_contacts() const { return m_near; }
+    /// Whether active contact q is a margin contact (they follow the penetrating ones).
+    bool is_margin(size_t q) const { return q >= m_contacts.size(); }
     std::int64_t ignored_local() const { return m_ignored_local; }
     /// Per contact: weight (1 / contacts of the vertex with that object), stiffness, damping, reduced mass.
     const std::vector<double>& weight() const { return m_weight; }
@@ -73,7 +84,8 @@ class ContactResponse {
     ContactParams m_params;
     Detector m_detector;
     Penetration m_penetration;
-    std::vector<Contact> m_contacts;
+    Proximity m_proximity;
+    std::vector<Contact> m_contacts, m_near, m_active;
     std::vector<double> m_weight, m_k, m_c, m_mred;
     std::vector<double> m_object_k; // stiffest spring per object (0: static)
     double m_mu = 0;

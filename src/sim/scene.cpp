@@ -396,6 +396,8 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         key("damping", &ContactParams::damping, &Reader::non_negative),
         key("friction", &ContactParams::friction, &Reader::non_negative),
         key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
+        key("margin", &ContactParams::margin, &Reader::non_negative),
+        key("speculative", &ContactParams::speculative, &Reader::boolean),
     };
     const std::vector<Key<Scene>> keys = {
         key("dt", &Scene::dt, &Reader::positive),

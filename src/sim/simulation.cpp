@@ -116,7 +116,7 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
                            "will likely blow up: use more substeps, a smaller dt, or vbd");
 
     StepStats first;
-    contacts.update(mesh().positions, first);
+    contacts.update(mesh().positions, v, scene.dt / scene.substeps, first);
     failure.setup(model, mesh().positions, v, contacts.energy());
     inverted = count_inverted_tets(model, mesh().positions);
     integrator = make_integrator(StepContext{scene, mesh(), model, contacts});
@@ -199,7 +199,7 @@ void Simulation::step()
         std::string bad;
         for (sub = 0; sub < substeps; ++sub) {
             try {
-                s.contacts.update(x, st);
+                s.contacts.update(x, s.v, h, st);
             } catch (const Error& e) {
                 // The input was checked at construction: a detector error now comes from the state (a vertex
                 // flung far away, a tet stretched over millions of cells), i.e. from a diverging run.
@@ -304,6 +304,11 @@ const std::vector<Contact>& Simulation::contacts() const
     return m_impl->contacts.contacts();
 }
 
+const std::vector<Contact>& Simulation::margin_contacts() const
+{
+    return m_impl->contacts.margin_contacts();
+}
+
 double Simulation::max_penetration() const
 {
     return m_impl->contacts.max_depth();
@@ -327,7 +332,7 @@ std::vector<double> Simulation::exact_depths() const
 void Simulation::refresh_contacts()
 {
     StepStats st;
-    m_impl->contacts.update(m_impl->mesh().positions, st);
+    m_impl->contacts.update(m_impl->mesh().positions, m_impl->v, m_impl->scene.dt / m_impl->scene.substeps, st);
 }
 
 double Simulation::contact_stiffness(int a, int b) const

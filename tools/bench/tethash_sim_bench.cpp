@@ -1,7 +1,8 @@
 // tethash_sim_bench: the simulator on the meshes people load. Drops every mesh of ../shared/meshes (scaled to
 // 1 m, 0.2 m above the ground, density 1000, young 1e5) and throws two armadillo_4k into each other at 2 m/s, for
 // each integrator and time step asked; prints per scene the median ms per step split into detection / depth /
-// response / integration, solver iterations, contacts, inverted tets and far self-penetrations at the end, and
+// response / integration, solver iterations, contacts, inverted tets and far self-penetrations (at the end and the
+// most at any frame of 1/60 s), and
 // the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step. When built
 // with Bullet (libbullet-dev found), each scene and dt also runs with Bullet's soft bodies in the same process
 // (rows "bullet"), so the ratio to the peer comes from one run.
@@ -36,11 +37,12 @@ struct Row {
     std::string scene, integrator;
     double dt = 0;
     Index vertices = 0, tets = 0;
-    double ms = 0, detect = 0, depth = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
+    double ms = 0, detect = 0, depth = 0, proximity = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
     double ms_mean = 0;  ///< mean ms per step: the cost that counts where some steps were refined
     double substeps = 1; ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
-    double mean_z = 0; ///< mean height of the vertices at the end (how far the body sagged or sank)
+    std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
+    double mean_z = 0;             ///< mean height of the vertices at the end (how far the body sagged or sank)
     bool stable = false;
     std::string failure;
 };
@@ -83,15 +85,20 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
-    std::vector<double> ms, det, dep, resp, integ, sw, con, sub;
+    std::vector<double> ms, det, dep, prox, resp, integ, sw, con, sub;
+    // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
+    const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
     try {
         for (int i = 0; i < steps; ++i) {
             const auto t0 = std::chrono::steady_clock::now();
             s.step();
             ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            if ((i + 1) % frame_every == 0)
+                r.far_self_max = std::max(r.far_self_max, sim::count_far_self_penetrations(s.mesh(), start));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
             dep.push_back(st.ms_depth);
+            prox.push_back(st.ms_proximity);
             resp.push_back(st.ms_response);
             integ.push_back(st.ms_integrate);
             sw.push_back(st.solver_iterations);
@@ -105,6 +112,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.ms = median(ms);
     r.detect = median(det);
     r.depth = median(dep);
+    r.proximity = median(prox);
     r.response = median(resp);
     r.integrate = median(integ);
     r.sweeps = median(sw);
@@ -113,6 +121,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.contacts = mean(con);
     r.inverted = sim::count_inverted(s.mesh(), start);
     r.far_self = sim::count_far_self_penetrations(s.mesh(), start);
+    r.far_self_max = std::max(r.far_self_max, r.far_self);
     r.mean_z = s.mesh().positions.col(2).mean();
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
     return r;
@@ -153,6 +162,7 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
         r.mean_z += end.positions.col(2).sum();
     }
     r.mean_z /= static_cast<double>(std::max<Index>(1, r.vertices));
+    r.far_self_max = r.far_self; // the peer's frames are not looked at: its end state only
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
     return r;
 }
@@ -160,11 +170,13 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
 
 void print(const Row& r)
 {
-    std::printf("%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %7.4f "
-                "%10.3g  %s\n",
-                r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
-                r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
-                static_cast<long long>(r.far_self), r.mean_z, r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
+    std::printf(
+        "%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %7.4f "
+        "%10.3g  %s\n",
+        r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
+        r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
+        static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max), r.mean_z,
+        r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
     std::fflush(stdout);
 }
 
@@ -188,7 +200,8 @@ int main(int argc, char** argv)
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     double seconds = 0.5;
     int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0;
-    double skin = -1, sweep_tolerance = -1, rho = -1;
+    double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
+    bool no_speculative = false;
     bool no_peer = false;
     app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
     app.add_option("--scenes", filter, "only scenes whose name contains this");
@@ -205,6 +218,9 @@ int main(int argc, char** argv)
                    "vbd early stop (fraction of the mean edge); default: scene's");
     app.add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1); default: scene's");
     app.add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size; default: scene's");
+    app.add_option("--margin", margin, "contact margin, as a fraction of the mean edge (0: off); default: scene's")
+        ->check(CLI::NonNegativeNumber);
+    app.add_flag("--no-speculative", no_speculative, "no speculative contacts (proximity.hpp)");
     app.add_flag("--no-peer", no_peer, "do not run the peer (Bullet soft bodies) even when built with it");
     app.add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
     try {
@@ -272,9 +288,9 @@ int main(int argc, char** argv)
                 scenes.emplace_back("two armadillos at 2 m/s", two);
             }
         }
-        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %7s %10s  %s\n", "scene",
-                    "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "resp", "integr",
-                    "iters", "subst", "contacts", "invert", "far", "mean_z", "dt/ms", "failure");
+        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %7s %10s  %s\n",
+                    "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
+                    "integr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!filter.empty() && name.find(filter) == std::string::npos) continue;
@@ -287,6 +303,8 @@ int main(int argc, char** argv)
                     if (max_substeps > 0) scene.max_substeps = max_substeps;
                     if (sweep_tolerance >= 0) scene.sweep_tolerance = sweep_tolerance;
                     if (rho >= 0) scene.acceleration = rho;
+                    if (margin >= 0) scene.contact.margin = margin;
+                    if (no_speculative) scene.contact.speculative = false;
                     if (skin >= 0) {
                         scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
                         scene.detect.skin = skin;
@@ -323,15 +341,17 @@ int main(int argc, char** argv)
             {
                 std::ofstream out(tmp);
                 if (!out) throw Error("--csv: cannot write '" + tmp + "'");
-                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_response,"
-                       "ms_integrate,iterations,substeps,contacts,inverted,far_self,mean_z,stable,failure\n";
+                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,ms_"
+                       "response,"
+                       "ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,stable,"
+                       "failure\n";
                 for (const Row& r : rows)
-                    out << fmt::format(
-                        "{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:.3g},{:.4g},{},{},{:."
-                        "5g},{},\"{}\"\n",
-                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth, r.response,
-                        r.integrate, r.sweeps, r.substeps, r.contacts, r.inverted, r.far_self, r.mean_z,
-                        r.stable ? 1 : 0, r.failure);
+                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:."
+                                       "3g},{:.4g},{},{},{},{:."
+                                       "5g},{},\"{}\"\n",
+                                       r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect,
+                                       r.depth, r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts,
+                                       r.inverted, r.far_self, r.far_self_max, r.mean_z, r.stable ? 1 : 0, r.failure);
             }
             std::filesystem::rename(tmp, csv);
         }

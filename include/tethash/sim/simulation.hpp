@@ -27,9 +27,11 @@ namespace tethash::sim {
 struct StepStats {
     double ms_detect = 0;           ///< Detector::detect
     double ms_depth = 0;            ///< penetration depth and direction (Penetration::compute)
+    double ms_proximity = 0;        ///< margin contacts and displacement bounds (near pairs of far surfaces)
     double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
     double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
-    std::int64_t contacts = 0;      ///< contacts at the last substep (those the response uses)
+    std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
+    std::int64_t near_contacts = 0; ///< margin contacts at the last substep: vertices near a far surface
     std::int64_t ignored_local = 0; ///< self-contacts at the last substep left to the elastic terms: the tet lies
                                     ///< within 2 mean edges of the vertex in the rest state (local inversion)
     double max_depth = 0;           ///< largest penetration depth at the last substep (0 without contacts)
@@ -76,6 +78,11 @@ class Simulation {
     /// Of the last detection, depth/direction filled. A vertex in a collider = "bsp" obstacle has a contact with
     /// tet −1 and tet_object = (number of tet objects) + (the obstacle's rank among the bsp objects).
     const std::vector<Contact>& contacts() const;
+    /// Of the last substep: vertices near a far boundary face, not inside it (scene key contact.margin). The face's
+    /// tet and the closest point's barycentric coordinates in it (the fourth 0); depth = the vertex's margin minus
+    /// its distance to the face (negative: a speculative contact, pushing only if the gap closes); direction away
+    /// from the face.
+    const std::vector<Contact>& margin_contacts() const;
     double max_penetration() const; ///< max depth over contacts() (0 if none)
     double mean_penetration() const;
     /// Exact distance of each contact's vertex to the penetrated object's boundary (for error studies).

@@ -1,0 +1,394 @@
+#include "proximity.hpp"
+
+#include "tethash/geometry.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tethash::sim {
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+/// A vertex's reach is this many times its travel in the substep ...
+constexpr double radius_travel = 1.5;
+/// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On the mat (a one-layer sheet
+/// crumpling) 1.5 cost twice as much as 0.5 per step for fewer far self-penetrations at the worst frame (23 against
+/// 41 of 20,000 vertices, docs/simulator.md).
+constexpr double radius_edges = 0.5;
+/// Two objects thrown at each other: their whole surfaces close at once, so the cap is wider (it costs only while
+/// they approach fast).
+constexpr double pair_edges = 2.0;
+
+std::uint32_t cell_hash(std::int64_t x, std::int64_t y, std::int64_t z)
+{
+    return static_cast<std::uint32_t>((x * 73856093) ^ (y * 19349663) ^ (z * 83492791));
+}
+
+} // namespace
+
+void Proximity::setup(const TetMesh& mesh, const Positions& rest, const Model& model,
+                      const std::vector<ObjectOptions>& options, double margin_edges, bool speculative,
+                      double reach_edges)
+{
+    m_speculative = speculative;
+    m_mesh = &mesh;
+    m_model = &model;
+    m_rest = rest;
+    m_faces.clear();
+    m_vertices.clear();
+    const size_t objects = model.object_mean_edge.size();
+    m_margin.assign(objects, 0.0);
+    m_reach2.assign(objects, -1.0);
+    m_static.assign(objects, 0);
+    m_edge = 0;
+    m_margin_max = 0;
+    for (size_t o = 0; o < objects; ++o) {
+        const ObjectOptions opt = o < options.size() ? options[o] : ObjectOptions{};
+        const double edge = model.object_mean_edge[o];
+        m_static[o] = opt.is_static || !(edge > 0) ? 1 : 0;
+        if (m_static[o]) continue;
+        m_margin[o] = margin_edges * edge;
+        m_margin_max = std::max(m_margin_max, m_margin[o]);
+        if (opt.self_collision) m_reach2[o] = reach_edges * edge * reach_edges * edge;
+        m_edge = std::max(m_edge, edge);
+    }
+    if (!(m_edge > 0)) return; // nothing moves
+
+    const Triangles tri = boundary_faces(mesh.tets);
+    const Adjacency vt = vertex_tets(mesh.tets, mesh.num_vertices());
+    std::vector<char> is_boundary(static_cast<size_t>(mesh.num_vertices()), 0);
+    for (Index f = 0; f < tri.rows(); ++f) {
+        Face fc{};
+        for (int k = 0; k < 3; ++k)
+            fc.v[k] = tri(f, k);
+        fc.tet = -1;
+        // The one tet holding the face: among the tets of its first corner, the one with the other two.
+        for (Index a = vt.offsets[static_cast<size_t>(fc.v[0])]; a < vt.offsets[static_cast<size_t>(fc.v[0]) + 1];
+             ++a) {
+            const Index t = vt.neighbours[static_cast<size_t>(a)];
+            int found = 0;
+            for (int c = 0; c < 4; ++c)
+                for (int k = 0; k < 3; ++k)
+                    if (mesh.tets(t, c) == fc.v[k]) {
+                        fc.slot[k] = c;
+                        ++found;
+                    }
+            if (found == 3) {
+                fc.tet = t;
+                break;
+            }
+        }
+        if (fc.tet < 0) continue; // cannot happen for a face of boundary_faces
+        fc.opp = mesh.tets(fc.tet, 6 - fc.slot[0] - fc.slot[1] - fc.slot[2]);
+        fc.object = mesh.tet_object.empty() ? 0 : mesh.tet_object[static_cast<size_t>(fc.tet)];
+        // The face's rest-state sphere (centroid, farthest corner), for the local test in bulk.
+        const Vec3 centre = (rest.row(fc.v[0]) + rest.row(fc.v[1]) + rest.row(fc.v[2])).transpose() / 3.0;
+        fc.rest_centre = centre;
+        fc.rest_radius = 0;
+        for (Index v : fc.v)
+            fc.rest_radius = std::max(fc.rest_radius, (rest.row(v).transpose() - centre).norm());
+        m_faces.push_back(fc);
+        for (Index v : fc.v)
+            is_boundary[static_cast<size_t>(v)] = 1;
+    }
+    for (Index i = 0; i < mesh.num_vertices(); ++i)
+        if (is_boundary[static_cast<size_t>(i)]) m_vertices.push_back(i);
+    m_stamp.assign(m_faces.size(), -1);
+    m_vertex_margin.assign(static_cast<size_t>(mesh.num_vertices()), 0.0);
+    for (Index i : m_vertices)
+        m_vertex_margin[static_cast<size_t>(i)] =
+            m_margin[static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)])];
+    m_first = true;
+}
+
+double Proximity::margin(Index p) const
+{
+    return m_vertex_margin.empty() ? 0.0 : m_vertex_margin[static_cast<size_t>(p)];
+}
+
+// Each boundary vertex's reach: 1.5 × its travel in the substep relative to its object's mean motion (a body
+// falling or thrown as a whole does not close its own gaps), at most radius_edges mean edges; each pair of objects
+// closes on each other by 1.5 × their mean velocities' difference × h, at most pair_edges mean edges.
+void Proximity::motion(const Positions& v, double h)
+{
+    const Model& model = *m_model;
+    const std::vector<char>& fixed = model.fixed;
+    const size_t objects = m_margin.size();
+    m_mean_v.assign(objects, Vec3::Zero());
+    std::vector<double> mass(objects, 0.0);
+    for (Index i = 0; i < v.rows(); ++i) {
+        const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
+        const double m = model.mass[static_cast<size_t>(i)];
+        if (!fixed[static_cast<size_t>(i)]) m_mean_v[o] += m * v.row(i).transpose();
+        mass[o] += m;
+    }
+    for (size_t o = 0; o < objects; ++o)
+        if (mass[o] > 0) m_mean_v[o] /= mass[o];
+    m_pair_now.assign(objects * objects, 0.0);
+    for (size_t a = 0; a < objects; ++a)
+        for (size_t b = 0; b < objects; ++b)
+            if (a != b)
+                m_pair_now[a * objects + b] =
+                    m_speculative ? std::min(radius_travel * (m_mean_v[a] - m_mean_v[b]).norm() * h, pair_edges * m_edge)
+                                  : 0.0;
+    const double cap = radius_edges * m_edge;
+    m_reach.resize(static_cast<size_t>(v.rows()));
+    m_radius = 0;
+    for (Index i : m_vertices) {
+        const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
+        const double travel = fixed[static_cast<size_t>(i)] ? 0.0 : (v.row(i).transpose() - m_mean_v[o]).norm() * h;
+        const double reach = m_speculative ? std::min(radius_travel * travel, cap) : 0.0;
+        m_reach[static_cast<size_t>(i)] = reach;
+        m_radius = std::max(m_radius, reach);
+    }
+}
+
+double Proximity::face_reach(const std::vector<double>& reach, const Face& f)
+{
+    return std::max({reach[static_cast<size_t>(f.v[0])], reach[static_cast<size_t>(f.v[1])],
+                     reach[static_cast<size_t>(f.v[2])]});
+}
+
+void Proximity::hash_faces(const Positions& x)
+{
+    const double inv_cell = 1.0 / m_edge;
+    const size_t nf = m_faces.size();
+    m_box.resize(nf);
+    m_entries.clear();
+    size_t buckets = 1;
+    while (buckets < 2 * nf)
+        buckets <<= 1;
+    m_mask = static_cast<std::uint32_t>(buckets - 1);
+    for (size_t f = 0; f < nf; ++f) {
+        const Face& fc = m_faces[f];
+        const double reach = face_reach(m_reach, fc);
+        const double grow = reach + m_margin_max;
+        Cell& box = m_box[f];
+        std::int64_t lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) {
+            const double l = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
+            const double u = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
+            // Single precision, rounded outwards: a filter only (the closest point decides).
+            box.lo[k] = std::nextafter(static_cast<float>(l), -std::numeric_limits<float>::infinity());
+            box.hi[k] = std::nextafter(static_cast<float>(u), std::numeric_limits<float>::infinity());
+            lo[k] = static_cast<std::int64_t>(std::floor(l * inv_cell));
+            hi[k] = static_cast<std::int64_t>(std::floor(u * inv_cell));
+        }
+        box.face = static_cast<std::int32_t>(f);
+        box.object = static_cast<std::int32_t>(fc.object);
+        for (int k = 0; k < 3; ++k)
+            box.rest[k] = static_cast<float>(fc.rest_centre[k]);
+        box.rest[3] = static_cast<float>(fc.rest_radius);
+        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
+            for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
+                for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz)
+                    m_entries.emplace_back(cell_hash(cx, cy, cz) & m_mask, static_cast<std::int32_t>(f));
+    }
+    m_bucket_start.assign(buckets + 1, 0);
+    for (const auto& e : m_entries)
+        ++m_bucket_start[e.first + 1];
+    for (size_t b = 0; b < buckets; ++b)
+        m_bucket_start[b + 1] += m_bucket_start[b];
+    // Each bucket holds its faces' boxes in a row: a query reads them in order.
+    m_cells.resize(m_entries.size());
+    m_stamp.assign(m_bucket_start.begin(), m_bucket_start.end() - 1); // the fill cursor first
+    for (const auto& e : m_entries)
+        m_cells[static_cast<size_t>(m_stamp[e.first]++)] = m_box[static_cast<size_t>(e.second)];
+    m_stamp.assign(nf, -1);
+
+    // Per bucket: its faces' object (−1: several) and a rest-state sphere around all their corners, so that a
+    // vertex skips a bucket of its own neighbourhood with one test.
+    m_summary.resize(buckets);
+    for (size_t b = 0; b < buckets; ++b) {
+        Summary& sm = m_summary[b];
+        const std::int32_t begin = m_bucket_start[b], end = m_bucket_start[b + 1];
+        sm.object = -1;
+        sm.radius = std::numeric_limits<double>::infinity();
+        if (begin == end) continue;
+        Vec3 c = Vec3::Zero();
+        bool one = true;
+        for (std::int32_t e = begin; e < end; ++e) {
+            const Face& fc = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(e)].face)];
+            one = one && fc.object == m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(begin)].face)].object;
+            c += fc.rest_centre;
+        }
+        if (!one) continue;
+        c /= static_cast<double>(end - begin);
+        double r = 0;
+        for (std::int32_t e = begin; e < end; ++e) {
+            const Face& fc = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(e)].face)];
+            r = std::max(r, (fc.rest_centre - c).norm() + fc.rest_radius);
+        }
+        sm.object = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(begin)].face)].object;
+        sm.centre = c;
+        sm.radius = r;
+    }
+}
+
+void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
+                       std::vector<Contact>& out)
+{
+    m_tested = 0;
+    if (m_faces.empty()) return;
+    motion(v, h);
+    hash_faces(x);
+    const Model& model = *m_model;
+    const std::vector<char>& fixed = model.fixed;
+    const size_t objects = m_margin.size();
+    std::vector<double> object_reach(objects, 0.0); // the widest pair term of each object, for the query boxes
+    for (size_t a = 0; a < objects; ++a)
+        for (size_t b = 0; b < objects; ++b)
+            if (a != b && !(m_static[a] && m_static[b]))
+                object_reach[a] = std::max(object_reach[a], m_pair_now[a * objects + b]);
+
+    // The objects a vertex is already inside (its penetration contacts answer for those).
+    auto inside_of = [&](Index p, Index object) {
+        const auto it = std::lower_bound(inside.begin(), inside.end(), p,
+                                         [](const Contact& c, Index vtx) { return c.vertex < vtx; });
+        for (auto c = it; c != inside.end() && c->vertex == p; ++c)
+            if (c->tet_object == object) return true;
+        return false;
+    };
+    auto inside_any = [&](Index p) {
+        const auto it = std::lower_bound(inside.begin(), inside.end(), p,
+                                         [](const Contact& c, Index vtx) { return c.vertex < vtx; });
+        return it != inside.end() && it->vertex == p;
+    };
+    const double inv_cell = 1.0 / m_edge;
+    std::vector<Best>& best = m_best;
+    for (Index p : m_vertices) {
+        const Index op = model.vertex_object[static_cast<size_t>(p)];
+        const Vec3 xp = x.row(p).transpose();
+        const Vec3 rp = m_rest.row(p).transpose();
+        const double r = m_reach[static_cast<size_t>(p)];
+        const double rq = r + object_reach[static_cast<size_t>(op)]; // the query box: any partner object
+        double clearance = std::numeric_limits<double>::infinity(); // squared distance to the nearest far face
+        // The local reach with a little slack for the single-precision spheres: a bucket or face wholly inside
+        // `local_reach` is local; one wholly beyond `far_reach` is not; between, the corners decide.
+        const double reach2 = m_reach2[static_cast<size_t>(op)];
+        const double local_reach = reach2 > 0 ? std::sqrt(reach2) * (1 - 1e-5) : -1.0;
+        const double far_reach = reach2 > 0 ? std::sqrt(reach2) * (1 + 1e-5) : -1.0;
+        best.clear();
+        std::int64_t lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = static_cast<std::int64_t>(std::floor((xp[k] - rq) * inv_cell));
+            hi[k] = static_cast<std::int64_t>(std::floor((xp[k] + rq) * inv_cell));
+        }
+        const bool one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
+        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
+            for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
+                for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
+                    const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
+                    const Summary& sm = m_summary[bk];
+                    if (sm.object == op && (sm.centre - rp).norm() + sm.radius < local_reach) continue;
+                    for (std::int32_t e = m_bucket_start[bk]; e < m_bucket_start[bk + 1]; ++e) {
+                        const Cell& b = m_cells[static_cast<size_t>(e)];
+                        if (xp[0] + rq < b.lo[0] || xp[0] - rq > b.hi[0] || xp[1] + rq < b.lo[1] ||
+                            xp[1] - rq > b.hi[1] || xp[2] + rq < b.lo[2] || xp[2] - rq > b.hi[2])
+                            continue;
+                        const std::int32_t f = b.face;
+                        bool near_rest = false; // within the local reach in the rest state: decided below
+                        if (b.object == op) {
+                            const double dr = std::sqrt((b.rest[0] - rp[0]) * (b.rest[0] - rp[0]) +
+                                                        (b.rest[1] - rp[1]) * (b.rest[1] - rp[1]) +
+                                                        (b.rest[2] - rp[2]) * (b.rest[2] - rp[2]));
+                            if (dr + b.rest[3] < local_reach) continue; // every corner near: local
+                            near_rest = dr - b.rest[3] < far_reach;
+                        }
+                        if (!one_cell) {
+                            if (m_stamp[static_cast<size_t>(f)] == p) continue;
+                            m_stamp[static_cast<size_t>(f)] = static_cast<std::int32_t>(p);
+                        }
+                        const Face& fc = m_faces[static_cast<size_t>(f)];
+                        if (fc.v[0] == p || fc.v[1] == p || fc.v[2] == p) continue;
+                        if (fixed[static_cast<size_t>(p)] && fixed[static_cast<size_t>(fc.v[0])] &&
+                            fixed[static_cast<size_t>(fc.v[1])] && fixed[static_cast<size_t>(fc.v[2])])
+                            continue;
+                        if (op == fc.object) {
+                            const double reach2 = m_reach2[static_cast<size_t>(op)];
+                            if (reach2 < 0) continue;
+                            bool local = false;
+                            if (near_rest)
+                                for (Index c : fc.v)
+                                    local = local || (m_rest.row(c).transpose() - rp).squaredNorm() < reach2;
+                            if (local) continue;
+                        } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
+                            continue;
+                        }
+                        ++m_tested;
+                        const Vec3 a = x.row(fc.v[0]).transpose(), bb = x.row(fc.v[1]).transpose(),
+                                   c = x.row(fc.v[2]).transpose();
+                        const Vec3 q = closest_point_on_triangle(xp, a, bb, c);
+                        const double d2 = (xp - q).squaredNorm();
+                        const double watch =
+                            m_margin_max + r + face_reach(m_reach, fc) +
+                            (op == fc.object
+                                 ? 0.0
+                                 : m_pair_now[static_cast<size_t>(op) * objects + static_cast<size_t>(fc.object)]);
+                        if (d2 >= watch * watch) continue;
+                        clearance = std::min(clearance, d2);
+                        // The vertex must be on the outer side of the face (else it is inside, or beside the
+                        // face's back: the penetration response or another face answers).
+                        Vec3 n = (bb - a).cross(c - a);
+                        if (n.dot(x.row(fc.opp).transpose() - a) > 0) n = -n;
+                        if (!((xp - q).dot(n) > 0)) continue;
+                        const double d = std::sqrt(d2);
+                        auto it = std::find_if(best.begin(), best.end(),
+                                               [&](const Best& bs) { return bs.object == fc.object; });
+                        if (it == best.end())
+                            best.push_back({fc.object, f, d, q});
+                        else if (d < it->dist || (d == it->dist && f < it->face))
+                            *it = {fc.object, f, d, q};
+                    }
+                }
+        std::sort(best.begin(), best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
+        // The vertex's margin never exceeds the clearance it has had: a body that starts nearer than the margin to
+        // another (stacked, resting, touching) is not pushed apart by it; the margin grows back as it separates.
+        if (inside_any(p)) clearance = 0; // penetrating: no clearance at all
+        double& vm = m_vertex_margin[static_cast<size_t>(p)];
+        const double full = m_margin[static_cast<size_t>(op)];
+        vm = std::min(full, m_first ? std::sqrt(clearance) : std::max(vm, std::sqrt(clearance)));
+        for (const Best& bs : best)
+            if (!inside_of(p, bs.object)) out.push_back(margin_contact(x, p, op, bs.object, bs.face, bs.dist, bs.q));
+    }
+    m_first = false;
+}
+
+Contact Proximity::margin_contact(const Positions& x, Index p, Index op, Index object, Index face, double dist,
+                                  const Eigen::Vector3d& q) const
+{
+    const Face& fc = m_faces[static_cast<size_t>(face)];
+    const Vec3 a = x.row(fc.v[0]).transpose(), b = x.row(fc.v[1]).transpose(), c = x.row(fc.v[2]).transpose();
+    // Barycentric coordinates of the closest point on the face (areas; a degenerate face: equal shares).
+    const Vec3 n = (b - a).cross(c - a);
+    const double area2 = n.squaredNorm();
+    double w[3] = {1.0 / 3, 1.0 / 3, 1.0 / 3};
+    if (area2 > 0) {
+        w[0] = (b - q).cross(c - q).dot(n) / area2;
+        w[1] = (c - q).cross(a - q).dot(n) / area2;
+        w[2] = 1.0 - w[0] - w[1];
+    }
+    Contact ct;
+    ct.vertex = p;
+    ct.vertex_object = op;
+    ct.tet = fc.tet;
+    ct.tet_object = object;
+    for (int k = 0; k < 3; ++k)
+        ct.bary[fc.slot[k]] = std::clamp(w[k], 0.0, 1.0);
+    ct.depth = m_vertex_margin[static_cast<size_t>(p)] - dist;
+    Vec3 dir = x.row(p).transpose() - q;
+    if (dist > 1e-12 * m_edge)
+        dir /= dist;
+    else
+        dir = n.normalized() * (n.dot(x.row(fc.opp).transpose() - a) > 0 ? -1.0 : 1.0);
+    for (int k = 0; k < 3; ++k)
+        ct.direction[k] = dir[k];
+    return ct;
+}
+
+} // namespace tethash::sim

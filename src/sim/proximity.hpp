@@ -1,0 +1,108 @@
+#pragma once
+// Contact before penetration (private to tethash::sim). The detector reports a vertex once it is inside a tet;
+// on thin parts (a strut, a finger, a one-layer sheet) a vertex can cross a whole layer within one substep, and
+// then it is inside nothing, or deep inside with a direction that points the wrong way. Margin contacts meet it
+// before: a boundary vertex near a far boundary face (of another object, or of its own object but farther than
+// the local reach in the rest state) gets a contact with that face, "depth" δ − distance, pushing it out along the
+// face's outer side. Pairs are watched out to δ plus how far the two ends may close on each other in the substep
+// (1.5 × their travel relative to their objects' mean motion, plus the objects' relative travel): such a contact
+// starts with a negative depth and pushes only if the gap closes below δ within the substep (a speculative contact;
+// vbd sees it close in its iterations, the other integrators push positive depths only).
+// Faces are hashed into a uniform grid of the mean edge; each vertex looks at the cells its reach covers (one cell
+// when nothing moves relative to its object). Deterministic: one thread, fixed order.
+
+#include "tethash/detect.hpp"
+#include "tethash/sim/model.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace tethash::sim {
+
+class Proximity {
+  public:
+    /// `margin_edges`: δ of each object as a fraction of its mean edge. `reach_edges`: a face of the vertex's own object nearer than this many of its mean edges in the
+    /// rest state is local (folds of its own neighbourhood are the material's business).
+    void setup(const TetMesh& mesh, const Positions& rest, const Model& model, const std::vector<ObjectOptions>& options,
+               double margin_edges, bool speculative, double reach_edges);
+    bool enabled() const { return !m_faces.empty(); }
+
+    /// At positions x (velocities v, substep h): appends to `out` one margin contact per (vertex, object) with the
+    /// nearest far face within watch, depth δ − distance (negative: speculative), unless the vertex is already
+    /// inside that object (`inside`: contacts sorted by vertex).
+    void update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
+                std::vector<Contact>& out);
+
+    /// The margin δ (length) of vertex p: its object's, or less where it has never been that far from a far face
+    /// (see update).
+    double margin(Index p) const;
+    /// The largest vertex reach of the last update.
+    double radius() const { return m_radius; }
+    std::int64_t pairs_tested() const { return m_tested; }
+
+  private:
+    struct Face {
+        Index v[3];
+        Index opp; ///< the fourth vertex of its tet (inside)
+        Index tet;
+        int slot[3]; ///< the corners' columns in the tet
+        Index object;
+        Eigen::Vector3d rest_centre; ///< centroid in the rest state
+        double rest_radius;          ///< its farthest corner's distance in the rest state
+    };
+    struct Best {
+        Index object, face;
+        double dist;
+        Eigen::Vector3d q;
+    };
+    /// Mean velocities per object, each boundary vertex's reach, the object pairs' reach.
+    void motion(const Positions& v, double h);
+    /// Faces' boxes grown by their reach and the largest margin, counting-sorted into the grid's buckets.
+    void hash_faces(const Positions& x);
+    static double face_reach(const std::vector<double>& reach, const Face& f);
+    Contact margin_contact(const Positions& x, Index p, Index op, Index object, Index face, double dist,
+                           const Eigen::Vector3d& q) const;
+
+    const TetMesh* m_mesh = nullptr;
+    const Model* m_model = nullptr;
+    Positions m_rest;
+    std::vector<Face> m_faces;
+    std::vector<Index> m_vertices; ///< boundary vertices that can take part in a pair
+    std::vector<double> m_margin;  ///< per object
+    std::vector<double> m_reach2;  ///< per object: squared local reach (0: self pairs off)
+    std::vector<char> m_static;    ///< per object
+    double m_edge = 0;             ///< largest mean edge of the moving objects (the grid's cell)
+    double m_margin_max = 0;
+    bool m_speculative = true;
+    bool m_first = true;                 ///< the next update is the first: it sets the start clearances
+    std::vector<double> m_vertex_margin; ///< per vertex: min(object margin, largest clearance so far)
+    double m_radius = 0;
+    std::int64_t m_tested = 0;
+    // Motion of the substep.
+    std::vector<double> m_reach;           ///< per vertex: 1.5 × its travel relative to its object, clamped
+    std::vector<Eigen::Vector3d> m_mean_v; ///< per object: mass-weighted mean velocity
+    std::vector<double> m_pair_now;        ///< objects²: how far two objects may close on each other in h
+    // Scratch kept between calls: face boxes, the grid (counting-sorted by bucket), per-face stamps.
+    struct Cell {
+        float lo[3], hi[3]; ///< the face's box grown by its reach and the largest margin
+        float rest[4];      ///< the face's rest sphere: centre, radius
+        std::int32_t face, object;
+    };
+    struct Summary {
+        Index object;           ///< of all its faces (−1: several, or empty)
+        Eigen::Vector3d centre; ///< rest-state sphere around all their corners
+        double radius;
+    };
+    std::vector<Summary> m_summary; ///< per bucket
+    std::vector<Cell> m_box;   ///< per face
+    std::vector<Cell> m_cells; ///< per bucket entry, in bucket order
+    std::vector<std::int32_t> m_bucket_start, m_stamp;
+    std::uint32_t m_mask = 0;
+    std::vector<std::pair<std::uint32_t, std::int32_t>> m_entries;
+    std::vector<Best> m_best;
+};
+
+} // namespace tethash::sim
