@@ -42,28 +42,31 @@ Vec3 outward_normal(const PositionsRef& x, const Face& f)
 }
 
 /// Segment p + t (q − p), t ∈ [0, 1], against triangle abc (Möller–Trumbore, both sides). Returns t or −1.
+/// A nearly parallel pair (|det| ≤ 1e-14 |e1| |e2| |d|) is no hit; that test (three square roots) is made
+/// last, on the few pairs that pass the others (on which a zero det gives NaN or ∞ and fails).
 double segment_triangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c)
 {
     const Vec3 d = q - p, e1 = b - a, e2 = c - a;
     const Vec3 s1 = d.cross(e2);
     const double det = e1.dot(s1);
-    const double scale = e1.norm() * e2.norm() * d.norm();
-    if (!(std::abs(det) > 1e-14 * scale)) return -1;
     const double inv = 1.0 / det;
     const Vec3 s = p - a;
     const double u = s.dot(s1) * inv;
-    if (u < 0 || u > 1) return -1;
+    if (!(u >= 0 && u <= 1)) return -1;
     const Vec3 s2 = s.cross(e1);
     const double v = d.dot(s2) * inv;
-    if (v < 0 || u + v > 1) return -1;
+    if (!(v >= 0 && u + v <= 1)) return -1;
     const double t = e2.dot(s2) * inv;
-    return (t >= 0 && t <= 1) ? t : -1;
+    if (!(t >= 0 && t <= 1)) return -1;
+    const double scale = e1.norm() * e2.norm() * d.norm();
+    return std::abs(det) > 1e-14 * scale ? t : -1;
 }
 
 /// Exact overlap of two boxes (closed).
 bool boxes_meet(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi)
 {
-    return !((alo.array() > bhi.array()).any() || (ahi.array() < blo.array()).any());
+    return !((alo[0] > bhi[0]) | (alo[1] > bhi[1]) | (alo[2] > bhi[2]) | (ahi[0] < blo[0]) | (ahi[1] < blo[1]) |
+             (ahi[2] < blo[2]));
 }
 
 /// The triangle tree over one object's boundary faces, kept between calls: refitted to the new positions
@@ -111,11 +114,11 @@ class Bvh {
     const Vec3& face_lo(Index f) const { return m_lo[static_cast<size_t>(f)]; }
     const Vec3& face_hi(Index f) const { return m_hi[static_cast<size_t>(f)]; }
 
-    /// Appends to `out` every face whose own box meets the box lo..hi, in no particular order.
-    void faces_in_box(const Vec3& lo, const Vec3& hi, std::vector<Index>& out) const
+    /// Calls visit(f) for every face whose own box meets the box lo..hi, in no particular order.
+    template <class Visit> void faces_in_box(const Vec3& lo, const Vec3& hi, Visit&& visit) const
     {
         m_tree.for_box(lo, hi, [&](Index f) {
-            if (boxes_meet(m_lo[static_cast<size_t>(f)], m_hi[static_cast<size_t>(f)], lo, hi)) out.push_back(f);
+            if (boxes_meet(m_lo[static_cast<size_t>(f)], m_hi[static_cast<size_t>(f)], lo, hi)) visit(f);
         });
     }
 
@@ -212,8 +215,14 @@ class PenetrationImpl {
     std::vector<char> need;                      // per object: penetrated in this call
     std::vector<Index> wave;                     // pairs valued by the current propagation round
     std::vector<std::pair<double, Vec3>> values; // their values
-    std::vector<Index> candidates;               // faces near a vertex's border edges
-    std::vector<Index> border;                   // a vertex's border neighbours
+    /// A face near a vertex's border edges, with its box.
+    struct Candidate {
+        double lo[3], hi[3];
+        Index face;
+        Index v[3];
+    };
+    std::vector<Candidate> candidates;
+    std::vector<Index> border; // a vertex's border neighbours
 
     void set(const TetsRef& tets, Index num_vertices, std::span<const Index> vobj, std::span<const Index> tobj);
     /// Brings the trees of the objects flagged in `need` to positions x (refit or build).
@@ -342,8 +351,21 @@ void PenetrationImpl::border_estimate(const PositionsRef& x, Pair& p, Penetratio
         hi = hi.cwiseMax(xj);
     }
     if (border.empty()) return;
+    // Faces through the vertex itself never count; the others are copied with their boxes, side by side.
     candidates.clear();
-    tree.faces_in_box(lo, hi, candidates);
+    tree.faces_in_box(lo, hi, [&](Index f) {
+        const Face& fc = fs[static_cast<size_t>(f)];
+        if (fc.v[0] == p.vertex || fc.v[1] == p.vertex || fc.v[2] == p.vertex) return;
+        Candidate c;
+        for (int k = 0; k < 3; ++k) {
+            c.lo[k] = tree.face_lo(f)[k];
+            c.hi[k] = tree.face_hi(f)[k];
+        }
+        c.face = f;
+        for (int k = 0; k < 3; ++k)
+            c.v[k] = fc.v[k];
+        candidates.push_back(c);
+    });
     if (candidates.empty()) return;
     double wsum = 0, dsum = 0;
     Vec3 nsum = Vec3::Zero();
@@ -352,13 +374,14 @@ void PenetrationImpl::border_estimate(const PositionsRef& x, Pair& p, Penetratio
         const Vec3 slo = xi.cwiseMin(xj), shi = xi.cwiseMax(xj);
         double best_t = 2;
         Index best_f = -1;
-        for (const Index f : candidates) {
-            if (!boxes_meet(tree.face_lo(f), tree.face_hi(f), slo, shi)) continue;
-            const Face& fc = fs[static_cast<size_t>(f)];
-            if (fc.v[0] == p.vertex || fc.v[1] == p.vertex || fc.v[2] == p.vertex || fc.v[0] == j || fc.v[1] == j ||
-                fc.v[2] == j)
-                continue;
-            const double t = segment_triangle(xi, xj, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+        for (const Candidate& c : candidates) {
+            // Plain comparisons, all evaluated (no early exit): most candidates fail one of them.
+            const bool meet = (c.lo[0] <= shi[0]) & (c.hi[0] >= slo[0]) & (c.lo[1] <= shi[1]) & (c.hi[1] >= slo[1]) &
+                              (c.lo[2] <= shi[2]) & (c.hi[2] >= slo[2]);
+            if (!meet) continue;
+            if (c.v[0] == j || c.v[1] == j || c.v[2] == j) continue;
+            const Index f = c.face;
+            const double t = segment_triangle(xi, xj, pos(x, c.v[0]), pos(x, c.v[1]), pos(x, c.v[2]));
             if (t >= 0 && (t < best_t || (t == best_t && f < best_f))) {
                 best_t = t;
                 best_f = f;

@@ -118,7 +118,10 @@ class TriangleBvh {
         stack[top++] = 0;
         while (top) {
             const Node& n = m_nodes[static_cast<std::size_t>(stack[--top])];
-            if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
+            // Plain comparisons, all evaluated: cheaper than branching on each.
+            if ((n.lo[0] > hi[0]) | (n.lo[1] > hi[1]) | (n.lo[2] > hi[2]) | (n.hi[0] < lo[0]) | (n.hi[1] < lo[1]) |
+                (n.hi[2] < lo[2]))
+                continue;
             if (n.left < 0) {
                 for (Index k = n.first; k < n.first + n.count; ++k)
                     visit(item(k));
