@@ -456,6 +456,15 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
     // (vertex, penetrated object) pairs, chained per vertex from s.head.
     std::vector<Pair>& pairs = s.pairs;
     pairs.clear();
+    // The per-vertex table is left clean however this call ends (an allocation failure included).
+    struct ClearHead {
+        PenetrationImpl& s;
+        ~ClearHead()
+        {
+            for (const Pair& p : s.pairs)
+                s.head[static_cast<size_t>(p.vertex)] = -1;
+        }
+    } clear_head{s};
     s.contact_slot.resize(contacts.size());
     s.need.assign(static_cast<size_t>(s.objects), 0);
     for (size_t c = 0; c < contacts.size(); ++c) {
@@ -546,8 +555,6 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
         for (int k = 0; k < 3; ++k)
             contacts[c].direction[k] = p.dir[k];
     }
-    for (const Pair& p : pairs)
-        s.head[static_cast<size_t>(p.vertex)] = -1;
     st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (stats) *stats = st;
 }
