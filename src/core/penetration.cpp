@@ -107,9 +107,6 @@ class Bvh {
         ++built;
     }
 
-    /// Forgets the tree (new topology).
-    void reset() { m_built = false; }
-
     bool empty() const { return m_tree.empty(); }
     const Vec3& face_lo(Index f) const { return m_lo[static_cast<size_t>(f)]; }
     const Vec3& face_hi(Index f) const { return m_hi[static_cast<size_t>(f)]; }
@@ -183,8 +180,6 @@ class Bvh {
     bool m_built = false;
 };
 
-} // namespace
-
 /// A (vertex, penetrated object) pair and its estimate.
 struct Pair {
     Index vertex = 0, object = 0;
@@ -196,6 +191,8 @@ struct Pair {
 
 /// A tree is rebuilt when refitting has made its cost() this many times the cost it had when built.
 constexpr double kRebuildFactor = 1.5;
+
+} // namespace
 
 class PenetrationImpl {
   public:
