@@ -431,3 +431,26 @@ TEST(CorePenetration, KeptTreesOnARealMeshGiveWhatAFreshPenetrationGives)
     EXPECT_GT(counts.refitted, 0);
     EXPECT_GT(counts.built, penetrated_objects(detector.contacts()));
 }
+
+TEST(CorePenetration, NewTopologyStartsWithNewTrees)
+{
+    TetMesh a = box(3, 1.0, {0, 0, 0});
+    a.ensure_object_ids();
+    a.append(box(3, 1.0, {0.6, 0.1, 0.0}));
+    TetMesh b = box(4, 1.0, {0, 0, 0});
+    b.ensure_object_ids();
+    b.append(box(2, 0.5, {0.3, 0.0, 0.1}));
+    b.append(box(3, 1.0, {-0.7, 0.0, 0.0}));
+    Penetration pen;
+    pen.set_topology(a);
+    std::vector<Contact> ca = brute_contacts(a);
+    pen.compute(a.positions, ca);
+    const std::vector<Contact> cb = brute_contacts(b);
+    ASSERT_FALSE(cb.empty());
+    pen.set_topology(b);
+    TreeCounts n;
+    check_against_fresh(pen, b, b.positions, cb, n);
+    EXPECT_EQ(n.refitted, 0);
+    EXPECT_EQ(n.built, penetrated_objects(cb));
+    EXPECT_GE(n.built, 2);
+}
