@@ -31,9 +31,9 @@ struct PenetrationStats {
     std::int64_t propagated = 0;     ///< pairs valued by propagation (step 2)
     std::int64_t fallback = 0;       ///< pairs valued by the closest-point fallback (step 3)
     std::int64_t intersections = 0;  ///< edge/boundary intersections found
+    double ms = 0;                   ///< wall time of compute()
     std::int64_t trees_built = 0;    ///< boundary trees of penetrated objects built (first use, or grown loose)
     std::int64_t trees_refitted = 0; ///< boundary trees kept from an earlier call, refitted to the positions
-    double ms = 0;                   ///< wall time of compute()
 };
 
 class PenetrationImpl;
