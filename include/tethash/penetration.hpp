@@ -26,17 +26,23 @@
 namespace tethash {
 
 struct PenetrationStats {
-    std::int64_t pairs = 0;         ///< distinct (vertex, penetrated object) pairs
-    std::int64_t border = 0;        ///< pairs valued from intersected edges (step 1)
-    std::int64_t propagated = 0;    ///< pairs valued by propagation (step 2)
-    std::int64_t fallback = 0;      ///< pairs valued by the closest-point fallback (step 3)
-    std::int64_t intersections = 0; ///< edge/boundary intersections found
-    double ms = 0;                  ///< wall time of compute()
+    std::int64_t pairs = 0;          ///< distinct (vertex, penetrated object) pairs
+    std::int64_t border = 0;         ///< pairs valued from intersected edges (step 1)
+    std::int64_t propagated = 0;     ///< pairs valued by propagation (step 2)
+    std::int64_t fallback = 0;       ///< pairs valued by the closest-point fallback (step 3)
+    std::int64_t intersections = 0;  ///< edge/boundary intersections found
+    double ms = 0;                   ///< wall time of compute()
+    std::int64_t trees_built = 0;    ///< boundary trees of penetrated objects built (first use, or grown loose)
+    std::int64_t trees_refitted = 0; ///< boundary trees kept from an earlier call, refitted to the positions
 };
 
 class PenetrationImpl;
 
-/// Keeps the per-object boundary surfaces and the vertex adjacency of a topology between calls.
+/// Keeps the per-object boundary surfaces and the vertex adjacency of a topology between calls, and the
+/// boundary trees of the objects penetrated so far: later calls refit them to the new positions (rebuilding
+/// one whose boxes have grown loose) and reuse their scratch, so a warmed-up compute() with no more contacts
+/// than before allocates nothing. The results do not depend on this history: every call gives bit for bit
+/// what a fresh Penetration gives. Not safe for concurrent calls on one object (exact_depths included).
 class Penetration {
   public:
     Penetration();
@@ -57,6 +63,7 @@ class Penetration {
 
     /// Reference for error reporting: for each contact, the exact distance from its vertex to the boundary
     /// surface of the penetrated object (closest point over all its boundary triangles). Size = contacts.size().
+    /// Uses (and refits) the kept trees, hence not safe concurrently with another call on this object.
     std::vector<double> exact_depths(const PositionsRef& positions, std::span<const Contact> contacts) const;
 
   private:

@@ -51,6 +51,51 @@ class TriangleBvh {
         build(n, corners, leaf_size, [](Index, const Node&) {});
     }
 
+    /// Recomputes every node's box (and every triangle's centre) from `corners(t, a, b, c)` at new positions,
+    /// keeping the tree's shape: the triangles of each node stay the same. A node's box is exactly the
+    /// union of its triangles' corner boxes, as after build. Nodes come before their children, so one
+    /// backward pass suffices.
+    template <class Corners> void refit(Corners&& corners)
+    {
+        for (auto id = static_cast<std::ptrdiff_t>(m_nodes.size()) - 1; id >= 0; --id) {
+            Node& node = m_nodes[static_cast<std::size_t>(id)];
+            if (node.left >= 0) {
+                const Node& l = m_nodes[static_cast<std::size_t>(node.left)];
+                const Node& r = m_nodes[static_cast<std::size_t>(node.right)];
+                node.lo = l.lo.cwiseMin(r.lo);
+                node.hi = l.hi.cwiseMax(r.hi);
+                continue;
+            }
+            Vec3 blo = Vec3::Constant(std::numeric_limits<double>::infinity()), bhi = -blo;
+            for (Index k = node.first; k < node.first + node.count; ++k) {
+                const Index t = item(k);
+                Vec3 a, b, c;
+                corners(t, a, b, c);
+                blo = blo.cwiseMin(a.cwiseMin(b).cwiseMin(c));
+                bhi = bhi.cwiseMax(a.cwiseMax(b).cwiseMax(c));
+                m_centre[static_cast<std::size_t>(t)] = (a + b + c) / 3.0;
+            }
+            node.lo = blo;
+            node.hi = bhi;
+        }
+    }
+
+    /// Sum of the surface areas of all node boxes divided by the root box's (the expected number of nodes
+    /// a random ray through the root visits): grows as a refitted tree's boxes come to overlap.
+    double cost() const
+    {
+        if (m_nodes.empty()) return 0;
+        auto area = [](const Node& n) {
+            const Vec3 e = (n.hi - n.lo).cwiseMax(Vec3::Zero());
+            return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+        };
+        double sum = 0;
+        for (const Node& n : m_nodes)
+            sum += area(n);
+        const double root = area(m_nodes.front());
+        return root > 0 ? sum / root : 0;
+    }
+
     bool empty() const { return m_nodes.empty(); }
     const std::vector<Node>& nodes() const { return m_nodes; }
     /// The triangle at position k of the tree's order (a node holds positions first .. first + count - 1).
@@ -73,7 +118,10 @@ class TriangleBvh {
         stack[top++] = 0;
         while (top) {
             const Node& n = m_nodes[static_cast<std::size_t>(stack[--top])];
-            if ((n.lo.array() > hi.array()).any() || (n.hi.array() < lo.array()).any()) continue;
+            // Plain comparisons, all evaluated: cheaper than branching on each.
+            if ((n.lo[0] > hi[0]) | (n.lo[1] > hi[1]) | (n.lo[2] > hi[2]) | (n.hi[0] < lo[0]) | (n.hi[1] < lo[1]) |
+                (n.hi[2] < lo[2]))
+                continue;
             if (n.left < 0) {
                 for (Index k = n.first; k < n.first + n.count; ++k)
                     visit(item(k));
