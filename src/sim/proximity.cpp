@@ -24,6 +24,19 @@ constexpr double radius_edges = 0.5;
 /// they approach fast).
 constexpr double pair_edges = 2.0;
 
+/// Single precision rounded down / up: a filter's box that contains the double one (float's relative rounding
+/// error is at most 2⁻²⁴; the margin taken is 4 × that).
+float round_down(double v)
+{
+    const float f = static_cast<float>(v);
+    return f - (std::abs(f) * 2.4e-7f + 1e-30f);
+}
+float round_up(double v)
+{
+    const float f = static_cast<float>(v);
+    return f + (std::abs(f) * 2.4e-7f + 1e-30f);
+}
+
 std::uint32_t cell_hash(std::int64_t x, std::int64_t y, std::int64_t z)
 {
     return static_cast<std::uint32_t>((x * 73856093) ^ (y * 19349663) ^ (z * 83492791));
@@ -134,8 +147,9 @@ void Proximity::motion(const Positions& v, double h)
         for (size_t b = 0; b < objects; ++b)
             if (a != b)
                 m_pair_now[a * objects + b] =
-                    m_speculative ? std::min(radius_travel * (m_mean_v[a] - m_mean_v[b]).norm() * h, pair_edges * m_edge)
-                                  : 0.0;
+                    m_speculative
+                        ? std::min(radius_travel * (m_mean_v[a] - m_mean_v[b]).norm() * h, pair_edges * m_edge)
+                        : 0.0;
     const double cap = radius_edges * m_edge;
     m_reach.resize(static_cast<size_t>(v.rows()));
     m_radius = 0;
@@ -150,8 +164,8 @@ void Proximity::motion(const Positions& v, double h)
 
 double Proximity::face_reach(const std::vector<double>& reach, const Face& f)
 {
-    return std::max({reach[static_cast<size_t>(f.v[0])], reach[static_cast<size_t>(f.v[1])],
-                     reach[static_cast<size_t>(f.v[2])]});
+    return std::max(
+        {reach[static_cast<size_t>(f.v[0])], reach[static_cast<size_t>(f.v[1])], reach[static_cast<size_t>(f.v[2])]});
 }
 
 void Proximity::hash_faces(const Positions& x)
@@ -174,8 +188,8 @@ void Proximity::hash_faces(const Positions& x)
             const double l = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
             const double u = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
             // Single precision, rounded outwards: a filter only (the closest point decides).
-            box.lo[k] = std::nextafter(static_cast<float>(l), -std::numeric_limits<float>::infinity());
-            box.hi[k] = std::nextafter(static_cast<float>(u), std::numeric_limits<float>::infinity());
+            box.lo[k] = round_down(l);
+            box.hi[k] = round_up(u);
             lo[k] = static_cast<std::int64_t>(std::floor(l * inv_cell));
             hi[k] = static_cast<std::int64_t>(std::floor(u * inv_cell));
         }
@@ -200,34 +214,6 @@ void Proximity::hash_faces(const Positions& x)
     for (const auto& e : m_entries)
         m_cells[static_cast<size_t>(m_stamp[e.first]++)] = m_box[static_cast<size_t>(e.second)];
     m_stamp.assign(nf, -1);
-
-    // Per bucket: its faces' object (−1: several) and a rest-state sphere around all their corners, so that a
-    // vertex skips a bucket of its own neighbourhood with one test.
-    m_summary.resize(buckets);
-    for (size_t b = 0; b < buckets; ++b) {
-        Summary& sm = m_summary[b];
-        const std::int32_t begin = m_bucket_start[b], end = m_bucket_start[b + 1];
-        sm.object = -1;
-        sm.radius = std::numeric_limits<double>::infinity();
-        if (begin == end) continue;
-        Vec3 c = Vec3::Zero();
-        bool one = true;
-        for (std::int32_t e = begin; e < end; ++e) {
-            const Face& fc = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(e)].face)];
-            one = one && fc.object == m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(begin)].face)].object;
-            c += fc.rest_centre;
-        }
-        if (!one) continue;
-        c /= static_cast<double>(end - begin);
-        double r = 0;
-        for (std::int32_t e = begin; e < end; ++e) {
-            const Face& fc = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(e)].face)];
-            r = std::max(r, (fc.rest_centre - c).norm() + fc.rest_radius);
-        }
-        sm.object = m_faces[static_cast<size_t>(m_cells[static_cast<size_t>(begin)].face)].object;
-        sm.centre = c;
-        sm.radius = r;
-    }
 }
 
 void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
@@ -267,7 +253,7 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
         const Vec3 rp = m_rest.row(p).transpose();
         const double r = m_reach[static_cast<size_t>(p)];
         const double rq = r + object_reach[static_cast<size_t>(op)]; // the query box: any partner object
-        double clearance = std::numeric_limits<double>::infinity(); // squared distance to the nearest far face
+        double clearance = std::numeric_limits<double>::infinity();  // squared distance to the nearest far face
         // The local reach with a little slack for the single-precision spheres: a bucket or face wholly inside
         // `local_reach` is local; one wholly beyond `far_reach` is not; between, the corners decide.
         const double reach2 = m_reach2[static_cast<size_t>(op)];
@@ -280,25 +266,31 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
             hi[k] = static_cast<std::int64_t>(std::floor((xp[k] + rq) * inv_cell));
         }
         const bool one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
+        // The query box in single precision, rounded outwards like the faces' boxes.
+        float qlo[3], qhi[3];
+        for (int k = 0; k < 3; ++k) {
+            qlo[k] = round_down(xp[k] - rq);
+            qhi[k] = round_up(xp[k] + rq);
+        }
         for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
             for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
                 for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
                     const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
-                    const Summary& sm = m_summary[bk];
-                    if (sm.object == op && (sm.centre - rp).norm() + sm.radius < local_reach) continue;
                     for (std::int32_t e = m_bucket_start[bk]; e < m_bucket_start[bk + 1]; ++e) {
                         const Cell& b = m_cells[static_cast<size_t>(e)];
-                        if (xp[0] + rq < b.lo[0] || xp[0] - rq > b.hi[0] || xp[1] + rq < b.lo[1] ||
-                            xp[1] - rq > b.hi[1] || xp[2] + rq < b.lo[2] || xp[2] - rq > b.hi[2])
+                        if ((qhi[0] < b.lo[0]) | (qlo[0] > b.hi[0]) | (qhi[1] < b.lo[1]) | (qlo[1] > b.hi[1]) |
+                            (qhi[2] < b.lo[2]) | (qlo[2] > b.hi[2]))
                             continue;
                         const std::int32_t f = b.face;
                         bool near_rest = false; // within the local reach in the rest state: decided below
                         if (b.object == op) {
-                            const double dr = std::sqrt((b.rest[0] - rp[0]) * (b.rest[0] - rp[0]) +
-                                                        (b.rest[1] - rp[1]) * (b.rest[1] - rp[1]) +
-                                                        (b.rest[2] - rp[2]) * (b.rest[2] - rp[2]));
-                            if (dr + b.rest[3] < local_reach) continue; // every corner near: local
-                            near_rest = dr - b.rest[3] < far_reach;
+                            // Squared: dr + radius < local_reach, dr − radius < far_reach (dr the centre's distance).
+                            const double dr2 = (b.rest[0] - rp[0]) * (b.rest[0] - rp[0]) +
+                                               (b.rest[1] - rp[1]) * (b.rest[1] - rp[1]) +
+                                               (b.rest[2] - rp[2]) * (b.rest[2] - rp[2]);
+                            const double inner = local_reach - b.rest[3], outer = far_reach + b.rest[3];
+                            if (inner > 0 && dr2 < inner * inner) continue; // every corner near: local
+                            near_rest = dr2 < outer * outer;
                         }
                         if (!one_cell) {
                             if (m_stamp[static_cast<size_t>(f)] == p) continue;

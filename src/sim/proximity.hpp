@@ -24,10 +24,11 @@ namespace tethash::sim {
 
 class Proximity {
   public:
-    /// `margin_edges`: δ of each object as a fraction of its mean edge. `reach_edges`: a face of the vertex's own object nearer than this many of its mean edges in the
-    /// rest state is local (folds of its own neighbourhood are the material's business).
-    void setup(const TetMesh& mesh, const Positions& rest, const Model& model, const std::vector<ObjectOptions>& options,
-               double margin_edges, bool speculative, double reach_edges);
+    /// `margin_edges`: δ of each object as a fraction of its mean edge. `reach_edges`: a face of the vertex's own
+    /// object nearer than this many of its mean edges in the rest state is local (folds of its own neighbourhood are
+    /// the material's business).
+    void setup(const TetMesh& mesh, const Positions& rest, const Model& model,
+               const std::vector<ObjectOptions>& options, double margin_edges, bool speculative, double reach_edges);
     bool enabled() const { return !m_faces.empty(); }
 
     /// At positions x (velocities v, substep h): appends to `out` one margin contact per (vertex, object) with the
@@ -91,12 +92,7 @@ class Proximity {
         float rest[4];      ///< the face's rest sphere: centre, radius
         std::int32_t face, object;
     };
-    struct Summary {
-        Index object;           ///< of all its faces (−1: several, or empty)
-        Eigen::Vector3d centre; ///< rest-state sphere around all their corners
-        double radius;
-    };
-    std::vector<Summary> m_summary; ///< per bucket
+
     std::vector<Cell> m_box;   ///< per face
     std::vector<Cell> m_cells; ///< per bucket entry, in bucket order
     std::vector<std::int32_t> m_bucket_start, m_stamp;
