@@ -17,9 +17,10 @@ using Vec3 = Eigen::Vector3d;
 /// A vertex's reach is this many times its travel in the substep ...
 constexpr double radius_travel = 1.5;
 /// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On the mat (a one-layer sheet
-/// crumpling) 1.5 cost twice as much as 0.5 per step for fewer far self-penetrations at the worst frame (23 against
-/// 41 of 20,000 vertices, docs/simulator.md).
-constexpr double radius_edges = 0.5;
+/// crumpling, every vertex moving) 0.5 cost twice as much as 0.25 per step at 1/240 (87 against 38 ms of
+/// proximity; 724 against 248 at 1/60) for about as many far self-penetrations at the worst frame (41 and 39 of
+/// 20,000 vertices); 1.5 cost twice as much again (docs/simulator.md).
+constexpr double radius_edges = 0.25;
 /// Two objects thrown at each other: their whole surfaces close at once, so the cap is wider (it costs only while
 /// they approach fast).
 constexpr double pair_edges = 2.0;
