@@ -89,8 +89,7 @@ class Proximity {
     // Scratch kept between calls: face boxes, the grid (counting-sorted by bucket), per-face stamps.
     struct Cell {
         float lo[3], hi[3]; ///< the face's box grown by its reach and the largest margin
-        float rest[4];      ///< the face's rest sphere: centre, radius
-        std::int32_t face, object;
+        std::int32_t face;
     };
 
     std::vector<Cell> m_box;   ///< per face
