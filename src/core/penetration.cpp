@@ -119,57 +119,20 @@ class Bvh {
         });
     }
 
-    /// Closest point over faces accepted by `accept(face)`: returns face id (−1 if none) and fills point, dist².
-    /// The least (distance², face id) over all accepted faces: a node is skipped only when its box, widened
-    /// by far more than the rounding of a computed closest point, is farther than the best so far.
+    /// Closest point over faces accepted by `accept(face)`: returns face id (−1 if none) and fills point, dist²;
+    /// the least (distance², face id), whatever the tree's shape (TriangleBvh::closest).
     template <class A>
     Index closest(const PositionsRef& x, const Vec3& p, A&& accept, Vec3& best_point, double& best_d2) const
     {
-        best_d2 = std::numeric_limits<double>::infinity();
-        Index best = -1;
-        const auto& nodes = m_tree.nodes();
-        if (nodes.empty()) return best;
-        const double scale =
-            std::max({nodes[0].lo.cwiseAbs().maxCoeff(), nodes[0].hi.cwiseAbs().maxCoeff(), p.cwiseAbs().maxCoeff()});
-        const double h = 1e-9 * scale + std::numeric_limits<double>::min();
-        auto lower = [&](const detail::TriangleBvh::Node& n) {
-            const double d2 =
-                ((n.lo.array() - h) - p.array()).max(p.array() - (n.hi.array() + h)).max(0.0).matrix().squaredNorm();
-            return d2 * (1 - 1e-12);
-        };
-        Index stack[128];
-        int top = 0;
-        stack[top++] = 0;
-        while (top) {
-            const auto& n = nodes[static_cast<size_t>(stack[--top])];
-            if (lower(n) > best_d2) continue;
-            if (n.left < 0) {
-                for (Index k = n.first; k < n.first + n.count; ++k) {
-                    const Index f = m_tree.item(k);
-                    const Face& fc = (*m_faces)[static_cast<size_t>(f)];
-                    if (!accept(fc)) continue;
-                    const Vec3 q = closest_point_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
-                    const double d2 = (q - p).squaredNorm();
-                    if (d2 < best_d2 || (d2 == best_d2 && f < best)) {
-                        best_d2 = d2;
-                        best_point = q;
-                        best = f;
-                    }
-                }
-            } else if (top < 126) {
-                // Nearer child last so that it is popped first.
-                const auto& l = nodes[static_cast<size_t>(n.left)];
-                const auto& r = nodes[static_cast<size_t>(n.right)];
-                if (detail::TriangleBvh::squared_distance(l, p) < detail::TriangleBvh::squared_distance(r, p)) {
-                    stack[top++] = n.right;
-                    stack[top++] = n.left;
-                } else {
-                    stack[top++] = n.left;
-                    stack[top++] = n.right;
-                }
-            }
-        }
-        return best;
+        return m_tree.closest(
+            p,
+            [&](Index f, Vec3& q) {
+                const Face& fc = (*m_faces)[static_cast<size_t>(f)];
+                if (!accept(fc)) return false;
+                q = closest_point_on_triangle(p, pos(x, fc.v[0]), pos(x, fc.v[1]), pos(x, fc.v[2]));
+                return true;
+            },
+            best_point, best_d2);
     }
 
   private:

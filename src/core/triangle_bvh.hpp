@@ -134,25 +134,36 @@ class TriangleBvh {
 
     /// The closest point to p over the triangles for which `point_of(t, q)` sets a point q (and returns
     /// true; false skips the triangle). Returns the triangle (-1 if none) and sets best_point and its
-    /// squared distance best_d2. Nearer children first, so most of the tree is pruned.
+    /// squared distance best_d2. Nearer children first, so most of the tree is pruned. The answer is the least
+    /// (distance², triangle) over all accepted triangles, whatever the tree's shape (built or refitted): a node
+    /// is skipped only when its box, widened by far more than the rounding of a computed closest point, is
+    /// farther than the best so far.
     template <class PointOf> Index closest(const Vec3& p, PointOf&& point_of, Vec3& best_point, double& best_d2) const
     {
         best_d2 = std::numeric_limits<double>::infinity();
         Index best = -1;
         if (m_nodes.empty()) return best;
+        const double scale = std::max(
+            {m_nodes[0].lo.cwiseAbs().maxCoeff(), m_nodes[0].hi.cwiseAbs().maxCoeff(), p.cwiseAbs().maxCoeff()});
+        const double h = 1e-9 * scale + std::numeric_limits<double>::min();
+        auto lower = [&](const Node& n) {
+            const double d2 =
+                ((n.lo.array() - h) - p.array()).max(p.array() - (n.hi.array() + h)).max(0.0).matrix().squaredNorm();
+            return d2 * (1 - 1e-12);
+        };
         Index stack[128];
         int top = 0;
         stack[top++] = 0;
         while (top) {
             const Node& n = m_nodes[static_cast<std::size_t>(stack[--top])];
-            if (squared_distance(n, p) >= best_d2) continue;
+            if (lower(n) > best_d2) continue;
             if (n.left < 0) {
                 for (Index k = n.first; k < n.first + n.count; ++k) {
                     const Index t = item(k);
                     Vec3 q;
                     if (!point_of(t, q)) continue;
                     const double d2 = (q - p).squaredNorm();
-                    if (d2 < best_d2) {
+                    if (d2 < best_d2 || (d2 == best_d2 && t < best)) {
                         best_d2 = d2;
                         best_point = q;
                         best = t;
