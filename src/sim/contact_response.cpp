@@ -132,7 +132,7 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     m_active.reserve(m_contacts.size() + m_near.size());
     for (const Contact& c : m_contacts) {
         m_active.push_back(c);
-        if (m_params.margin > 0 && c.tet >= 0 && c.depth > 0) m_active.back().depth += m_proximity.margin(c.vertex);
+        if (c.tet >= 0 && c.depth > 0) m_active.back().depth += m_proximity.margin(c.vertex); // 0 without margin
     }
     m_active.insert(m_active.end(), m_near.begin(), m_near.end());
     const std::vector<Contact>& active = m_active;

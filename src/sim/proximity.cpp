@@ -50,7 +50,6 @@ void Proximity::setup(const TetMesh& mesh, const Positions& rest, const Model& m
                       double reach_edges)
 {
     m_speculative = speculative;
-    m_mesh = &mesh;
     m_model = &model;
     m_rest = rest;
     m_faces.clear();
@@ -166,15 +165,15 @@ void Proximity::motion(const Positions& v, double h)
     const std::vector<char>& fixed = model.fixed;
     const size_t objects = m_margin.size();
     m_mean_v.assign(objects, Vec3::Zero());
-    std::vector<double> mass(objects, 0.0);
+    m_object_mass.assign(objects, 0.0);
     for (Index i = 0; i < v.rows(); ++i) {
         const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
         const double m = model.mass[static_cast<size_t>(i)];
         if (!fixed[static_cast<size_t>(i)]) m_mean_v[o] += m * v.row(i).transpose();
-        mass[o] += m;
+        m_object_mass[o] += m;
     }
     for (size_t o = 0; o < objects; ++o)
-        if (mass[o] > 0) m_mean_v[o] /= mass[o];
+        if (m_object_mass[o] > 0) m_mean_v[o] /= m_object_mass[o];
     m_pair_now.assign(objects * objects, 0.0);
     for (size_t a = 0; a < objects; ++a)
         for (size_t b = 0; b < objects; ++b)
@@ -183,15 +182,18 @@ void Proximity::motion(const Positions& v, double h)
                     m_speculative
                         ? std::min(radius_travel * (m_mean_v[a] - m_mean_v[b]).norm() * h, pair_edges * m_edge)
                         : 0.0;
+    // The widest pair term of each object, for its vertices' query boxes.
+    m_object_reach.assign(objects, 0.0);
+    for (size_t a = 0; a < objects; ++a)
+        for (size_t b = 0; b < objects; ++b)
+            if (a != b && !(m_static[a] && m_static[b]))
+                m_object_reach[a] = std::max(m_object_reach[a], m_pair_now[a * objects + b]);
     const double cap = radius_edges * m_edge;
     m_reach.resize(static_cast<size_t>(v.rows()));
-    m_radius = 0;
     for (Index i : m_vertices) {
         const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
         const double travel = fixed[static_cast<size_t>(i)] ? 0.0 : (v.row(i).transpose() - m_mean_v[o]).norm() * h;
-        const double reach = m_speculative ? std::min(radius_travel * travel, cap) : 0.0;
-        m_reach[static_cast<size_t>(i)] = reach;
-        m_radius = std::max(m_radius, reach);
+        m_reach[static_cast<size_t>(i)] = m_speculative ? std::min(radius_travel * travel, cap) : 0.0;
     }
 }
 
@@ -249,32 +251,12 @@ void Proximity::hash_faces(const Positions& x)
 void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
                        std::vector<Contact>& out)
 {
-    m_tested = 0;
     if (m_faces.empty()) return;
     motion(v, h);
     hash_faces(x);
     const Model& model = *m_model;
     const std::vector<char>& fixed = model.fixed;
     const size_t objects = m_margin.size();
-    std::vector<double> object_reach(objects, 0.0); // the widest pair term of each object, for the query boxes
-    for (size_t a = 0; a < objects; ++a)
-        for (size_t b = 0; b < objects; ++b)
-            if (a != b && !(m_static[a] && m_static[b]))
-                object_reach[a] = std::max(object_reach[a], m_pair_now[a * objects + b]);
-
-    // The objects a vertex is already inside (its penetration contacts answer for those).
-    auto inside_of = [&](Index p, Index object) {
-        const auto it = std::lower_bound(inside.begin(), inside.end(), p,
-                                         [](const Contact& c, Index vtx) { return c.vertex < vtx; });
-        for (auto c = it; c != inside.end() && c->vertex == p; ++c)
-            if (c->tet_object == object) return true;
-        return false;
-    };
-    auto inside_any = [&](Index p) {
-        const auto it = std::lower_bound(inside.begin(), inside.end(), p,
-                                         [](const Contact& c, Index vtx) { return c.vertex < vtx; });
-        return it != inside.end() && it->vertex == p;
-    };
     const double inv_cell = 1.0 / m_edge;
     std::vector<Best>& best = m_best;
     for (Index p : m_vertices) {
@@ -282,10 +264,10 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
         const Vec3 xp = x.row(p).transpose();
         const Vec3 rp = m_rest.row(p).transpose();
         const double r = m_reach[static_cast<size_t>(p)];
-        const double rq = r + object_reach[static_cast<size_t>(op)]; // the query box: any partner object
-        double clearance = std::numeric_limits<double>::infinity();  // squared distance to the nearest far face
-        // The local reach with a little slack for the single-precision spheres: a bucket or face wholly inside
-        // `local_reach` is local; one wholly beyond `far_reach` is not; between, the corners decide.
+        const double rq = r + m_object_reach[static_cast<size_t>(op)]; // the query box: any partner object
+        double clearance = std::numeric_limits<double>::infinity();    // squared distance to the nearest far face
+        // The local reach with a little slack for rounding: a face whose rest sphere lies wholly inside
+        // `local_reach` is local; one wholly beyond `far_reach` is not; between, its corners decide.
         const double reach2 = m_reach2[static_cast<size_t>(op)];
         const double local_reach = reach2 > 0 ? std::sqrt(reach2) * (1 - 1e-5) : -1.0;
         const double far_reach = reach2 > 0 ? std::sqrt(reach2) * (1 + 1e-5) : -1.0;
@@ -312,14 +294,17 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
                             (qhi[2] < b.lo[2]) | (qlo[2] > b.hi[2]))
                             continue;
                         const std::int32_t f = b.face;
-                        bool near_rest = false; // within the local reach in the rest state: decided below
                         const Face& fc = m_faces[static_cast<size_t>(f)];
+                        bool near_rest = false; // the corners decide whether the face is local (below)
                         if (fc.object == op) {
+                            if (reach2 < 0) continue; // self-collision off
                             // Squared: dr + radius < local_reach, dr − radius < far_reach (dr the centre's distance).
                             const double dr2 = (fc.rest_centre - rp).squaredNorm();
                             const double inner = local_reach - fc.rest_radius, outer = far_reach + fc.rest_radius;
                             if (inner > 0 && dr2 < inner * inner) continue; // every corner near: local
                             near_rest = dr2 < outer * outer;
+                        } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
+                            continue;
                         }
                         if (!one_cell) {
                             if (m_stamp[static_cast<size_t>(f)] == p) continue;
@@ -329,18 +314,12 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
                         if (fixed[static_cast<size_t>(p)] && fixed[static_cast<size_t>(fc.v[0])] &&
                             fixed[static_cast<size_t>(fc.v[1])] && fixed[static_cast<size_t>(fc.v[2])])
                             continue;
-                        if (op == fc.object) {
-                            const double reach2 = m_reach2[static_cast<size_t>(op)];
-                            if (reach2 < 0) continue;
+                        if (near_rest) {
                             bool local = false;
-                            if (near_rest)
-                                for (Index c : fc.v)
-                                    local = local || (m_rest.row(c).transpose() - rp).squaredNorm() < reach2;
+                            for (Index c : fc.v)
+                                local = local || (m_rest.row(c).transpose() - rp).squaredNorm() < reach2;
                             if (local) continue;
-                        } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
-                            continue;
                         }
-                        ++m_tested;
                         const Vec3 a = x.row(fc.v[0]).transpose(), bb = x.row(fc.v[1]).transpose(),
                                    c = x.row(fc.v[2]).transpose();
                         const Vec3 q = closest_point_on_triangle(xp, a, bb, c);
@@ -367,14 +346,21 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
                     }
                 }
         std::sort(best.begin(), best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
+        // The vertex's penetration contacts (`inside` is sorted by vertex): the objects it is inside answer for it.
+        const auto in_begin = std::lower_bound(inside.begin(), inside.end(), p,
+                                               [](const Contact& c, Index vtx) { return c.vertex < vtx; });
+        auto in_end = in_begin;
+        while (in_end != inside.end() && in_end->vertex == p)
+            ++in_end;
         // The vertex's margin never exceeds the clearance it has had: a body that starts nearer than the margin to
         // another (stacked, resting, touching) is not pushed apart by it; the margin grows back as it separates.
-        if (inside_any(p)) clearance = 0; // penetrating: no clearance at all
+        if (in_begin != in_end) clearance = 0; // penetrating: no clearance at all
         double& vm = m_vertex_margin[static_cast<size_t>(p)];
         const double full = m_margin[static_cast<size_t>(op)];
         vm = std::min(full, m_first ? std::sqrt(clearance) : std::max(vm, std::sqrt(clearance)));
         for (const Best& bs : best)
-            if (!inside_of(p, bs.object)) out.push_back(margin_contact(x, p, op, bs.object, bs.face, bs.dist, bs.q));
+            if (std::none_of(in_begin, in_end, [&](const Contact& c) { return c.tet_object == bs.object; }))
+                out.push_back(margin_contact(x, p, op, bs.object, bs.face, bs.dist, bs.q));
     }
     m_first = false;
 }

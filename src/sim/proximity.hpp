@@ -40,9 +40,6 @@ class Proximity {
     /// The margin δ (length) of vertex p: its object's, or less where it has never been that far from a far face
     /// (see update).
     double margin(Index p) const;
-    /// The largest vertex reach of the last update.
-    double radius() const { return m_radius; }
-    std::int64_t pairs_tested() const { return m_tested; }
 
   private:
     struct Face {
@@ -67,7 +64,6 @@ class Proximity {
     Contact margin_contact(const Positions& x, Index p, Index op, Index object, Index face, double dist,
                            const Eigen::Vector3d& q) const;
 
-    const TetMesh* m_mesh = nullptr;
     const Model* m_model = nullptr;
     Positions m_rest;
     std::vector<Face> m_faces;
@@ -80,12 +76,12 @@ class Proximity {
     bool m_speculative = true;
     bool m_first = true;                 ///< the next update is the first: it sets the start clearances
     std::vector<double> m_vertex_margin; ///< per vertex: min(object margin, largest clearance so far)
-    double m_radius = 0;
-    std::int64_t m_tested = 0;
     // Motion of the substep.
     std::vector<double> m_reach;           ///< per vertex: 1.5 × its travel relative to its object, clamped
     std::vector<Eigen::Vector3d> m_mean_v; ///< per object: mass-weighted mean velocity
+    std::vector<double> m_object_mass;     ///< per object (scratch of motion)
     std::vector<double> m_pair_now;        ///< objects²: how far two objects may close on each other in h
+    std::vector<double> m_object_reach;    ///< per object: its widest m_pair_now, for its vertices' query boxes
     // Scratch kept between calls: face boxes, the grid (counting-sorted by bucket), per-face stamps.
     struct Cell {
         float lo[3], hi[3]; ///< the face's box grown by its reach and the largest margin
