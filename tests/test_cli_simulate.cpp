@@ -150,15 +150,15 @@ TEST(CliSimulate, ExplicitStabilityWarningIsPrintedUpFront)
 
 TEST(CliSimulate, BlowUpWithinSubstepsIsARunFailureNamingTheStep)
 {
-    // Diverges within a step of 2 substeps: must exit 1 (run failure) naming step and substep, not 2 (a
-    // detector error about the grid), keep the frames written so far, and never write a NaN frame.
+    // Diverges within the second step of 3 substeps (19× its explicit limit): must exit 1 (run failure) naming step and
+    // substep, not 2 (a detector error about the grid), keep the frames written so far, and never write a NaN frame.
     const auto dir = temp_dir();
     std::string text = kSmall;
     text.replace(text.find("every = 2"), 9, "every = 1");
     write_text(dir / "s.toml", text);
     const auto r =
         run_tethash("simulate " + quote(dir / "s.toml") +
-                    " --integrator symplectic_euler --dt 0.01 --substeps 2 --steps 100 --out " + quote(dir / "out"));
+                    " --integrator symplectic_euler --dt 0.014 --substeps 3 --steps 100 --out " + quote(dir / "out"));
     EXPECT_EQ(r.status, 1) << r.out << r.err;
     EXPECT_NE(r.err.find("blew up at step "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find(", substep "), std::string::npos) << r.err;

@@ -119,7 +119,7 @@ TEST(SimFriction, ContactFrictionOnAStaticObstacle)
     EXPECT_LT(high, 0.05);
 }
 
-TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
+TEST(SimContactStiffness, FollowsTheSofterMaterialAndTheEffectiveMass)
 {
     Scene s;
     ObjectSpec cushion = box_object(Eigen::Vector3d(1.0, 1.0, 0.3), {0, 0, 0.15}, 3);
@@ -134,24 +134,26 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
     s.integrator = Integrator::implicit_euler;
     s.output.every = 0;
     Simulation sim(s);
-    auto stiffest = [&](int k) {
-        double m = 0;
-        const auto [first, count] = sim.object_vertices(k);
-        const Edges& e = sim.model().springs.edges;
-        for (Index q = 0; q < e.rows(); ++q)
-            if (e(q, 0) >= first && e(q, 0) < first + count)
-                m = std::max(m, sim.model().springs.k[static_cast<size_t>(q)]);
-        return m;
-    };
-    const double k_soft = stiffest(0), k_hard = stiffest(1);
-    ASSERT_GT(k_hard, 100 * k_soft);
-    // Steel on cushion: bounded by twice the soft side, far below the steel's own scale.
-    EXPECT_LE(sim.contact_stiffness(0, 1), 20 * k_soft);
-    EXPECT_GT(sim.contact_stiffness(0, 1), 10 * k_soft);
-    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 1), sim.contact_stiffness(1, 0));
-    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 2), 10 * k_soft); // static partner: as stiff as the cushion
-    EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 1), 10 * k_hard);
-    EXPECT_THROW(sim.contact_stiffness(0, 3), Error);
+    // ω² = young / (density · mean edge²) per object.
+    const auto& w2 = sim.model().object_frequency_sq;
+    ASSERT_EQ(w2.size(), 3U);
+    for (int o = 0; o < 2; ++o) {
+        const sim::Material& mat = s.objects[static_cast<size_t>(o)].material;
+        const double lbar = sim.model().object_mean_edge[static_cast<size_t>(o)];
+        EXPECT_NEAR(w2[static_cast<size_t>(o)], mat.young / (mat.density * lbar * lbar), 1e-9 * w2[0]);
+    }
+    EXPECT_EQ(w2[2], 0.0); // static
+    ASSERT_GT(w2[1], 2 * w2[0]);
+    // Steel on cushion: the softer (the cushion's) frequency, whichever side is the vertex; proportional to the
+    // effective mass.
+    const double m = 0.01;
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 1, m), 50 * w2[0] * m);
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 0, m), sim.contact_stiffness(0, 1, m));
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(0, 1, 2 * m), 2 * sim.contact_stiffness(0, 1, m));
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 2, m), 50 * w2[1] * m); // static partner: the steel's own
+    EXPECT_DOUBLE_EQ(sim.contact_stiffness(1, 1, m), 50 * w2[1] * m);
+    EXPECT_THROW(sim.contact_stiffness(0, 3, m), Error);
+    EXPECT_THROW(sim.contact_stiffness(0, 1, -1.0), Error);
 
     // The steel block settles on the cushion (implicit Euler, automatic stiffness): finite, no energy
     // gain, shallow penetration.
@@ -167,8 +169,8 @@ TEST(SimContactStiffness, FollowsTheSofterObjectOfThePair)
 
     s.contact.stiffness = 123.0; // given: used for every pair
     Simulation fixed(s);
-    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(0, 1), 123.0);
-    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(1, 1), 123.0);
+    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(0, 1, m), 123.0);
+    EXPECT_DOUBLE_EQ(fixed.contact_stiffness(1, 1, 5 * m), 123.0);
 }
 
 TEST(SimBlowUp, CaughtWithinTheStepBeforeDetectionFails)

@@ -37,12 +37,9 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
     m_rest = mesh.rest();
     m_params = scene.contact;
     m_mu = scene.contact.friction;
-    m_object_k.assign(scene.objects.size() + num_obstacles, 0.0); // obstacles: static, no springs
-    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
-        double& ko =
-            m_object_k[static_cast<size_t>(model.vertex_object[static_cast<size_t>(model.springs.edges(e, 0))])];
-        ko = std::max(ko, model.springs.k[static_cast<size_t>(e)]);
-    }
+    m_object_rate.assign(scene.objects.size() + num_obstacles, 0.0); // obstacles: static
+    for (size_t o = 0; o < model.object_frequency_sq.size() && o < m_object_rate.size(); ++o)
+        m_object_rate[o] = contact_rate_factor * model.object_frequency_sq[o];
     int dynamic_objects = 0;
     bool self = false;
     for (const ObjectSpec& o : scene.objects) {
@@ -64,17 +61,17 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
     }
 }
 
-double ContactResponse::pair_stiffness(Index a, Index b) const
+double ContactResponse::pair_stiffness(Index a, Index b, double m_eff) const
 {
-    // 10 × the harmonic mean of the stiffest springs of the two objects: dominated by the softer one, so a
-    // very stiff object pressing on a soft one gets a contact about as stiff as the soft one can bear. A static
-    // object (no springs) counts as stiff as its partner.
+    // contact_rate_factor × the softer material's ω² × the contact's effective mass: the contact's own frequency
+    // is a fixed multiple of the softer object's at its mean edge, whatever the two vertices weigh (a sliver's
+    // light vertex gets a soft penalty, a heavy one a stiff one), so it adds a fixed share to every vertex's
+    // stiffness-to-mass ratio and never sets the explicit limit. A static object takes its partner's.
     if (m_params.stiffness > 0) return m_params.stiffness;
-    double ka = m_object_k[static_cast<size_t>(a)], kb = m_object_k[static_cast<size_t>(b)];
-    if (!(ka > 0)) ka = kb;
-    if (!(kb > 0)) kb = ka;
-    if (!(ka > 0)) return 1e4; // two objects without springs (cannot happen for a contact the detector reports)
-    return 10 * 2 * ka * kb / (ka + kb);
+    double ra = m_object_rate[static_cast<size_t>(a)], rb = m_object_rate[static_cast<size_t>(b)];
+    if (!(ra > 0)) ra = rb;
+    if (!(rb > 0)) rb = ra;
+    return std::min(ra, rb) * m_eff;
 }
 
 void ContactResponse::update(const Positions& x, const Positions& v, double h, StepStats& stats)
@@ -143,20 +140,15 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     m_weight.assign(nc, 1.0);
     for (size_t q = 0; q < nc; ++q) {
         const Contact& c = active[q];
-        m_k[q] = pair_stiffness(c.vertex_object, c.tet_object);
-        // Reduced mass of the vertex and the penetrated tet's point (fixed vertices have infinite mass).
-        const double inv_v =
-            model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
-        double mt = 0;
-        bool tet_fixed = c.tet < 0; // an obstacle
+        // Effective mass of the contact: 1 / (1/m_v + Σ b_j² / m_j), the mass the penalty's direction sees when
+        // the tet's point is x = Σ b_j x_j (fixed vertices and obstacles: infinite mass).
+        double inv = model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
         for (int k = 0; k < 4 && c.tet >= 0; ++k) {
             const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
-            if (model.fixed[j] && c.bary[k] > 0.25) tet_fixed = true;
-            mt += c.bary[k] * model.mass[j];
+            if (!model.fixed[j]) inv += c.bary[k] * c.bary[k] / model.mass[j];
         }
-        const double inv_t = tet_fixed || !(mt > 0) ? 0.0 : 1.0 / mt;
-        const double inv = inv_v + inv_t;
         m_mred[q] = inv > 0 ? 1.0 / inv : 0.0;
+        m_k[q] = pair_stiffness(c.vertex_object, c.tet_object, m_mred[q]);
         m_c[q] = m_params.damping > 0 ? m_params.damping : std::sqrt(m_k[q] * m_mred[q]);
     }
     // Weight: a vertex inside k tets of one object (on shared faces) gets 1/k of the response from each.

@@ -18,10 +18,16 @@
 
 namespace tethash::sim {
 
+/// Automatic contact and ground penalties: k = contact_rate_factor · ω² · m_eff, ω² the softer object's
+/// Model::object_frequency_sq and m_eff the contact's effective mass (the vertex's own mass for the ground). A
+/// contact then vibrates at √50 ≈ 7 ω whatever its vertices weigh: about as stiff as the former 10 × the
+/// stiffest spring on a graded mesh's typical vertex, softer on its light ones.
+inline constexpr double contact_rate_factor = 50;
+
 class ContactResponse {
   public:
-    /// Builds the detector and penetration topology when some pair of objects can collide; stiffest spring per
-    /// object for the automatic contact stiffness.
+    /// Builds the detector and penetration topology when some pair of objects can collide; the automatic
+    /// penalty per object.
     /// `obstacles` (kept, may be null): static BSP obstacles whose contacts join the tet contacts (tet −1).
     void setup(const Scene& scene, const TetMesh& mesh, const Model& model, const std::vector<ObjectOptions>& options,
                const SceneObstacles* obstacles = nullptr);
@@ -32,8 +38,9 @@ class ContactResponse {
     /// to `stats` (ms_detect, ms_depth, ms_response).
     void update(const Positions& x, const Positions& v, double h, StepStats& stats);
 
-    /// Contact penalty stiffness between a vertex of object a and a tet of object b (see simulation.hpp).
-    double pair_stiffness(Index a, Index b) const;
+    /// Contact penalty stiffness between a vertex of object a and a tet of object b whose contact has effective
+    /// mass m_eff (see simulation.hpp).
+    double pair_stiffness(Index a, Index b, double m_eff) const;
 
     /// The vertices inside tets (sorted by vertex, tet; then the obstacles'), with their penetration depth and
     /// direction.
@@ -87,7 +94,7 @@ class ContactResponse {
     Proximity m_proximity;
     std::vector<Contact> m_contacts, m_near, m_active;
     std::vector<double> m_weight, m_k, m_c, m_mred;
-    std::vector<double> m_object_k; // stiffest spring per object (0: static)
+    std::vector<double> m_object_rate; // automatic penalty per unit effective mass per object (0: static)
     double m_mu = 0;
     std::int64_t m_ignored_local = 0;
 };

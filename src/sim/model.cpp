@@ -40,6 +40,30 @@ double regular_tet_volume(double l)
     return l * l * l / (6.0 * std::sqrt(2.0));
 }
 
+/// Per-vertex Gershgorin sums of the stiffness (Σ |K_ij| over the block row) and damping.
+void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, std::vector<double>& csum)
+{
+    const size_t n = m.mass.size();
+    ksum.assign(n, 0.0);
+    csum.assign(n, 0.0);
+    for (Index e = 0; e < m.springs.edges.rows(); ++e) {
+        for (int s = 0; s < 2; ++s) {
+            ksum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.k[static_cast<size_t>(e)];
+            csum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.c[static_cast<size_t>(e)];
+        }
+    }
+    Eigen::Matrix<double, 4, 3> g;
+    for (Index t = 0; t < m.volumes.tets.rows(); ++t) {
+        volume_and_gradient(x, &m.volumes.tets(t, 0), g);
+        const double s = m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)];
+        double total = 0;
+        for (int a = 0; a < 4; ++a)
+            total += g.row(a).norm();
+        for (int a = 0; a < 4; ++a)
+            ksum[static_cast<size_t>(m.volumes.tets(t, a))] += s * g.row(a).norm() * total;
+    }
+}
+
 } // namespace
 
 Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
@@ -148,7 +172,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     m.springs.c.resize(static_cast<size_t>(ne));
     m.object_mean_edge.assign(static_cast<size_t>(objects), 0.0);
     std::vector<double> edge_count(static_cast<size_t>(objects), 0.0);
-    std::vector<double> vertex_edge_sum(static_cast<size_t>(n), 0.0), vertex_edge_count(static_cast<size_t>(n), 0.0);
+    std::vector<double> vertex_edge_count(static_cast<size_t>(n), 0.0);
     for (Index e = 0; e < ne; ++e) {
         const Index i = m.springs.edges(e, 0), j = m.springs.edges(e, 1);
         const double len = (row(rest, i) - row(rest, j)).norm();
@@ -163,34 +187,53 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         m.springs.c[static_cast<size_t>(e)] = mat.damping * k;
         m.object_mean_edge[static_cast<size_t>(o)] += len;
         edge_count[static_cast<size_t>(o)] += 1;
-        for (Index v : {i, j}) {
-            vertex_edge_sum[static_cast<size_t>(v)] += len;
+        for (Index v : {i, j})
             vertex_edge_count[static_cast<size_t>(v)] += 1;
-        }
     }
     for (size_t o = 0; o < m.object_mean_edge.size(); ++o)
         if (edge_count[o] > 0) m.object_mean_edge[o] /= edge_count[o];
 
-    // Mass floor: a vertex whose tets are all slivers lumps almost no mass while its edges are ordinary; it then
-    // sets the explicit limit and stalls the iterative solvers. Each free vertex gets at least a quarter of the
-    // volume of a tenth-size regular tet of its mean edge (the same V̂ floor as the volume term); the total mass
-    // of each object is then scaled back to density × volume.
+    // Mass floor at the material's step: a vertex whose tets are all slivers lumps almost no mass while its
+    // springs and volume terms are ordinary; it would then set the explicit limit and condition the solvers.
+    // Each object has a wave speed c = sqrt(young / density) and a frequency ω = c / L̄ at its mean edge L̄
+    // (object_frequency_sq); every free vertex gets at least the mass that keeps its Gershgorin bound of
+    // stiffness / mass at (2 / h_m)², h_m = material_courant / ω, so no vertex's explicit limit falls below
+    // h_m whatever the tets' shapes. The mass the floor adds (0.13 % of the hand, 7 % of its vertices) is taken
+    // back from the vertices above the floor, so each object keeps density × volume.
+    m.object_frequency_sq.assign(static_cast<size_t>(objects), 0.0);
+    for (Index o = 0; o < objects; ++o) {
+        const double lbar = m.object_mean_edge[static_cast<size_t>(o)];
+        if (is_static(o) || !(lbar > 0)) continue;
+        const Material& mat = material(o);
+        const double young = mat.stiffness > 0 ? mat.stiffness / lbar : mat.young;
+        m.object_frequency_sq[static_cast<size_t>(o)] = young / (mat.density * lbar * lbar);
+    }
     {
-        std::vector<double> before(static_cast<size_t>(objects), 0.0), after(static_cast<size_t>(objects), 0.0);
+        std::vector<double> ksum, csum;
+        gershgorin(m, rest, ksum, csum);
+        std::vector<double> total(static_cast<size_t>(objects), 0.0), floored(static_cast<size_t>(objects), 0.0);
+        std::vector<double> above(static_cast<size_t>(objects), 0.0);
+        std::vector<char> at_floor(static_cast<size_t>(n), 0);
         for (Index i = 0; i < n; ++i) {
             const size_t u = static_cast<size_t>(i);
-            const Index o = m.vertex_object[u];
+            const size_t o = static_cast<size_t>(m.vertex_object[u]);
             if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
-            before[static_cast<size_t>(o)] += m.mass[u];
-            const double floor =
-                material(o).density * 0.25 * 0.1 * regular_tet_volume(vertex_edge_sum[u] / vertex_edge_count[u]);
-            m.mass[u] = std::max(m.mass[u], floor);
-            after[static_cast<size_t>(o)] += m.mass[u];
+            total[o] += m.mass[u];
+            const double floor = ksum[u] * material_courant * material_courant / (4 * m.object_frequency_sq[o]);
+            if (floor > m.mass[u]) {
+                m.mass[u] = floor;
+                at_floor[u] = 1;
+                floored[o] += floor;
+            } else {
+                above[o] += m.mass[u];
+            }
         }
         for (Index i = 0; i < n; ++i) {
             const size_t u = static_cast<size_t>(i);
             const size_t o = static_cast<size_t>(m.vertex_object[u]);
-            if (!m.fixed[u] && vertex_edge_count[u] > 0 && after[o] > 0) m.mass[u] *= before[o] / after[o];
+            if (m.fixed[u] || !(vertex_edge_count[u] > 0) || at_floor[u]) continue;
+            // Floors holding more than 90 % of an object's mass (none on the shared meshes) add mass instead.
+            if (above[o] > 0 && total[o] - floored[o] > 0.1 * total[o]) m.mass[u] *= (total[o] - floored[o]) / above[o];
         }
     }
     for (Index i = 0; i < n; ++i)
@@ -277,32 +320,6 @@ Energy Model::energy(const Positions& x, const Positions& v) const
     }
     return en;
 }
-
-namespace {
-/// Per-vertex Gershgorin sums of the stiffness (Σ |K_ij| over the block row) and damping.
-void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, std::vector<double>& csum)
-{
-    const size_t n = m.mass.size();
-    ksum.assign(n, 0.0);
-    csum.assign(n, 0.0);
-    for (Index e = 0; e < m.springs.edges.rows(); ++e) {
-        for (int s = 0; s < 2; ++s) {
-            ksum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.k[static_cast<size_t>(e)];
-            csum[static_cast<size_t>(m.springs.edges(e, s))] += 2 * m.springs.c[static_cast<size_t>(e)];
-        }
-    }
-    Eigen::Matrix<double, 4, 3> g;
-    for (Index t = 0; t < m.volumes.tets.rows(); ++t) {
-        volume_and_gradient(x, &m.volumes.tets(t, 0), g);
-        const double s = m.volumes.k[static_cast<size_t>(t)] / m.volumes.rest[static_cast<size_t>(t)];
-        double total = 0;
-        for (int a = 0; a < 4; ++a)
-            total += g.row(a).norm();
-        for (int a = 0; a < 4; ++a)
-            ksum[static_cast<size_t>(m.volumes.tets(t, a))] += s * g.row(a).norm() * total;
-    }
-}
-} // namespace
 
 double Model::omega_max_sq(const Positions& x) const
 {

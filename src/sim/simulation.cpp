@@ -27,24 +27,22 @@ double ms_since(Clock::time_point t0)
 }
 
 /// Explicit stability limit of the model with, per vertex, the stiffer of its stiffest possible contact and the
-/// ground (with their damping).
+/// ground (with their damping). A contact's effective mass is at most the vertex's own.
 double estimate_dt_limit(const Scene& scene, const Model& model, const TetMesh& mesh, const ContactResponse& contacts)
 {
     const Index n = mesh.num_vertices();
     std::vector<double> extra_k(static_cast<size_t>(n), 0.0), extra_c(static_cast<size_t>(n), 0.0);
     const Index nobj = static_cast<Index>(scene.objects.size());
-    std::vector<double> obj_contact_k(static_cast<size_t>(nobj), 0.0);
-    if (contacts.enabled())
-        for (Index a = 0; a < nobj; ++a)
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const Index a = model.vertex_object[u];
+        double k = 0;
+        if (contacts.enabled())
             for (Index b = 0; b < nobj; ++b)
                 if ((a != b || scene.objects[static_cast<size_t>(a)].self_collision) &&
                     !(scene.objects[static_cast<size_t>(a)].is_static &&
                       scene.objects[static_cast<size_t>(b)].is_static))
-                    obj_contact_k[static_cast<size_t>(a)] =
-                        std::max(obj_contact_k[static_cast<size_t>(a)], contacts.pair_stiffness(a, b));
-    for (Index i = 0; i < n; ++i) {
-        const size_t u = static_cast<size_t>(i);
-        double k = obj_contact_k[static_cast<size_t>(model.vertex_object[u])];
+                    k = std::max(k, contacts.pair_stiffness(a, b, model.mass[u]));
         if (model.ground.enabled) k = std::max(k, model.ground_k_at(i));
         extra_k[u] = k;
         extra_c[u] =
@@ -124,8 +122,8 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
 
 void SimulationImpl::automatic_ground()
 {
-    // Automatic ground stiffness per vertex = the contact stiffness of its object against a partner as stiff as
-    // itself (10 × its stiffest spring), automatic damping per vertex sqrt(k m) (half critical).
+    // Automatic ground stiffness per vertex = a contact of its object with itself whose effective mass is the
+    // vertex's (contact_rate_factor ω² m), automatic damping per vertex sqrt(k m) (half critical).
     const Index n = mesh().num_vertices();
     if (!model.ground.enabled || (model.ground.stiffness > 0 && model.ground.damping > 0)) return;
     model.ground_k.assign(static_cast<size_t>(n), model.ground.stiffness);
@@ -133,7 +131,7 @@ void SimulationImpl::automatic_ground()
     for (Index i = 0; i < n; ++i) {
         const Index o = model.vertex_object[static_cast<size_t>(i)];
         double& k = model.ground_k[static_cast<size_t>(i)];
-        if (!(k > 0)) k = scene.contact.stiffness > 0 ? scene.contact.stiffness : contacts.pair_stiffness(o, o);
+        if (!(k > 0)) k = contacts.pair_stiffness(o, o, model.mass[static_cast<size_t>(i)]);
         double& c = model.ground_c[static_cast<size_t>(i)];
         if (!(c > 0)) c = std::sqrt(k * model.mass[static_cast<size_t>(i)]);
     }
@@ -335,13 +333,15 @@ void Simulation::refresh_contacts()
     m_impl->contacts.update(m_impl->mesh().positions, m_impl->v, m_impl->scene.dt / m_impl->scene.substeps, st);
 }
 
-double Simulation::contact_stiffness(int a, int b) const
+double Simulation::contact_stiffness(int a, int b, double effective_mass) const
 {
     const int n = static_cast<int>(m_impl->scene.objects.size());
     if (a < 0 || a >= n || b < 0 || b >= n)
         throw Error("contact_stiffness: object index out of range (" + std::to_string(a) + ", " + std::to_string(b) +
                     "; " + std::to_string(n) + " objects)");
-    return m_impl->contacts.pair_stiffness(a, b);
+    if (!(effective_mass >= 0) || !std::isfinite(effective_mass))
+        throw Error("contact_stiffness: effective mass must be finite and ≥ 0, got " + std::to_string(effective_mass));
+    return m_impl->contacts.pair_stiffness(a, b, effective_mass);
 }
 
 const StepStats& Simulation::last_stats() const

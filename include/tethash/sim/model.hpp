@@ -9,8 +9,10 @@
 /// edge) / (rest length)², so a sliver (small volume) gets a small spring and a big tet a stiff one; under a
 /// uniform dilation the springs then store the bulk energy of a linear-elastic solid of Poisson ratio 1/4 on any
 /// mesh. Masses are lumped from the same volumes, so the stiffness-to-mass ratio of a vertex is ≈ 12 young /
-/// (density · edge²) whatever the tets' shapes; vertices whose lumped mass is tiny against their edges (all
-/// their tets slivers) get a floor (see Model::build).
+/// (density · edge²) whatever the tets' shapes; vertices whose lumped mass is tiny against their springs and
+/// volume terms (all their tets slivers) get a floor that keeps every vertex's explicit limit at or above
+/// material_courant · L̄ / c (c = sqrt(young / density) the wave speed, L̄ the object's mean edge): the explicit
+/// limit is the material's, not the worst sliver's (see Model::build).
 
 #include "tethash/mesh.hpp"
 
@@ -37,7 +39,7 @@ struct Ground {
     Eigen::Vector3d normal{0, 0, 1}; ///< normalised on load
     double height = 0;
     double stiffness = 0;  ///< penalty stiffness per vertex (force / length); 0 = automatic per vertex:
-                           ///< contact.stiffness if given, else 10 × the stiffest spring of its object
+                           ///< contact.stiffness if given, else 50 ω² m (ω² its object's object_frequency_sq)
     double damping = 0;    ///< normal damping (force · s / length); 0 = per vertex sqrt(k · m) (half critical)
     double friction = 0.5; ///< Coulomb coefficient
 };
@@ -62,14 +64,22 @@ struct Energy {
     double internal() const { return kinetic + spring + volume + ground + contact; } ///< all ≥ 0
 };
 
+/// Mass floor of Model::build: no free vertex's explicit limit (Gershgorin, springs and volume terms) below
+/// material_courant / ω of its object. A regular mesh's is ≈ 0.2 / ω (a BCC lattice: 0.196), so only vertices
+/// whose tets are much worse than regular are floored.
+inline constexpr double material_courant = 0.1;
+
 /// Everything computed once from the rest state.
 struct Model {
     Springs springs;
     VolumeTerms volumes;
     std::vector<Index> vertex_object;     ///< n: object of each vertex
     std::vector<double> object_mean_edge; ///< per object: mean rest length of its unique edges (0: static)
-    std::vector<double> mass;             ///< n lumped masses (static objects: their own mass, unused)
-    std::vector<char> fixed;              ///< n: 1 = pinned or static (never moves)
+    /// Per object: ω² = young / (density · L̄²), the material's frequency squared at its mean edge (1/s²; 0:
+    /// static). Mass floors and automatic contact penalties are set from it.
+    std::vector<double> object_frequency_sq;
+    std::vector<double> mass; ///< n lumped masses (static objects: their own mass, unused)
+    std::vector<char> fixed;  ///< n: 1 = pinned or static (never moves)
     Eigen::Vector3d gravity{0, 0, 0};
     Ground ground;
     /// Per-vertex ground penalty stiffness and damping (n each); empty: ground.stiffness / ground.damping

@@ -67,10 +67,10 @@ struct PinRegion {
 /// Contact response: penalty force f = k·d·r − c·(v_rel·r) r on the vertex, minus that with barycentric
 /// weights on the four vertices of the penetrated tet.
 struct ContactParams {
-    double stiffness = 0;  ///< force / length; 0 = automatic per pair of objects a, b: 10 × the harmonic mean
-                           ///< of their stiffest springs (a static object counts as stiff as its partner)
-    double damping = 0;    ///< force · s / length; 0 = automatic per contact: sqrt(k · reduced mass) (half critical)
-    double friction = 0;   ///< Coulomb coefficient (0: off)
+    double stiffness = 0; ///< force / length; 0 = automatic per contact: 50 × the softer object's ω² (young /
+                          ///< (density · mean edge²)) × the contact's effective mass (Simulation::contact_stiffness)
+    double damping = 0;   ///< force · s / length; 0 = automatic per contact: sqrt(k · effective mass) (half critical)
+    double friction = 0;  ///< Coulomb coefficient (0: off)
     bool in_matrix = true; ///< implicit Euler: contact stiffness in the system matrix
     /// A vertex nearer than margin × (mean edge of its object or the other's, the larger) to a far boundary face is
     /// pushed before it enters (0: only vertices inside tets are pushed). Penetrated vertices are pushed with their

@@ -90,10 +90,12 @@ class Simulation {
     /// Runs detection + penetration at the current positions (updates contacts()).
     void refresh_contacts();
 
-    /// Contact penalty stiffness (force / length) used between a vertex of object `a` and a tet of object `b`:
-    /// scene().contact.stiffness when set, else 10 × the harmonic mean of the two objects' stiffest springs
-    /// (a static object counts as stiff as its partner). Damping per contact: sqrt(k · reduced mass).
-    double contact_stiffness(int a, int b) const;
+    /// Contact penalty stiffness (force / length) used between a vertex of object `a` and a tet of object `b`
+    /// when the contact's effective mass is `effective_mass` (1 / (1/m_vertex + Σ b_j² / m_j) over the tet's
+    /// corners j with barycentric weights b_j): scene().contact.stiffness when set, else 50 × the softer
+    /// object's Model::object_frequency_sq × effective_mass (a static object takes its partner's), so that no
+    /// contact's stiffness-to-mass ratio depends on the mesh. Damping per contact: sqrt(k · effective mass).
+    double contact_stiffness(int a, int b, double effective_mass) const;
 
     const StepStats& last_stats() const;
     /// Explicit stability limit 2/ω_max of the model (s); a warning is issued when dt/substeps exceeds it
