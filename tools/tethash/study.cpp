@@ -273,7 +273,9 @@ Registrar reg{
          sub.add_option("--to", a->to, "range end");
          sub.add_option("--points", a->points, "number of log-spaced points");
          sub.add_option("--integrator", a->o.integrator,
-                        "integrators: vbd, implicit_euler, symplectic_euler, all (default: all)");
+                        "integrators: vbd, implicit_euler, symplectic_euler, all; a list 'vbd,symplectic_euler' "
+                        "(default: all)")
+             ->delimiter(',');
          sub.add_option("--dt", a->o.dt,
                         "time steps in s (list, FROM:TO:POINTS, xF = F x the scene's dt; default: x0.25:x4:5; "
                         "stability: 1e-3,1/240,1/60 where xF = F x 1/240)");
