@@ -15,9 +15,9 @@ module tethash
   integer(c_int), parameter :: TETHASH_ERROR_STATE = 3
   integer(c_int), parameter :: TETHASH_ERROR_OUT_OF_MEMORY = 4
   integer(c_int), parameter :: TETHASH_ERROR_INTERNAL = 5
-  integer(c_int), parameter :: TETHASH_CELL_SIZE_AUTO = 0, TETHASH_CELL_SIZE_ABSOLUTE = 1, &
+  integer(c_int32_t), parameter :: TETHASH_CELL_SIZE_AUTO = 0, TETHASH_CELL_SIZE_ABSOLUTE = 1, &
                                TETHASH_CELL_SIZE_FACTOR = 2
-  integer(c_int), parameter :: TETHASH_HASH_COLUMN = 0, TETHASH_HASH_TESCHNER = 1
+  integer(c_int32_t), parameter :: TETHASH_HASH_COLUMN = 0, TETHASH_HASH_TESCHNER = 1
 
   type, bind(C) :: tethash_contact
     integer(c_int32_t) :: vertex, tet, vertex_object, tet_object
@@ -44,9 +44,9 @@ module tethash
     end subroutine
     function tethash_detector_set_cell_size(detector, mode, value) bind(C, name="tethash_detector_set_cell_size") &
         result(status)
-      import :: c_ptr, c_int, c_double
+      import :: c_ptr, c_int, c_int32_t, c_double
       type(c_ptr), value :: detector
-      integer(c_int), value :: mode
+      integer(c_int32_t), value :: mode
       real(c_double), value :: value
       integer(c_int) :: status
     end function
@@ -65,9 +65,9 @@ module tethash
       integer(c_int) :: status
     end function
     function tethash_detector_set_hash(detector, hash) bind(C, name="tethash_detector_set_hash") result(status)
-      import :: c_ptr, c_int
+      import :: c_ptr, c_int, c_int32_t
       type(c_ptr), value :: detector
-      integer(c_int), value :: hash
+      integer(c_int32_t), value :: hash
       integer(c_int) :: status
     end function
     function tethash_detector_set_skin(detector, skin) bind(C, name="tethash_detector_set_skin") result(status)

@@ -26,6 +26,10 @@ program detect_fortran
 
   call ok(tethash_detector_create(d), "create")
   call ok(tethash_detector_set_threads(d, 1_c_int32_t), "set_threads")
+  ! Enumerations are int32 on both sides: the module's constants pass as they are.
+  call ok(tethash_detector_set_hash(d, TETHASH_HASH_TESCHNER), "set_hash")
+  call ok(tethash_detector_set_cell_size(d, TETHASH_CELL_SIZE_AUTO, 1d0), "set_cell_size")
+  call expect(tethash_detector_set_hash(d, 7_c_int32_t) == TETHASH_ERROR_INVALID_ARGUMENT, "hash 7 refused")
   call ok(tethash_detector_set_topology(d, tets, 2_c_int64_t, 8_c_int64_t, c_loc(vertex_object), &
                                         c_loc(tet_object)), "set_topology")
   call ok(tethash_detector_detect(d, x, 8_c_int64_t, count), "detect")
