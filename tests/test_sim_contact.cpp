@@ -153,6 +153,39 @@ TEST(SimContact, DistantPartsOfOneBodyCollide)
     }
 }
 
+TEST(SimQuality, FarSelfPenetrationsCountsFoldsThroughDistantPartsOnly)
+{
+    // One object of two unit boxes 4 apart in the rest state: a vertex of the upper box moved into the lower one
+    // is a fold through a distant part (it, and lower vertices its stretched tets now hold, count); one moved into
+    // its own box's middle is local (0). The counter kept across states gives what the one-call function gives.
+    meshing::GenerateParams g;
+    g.shape = "box";
+    g.resolution = 2;
+    TetMesh parts = meshing::generate(g);
+    parts.rest_positions.resize(0, 3);
+    TetMesh upper = parts;
+    upper.positions.col(2).array() += 4.0;
+    parts.append(upper);
+    parts.vertex_object.assign(static_cast<size_t>(parts.num_vertices()), 0);
+    parts.tet_object.assign(static_cast<size_t>(parts.num_tets()), 0);
+    const Positions start = parts.positions;
+    const Index half = parts.num_vertices() / 2;
+    FarSelfPenetrations far(parts, start);
+    EXPECT_EQ(far.count(parts.positions), 0);
+
+    TetMesh folded = parts;
+    folded.positions.row(half) = start.topRows(half).colwise().mean() + Eigen::RowVector3d(0.013, 0.021, 0.017);
+    const std::int64_t folds = count_far_self_penetrations(folded, start);
+    EXPECT_GE(folds, 1);
+    EXPECT_EQ(far.count(folded.positions), folds);
+
+    TetMesh local = parts;
+    local.positions.row(half) = start.bottomRows(half).colwise().mean() + Eigen::RowVector3d(0.013, 0.021, 0.017);
+    EXPECT_EQ(far.count(local.positions), 0);
+    EXPECT_EQ(count_far_self_penetrations(local, start), 0);
+    EXPECT_EQ(far.count(folded.positions), folds); // the same counter again
+}
+
 TEST(SimContact, StiffnessFrom1e1To1e9StaysFiniteAndBoundedWithImplicitEuler)
 {
     for (double young : {1e1, 1e3, 1e5, 1e7, 1e9}) {

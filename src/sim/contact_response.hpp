@@ -54,7 +54,7 @@ class ContactResponse {
     /// Whether active contact q is a margin contact (they follow the penetrating ones).
     bool is_margin(size_t q) const { return q >= m_contacts.size(); }
     std::int64_t ignored_local() const { return m_ignored_local; }
-    /// Per contact: weight (1 / contacts of the vertex with that object), stiffness, damping, reduced mass.
+    /// Per contact: weight (1 / contacts of the vertex with that object), stiffness, damping, effective mass.
     const std::vector<double>& weight() const { return m_weight; }
     const std::vector<double>& stiffness() const { return m_k; }
     const std::vector<double>& damping() const { return m_c; }

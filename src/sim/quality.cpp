@@ -20,21 +20,27 @@ std::int64_t count_inverted(const TetMesh& mesh, const PositionsRef& start)
 
 std::int64_t count_far_self_penetrations(const TetMesh& mesh, const PositionsRef& start, double reach)
 {
-    Detector det(DetectParams{});
-    DetectParams p;
-    p.threads = 1;
-    det.set_params(p);
-    det.set_topology(mesh);
-    const double far = reach * mean_edge_length(start, mesh.tets);
-    std::vector<char> counted(static_cast<size_t>(mesh.num_vertices()), 0);
+    return FarSelfPenetrations(mesh, start, reach).count(mesh.positions);
+}
+
+FarSelfPenetrations::FarSelfPenetrations(const TetMesh& mesh, const PositionsRef& start, double reach)
+    : m_detector(DetectParams{.threads = 1}), m_tets(mesh.tets), m_start(start),
+      m_far(reach * mean_edge_length(start, mesh.tets)), m_counted(static_cast<size_t>(mesh.num_vertices()), 0)
+{
+    m_detector.set_topology(mesh);
+}
+
+std::int64_t FarSelfPenetrations::count(const PositionsRef& positions)
+{
+    std::fill(m_counted.begin(), m_counted.end(), 0);
     std::int64_t count = 0;
-    for (const Contact& c : det.detect(mesh.positions)) {
-        if (c.vertex_object != c.tet_object || counted[static_cast<size_t>(c.vertex)]) continue;
+    for (const Contact& c : m_detector.detect(positions)) {
+        if (c.vertex_object != c.tet_object || m_counted[static_cast<size_t>(c.vertex)]) continue;
         double nearest = INFINITY;
         for (int k = 0; k < 4; ++k)
-            nearest = std::min(nearest, (start.row(c.vertex) - start.row(mesh.tets(c.tet, k))).norm());
-        if (nearest > far) {
-            counted[static_cast<size_t>(c.vertex)] = 1;
+            nearest = std::min(nearest, (m_start.row(c.vertex) - m_start.row(m_tets(c.tet, k))).norm());
+        if (nearest > m_far) {
+            m_counted[static_cast<size_t>(c.vertex)] = 1;
             ++count;
         }
     }

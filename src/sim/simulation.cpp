@@ -32,17 +32,25 @@ double estimate_dt_limit(const Scene& scene, const Model& model, const TetMesh& 
 {
     const Index n = mesh.num_vertices();
     std::vector<double> extra_k(static_cast<size_t>(n), 0.0), extra_c(static_cast<size_t>(n), 0.0);
+    // Per object the partner giving the stiffest contact (the stiffness grows with the effective mass in the same
+    // way for every partner, so one partner per object serves all its vertices); -1: it touches nothing.
     const Index nobj = static_cast<Index>(scene.objects.size());
-    for (Index i = 0; i < n; ++i) {
-        const size_t u = static_cast<size_t>(i);
-        const Index a = model.vertex_object[u];
-        double k = 0;
-        if (contacts.enabled())
+    std::vector<Index> partner(static_cast<size_t>(nobj), -1);
+    if (contacts.enabled())
+        for (Index a = 0; a < nobj; ++a)
             for (Index b = 0; b < nobj; ++b)
                 if ((a != b || scene.objects[static_cast<size_t>(a)].self_collision) &&
                     !(scene.objects[static_cast<size_t>(a)].is_static &&
-                      scene.objects[static_cast<size_t>(b)].is_static))
-                    k = std::max(k, contacts.pair_stiffness(a, b, model.mass[u]));
+                      scene.objects[static_cast<size_t>(b)].is_static)) {
+                    Index& best = partner[static_cast<size_t>(a)];
+                    if (best < 0 || contacts.pair_stiffness(a, b, 1.0) > contacts.pair_stiffness(a, best, 1.0))
+                        best = b;
+                }
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const Index a = model.vertex_object[u];
+        const Index b = static_cast<size_t>(a) < partner.size() ? partner[static_cast<size_t>(a)] : -1;
+        double k = b >= 0 ? contacts.pair_stiffness(a, b, model.mass[u]) : 0.0;
         if (model.ground.enabled) k = std::max(k, model.ground_k_at(i));
         extra_k[u] = k;
         extra_c[u] =

@@ -85,6 +85,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
+    sim::FarSelfPenetrations far(s.mesh(), start);
     std::vector<double> ms, det, dep, prox, resp, integ, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
@@ -93,8 +94,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
             const auto t0 = std::chrono::steady_clock::now();
             s.step();
             ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-            if ((i + 1) % frame_every == 0)
-                r.far_self_max = std::max(r.far_self_max, sim::count_far_self_penetrations(s.mesh(), start));
+            if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
             dep.push_back(st.ms_depth);
@@ -120,7 +120,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.substeps = sub.empty() ? 1 : mean(sub);
     r.contacts = mean(con);
     r.inverted = sim::count_inverted(s.mesh(), start);
-    r.far_self = sim::count_far_self_penetrations(s.mesh(), start);
+    r.far_self = far.count(s.positions());
     r.far_self_max = std::max(r.far_self_max, r.far_self);
     r.mean_z = s.mesh().positions.col(2).mean();
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
@@ -341,14 +341,12 @@ int main(int argc, char** argv)
             {
                 std::ofstream out(tmp);
                 if (!out) throw Error("--csv: cannot write '" + tmp + "'");
-                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,ms_"
-                       "response,"
-                       "ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,stable,"
-                       "failure\n";
+                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
+                       "ms_response,ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,"
+                       "stable,failure\n";
                 for (const Row& r : rows)
-                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},{:."
-                                       "3g},{:.4g},{},{},{},{:."
-                                       "5g},{},\"{}\"\n",
+                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},"
+                                       "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{},\"{}\"\n",
                                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect,
                                        r.depth, r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts,
                                        r.inverted, r.far_self, r.far_self_max, r.mean_z, r.stable ? 1 : 0, r.failure);

@@ -72,9 +72,10 @@ struct ContactParams {
     double damping = 0;   ///< force · s / length; 0 = automatic per contact: sqrt(k · effective mass) (half critical)
     double friction = 0;  ///< Coulomb coefficient (0: off)
     bool in_matrix = true; ///< implicit Euler: contact stiffness in the system matrix
-    /// A vertex nearer than margin × (mean edge of its object or the other's, the larger) to a far boundary face is
-    /// pushed before it enters (0: only vertices inside tets are pushed). Penetrated vertices are pushed with their
-    /// depth plus the margin, so the force does not jump where a vertex crosses the surface.
+    /// A vertex nearer than margin × its object's mean edge to a far boundary face is pushed before it enters (0:
+    /// only vertices inside tets are pushed); never more than the clearance it has had since the start. Penetrated
+    /// vertices are pushed with their depth plus the margin, so the force does not jump where a vertex crosses the
+    /// surface.
     double margin = 0.25;
     /// Vertices and far boundary faces that may meet within a substep (from their velocities) get a contact that
     /// pushes only if the gap closes within the substep's iterations (vbd; the other integrators push positive

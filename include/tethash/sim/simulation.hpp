@@ -27,7 +27,7 @@ namespace tethash::sim {
 struct StepStats {
     double ms_detect = 0;           ///< Detector::detect
     double ms_depth = 0;            ///< penetration depth and direction (Penetration::compute)
-    double ms_proximity = 0;        ///< margin contacts and displacement bounds (near pairs of far surfaces)
+    double ms_proximity = 0;        ///< margin and speculative contacts (near pairs of far surfaces)
     double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
     double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
     std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
