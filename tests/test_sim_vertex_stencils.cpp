@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -58,7 +59,9 @@ struct Stencils {
                 TetLanes& t = tets[static_cast<std::size_t>(e)];
                 t.a[l] = t.b[l] = t.c[l] = own;
                 t.k36[l] = t.w0[l] = t.wt[l] = 0;
+                t.guard[l] = 0;
                 if (l >= lanes || e >= 4 - l) continue;
+                t.guard[l] = 0.02F * static_cast<float>(e + 1);
                 t.a[l] = 4 + (l + e) % 12;
                 t.b[l] = 4 + (l + e + 5) % 12;
                 t.c[l] = 4 + (l + 2 * e + 9) % 12;
@@ -87,30 +90,41 @@ struct Stencils {
             if (s.k[l] != 0) e += 0.5 * s.k[l] * std::pow(length(i, s.other[l]) - s.rest[l], 2);
         for (const TetLanes& t : tets) {
             if (t.k36[l] == 0) continue;
-            const double* p = x.data() + 3 * i;
-            const double* a = x.data() + 3 * t.a[l];
-            const double* b = x.data() + 3 * t.b[l];
-            const double* c = x.data() + 3 * t.c[l];
-            const double ba[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            const double ca[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-            const double n[3] = {ba[1] * ca[2] - ba[2] * ca[1], ba[2] * ca[0] - ba[0] * ca[2],
-                                 ba[0] * ca[1] - ba[1] * ca[0]};
-            const double w = (a[0] - p[0]) * n[0] + (a[1] - p[1]) * n[1] + (a[2] - p[2]) * n[2];
-            e += 0.5 * t.k36[l] * (w - t.w0[l]) * (w - t.w0[l]);
+            const double wl = w(l, t);
+            e += 0.5 * t.k36[l] * (wl - t.w0[l]) * (wl - t.w0[l]);
         }
         return e;
     }
+    /// W = 6V of lane l's volume entry e (W = (a − p) · ((b − a) × (c − a))), and its face normal |N|.
+    double w(int l, const TetLanes& t, double* n_norm = nullptr) const
+    {
+        const double* p = x.data() + 3 * g.vertex[l];
+        const double* a = x.data() + 3 * t.a[l];
+        const double* b = x.data() + 3 * t.b[l];
+        const double* c = x.data() + 3 * t.c[l];
+        const double ba[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double ca[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {ba[1] * ca[2] - ba[2] * ca[1], ba[2] * ca[0] - ba[0] * ca[2],
+                             ba[0] * ca[1] - ba[1] * ca[0]};
+        if (n_norm) *n_norm = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        return (a[0] - p[0]) * n[0] + (a[1] - p[1]) * n[1] + (a[2] - p[2]) * n[2];
+    }
+    /// The kernels read positions with a stride of 4 doubles, 32-byte aligned.
+    struct alignas(32) P4 {
+        double c[4];
+    };
+    std::vector<P4> x4() const
+    {
+        std::vector<P4> out(x.size() / 3);
+        for (std::size_t i = 0; i < out.size(); ++i)
+            out[i] = {x[3 * i], x[3 * i + 1], x[3 * i + 2], 0.0};
+        return out;
+    }
     LaneTerms gather(GatherFn fn) const
     {
-        // The kernels read positions with a stride of 4 doubles, 32-byte aligned.
-        struct alignas(32) P4 {
-            double c[4];
-        };
-        std::vector<P4> x4(x.size() / 3);
-        for (std::size_t i = 0; i < x4.size(); ++i)
-            x4[i] = {x[3 * i], x[3 * i + 1], x[3 * i + 2], 0.0};
+        const std::vector<P4> p = x4();
         LaneTerms out;
-        fn(g, springs.data(), tets.data(), x4.data()->c, 240.0, out);
+        fn(g, springs.data(), tets.data(), p.data()->c, 240.0, out);
         return out;
     }
 };
@@ -297,4 +311,63 @@ TEST(SimVertexStencils, StartOfSubstepLengthsAndVolumesMatchTheOneLaneVersion)
             EXPECT_NEAR(ta[e].wt[l], w, 1e-13) << "entry " << e << " lane " << l;
             EXPECT_NEAR(tb[e].wt[l], w, 1e-13) << "entry " << e << " lane " << l;
         }
+}
+
+TEST(SimVertexStencils, InversionGuardLowersNoTetBelowItsFloor)
+{
+    // reach2 is min over a lane's guarded entries with W > 0 of ((W − τ)⁺ / |N|)² in both kernels; a step scaled by
+    // guarded_fraction lowers no such entry by more than 0.9 (W − τ)⁺ (W is linear in the lane's vertex), and a step
+    // shorter than 0.9 × reach needs no scaling.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int shortened = 0, steps = 0;
+    for (unsigned seed = 1; seed <= 60; ++seed) {
+        Stencils s(seed, 4);
+        for (GatherFn fn : {choose_gather(), scalar_gather()}) {
+            const LaneTerms t = s.gather(fn);
+            for (int l = 0; l < 4; ++l) {
+                double expect = std::numeric_limits<double>::infinity();
+                for (const TetLanes& e : s.tets) {
+                    double n = 0;
+                    const double w = s.w(l, e, &n);
+                    if (e.guard[l] > 0 && w > 0)
+                        expect = std::min(expect, std::pow(std::max(0.0, w - e.guard[l]) / n, 2));
+                }
+                if (std::isinf(expect)) {
+                    EXPECT_TRUE(std::isinf(t.reach2[l])) << gather_kernel_name(fn) << " seed " << seed;
+                } else {
+                    EXPECT_NEAR(t.reach2[l], expect, 1e-9 * expect) << gather_kernel_name(fn) << " seed " << seed;
+                }
+            }
+        }
+        const LaneTerms t = s.gather(scalar_gather());
+        for (int l = 0; l < 4; ++l) {
+            const double len = 2 * (u(rng) + 1);
+            double d[3] = {u(rng), u(rng), u(rng)};
+            const double dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (double& c : d)
+                c *= len / dn;
+            const std::vector<Stencils::P4> p = s.x4();
+            const double f = guarded_fraction(s.g, s.tets.data(), l, p.data()->c, d);
+            ASSERT_GE(f, 0.0);
+            ASSERT_LE(f, 1.0);
+            if (len < 0.9 * std::sqrt(t.reach2[l])) {
+                EXPECT_EQ(f, 1.0) << "seed " << seed << " lane " << l;
+            }
+            ++steps;
+            shortened += f < 1 ? 1 : 0;
+            Stencils moved = s;
+            for (int r = 0; r < 3; ++r)
+                moved.x[3 * static_cast<std::size_t>(s.g.vertex[l]) + static_cast<std::size_t>(r)] += f * d[r];
+            for (const TetLanes& e : s.tets) {
+                const double before = s.w(l, e), after = moved.w(l, e);
+                if (!(e.guard[l] > 0) || !(before > 0)) continue;
+                EXPECT_GE(after, before - 0.9 * std::max(0.0, before - e.guard[l]) - 1e-12)
+                    << "seed " << seed << " lane " << l;
+                EXPECT_GT(after, 0) << "seed " << seed << " lane " << l;
+            }
+        }
+    }
+    EXPECT_GT(shortened, steps / 10); // the guard acted (random steps of up to 4 against tets of size ~1)
+    EXPECT_LT(shortened, steps);      // and not on every step
 }

@@ -101,6 +101,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     m.volumes.tets.resize(static_cast<Index>(dyn.size()), 4);
     m.volumes.rest.resize(dyn.size());
     m.volumes.k.resize(dyn.size());
+    m.volumes.sliver.resize(dyn.size());
     Eigen::Matrix<double, 4, 3> g;
     for (size_t q = 0; q < dyn.size(); ++q) {
         const Index t = dyn[q];
@@ -130,6 +131,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         const double vhat = std::max(vol, 0.1 * regular_tet_volume(lmean));
         m.volumes.rest[q] = vol;
         m.volumes.k[q] = mat.volume_stiffness * young * vol / vhat;
+        m.volumes.sliver[q] = vhat > vol ? 1 : 0;
     }
 
     // Springs: unique edges of the dynamic tets, Van Gelder stiffness k = young · ΣV_adjacent / L0².

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
+#include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -47,6 +48,8 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
         dh[l] = g.damping[l] * inv_h;
     }
     double f[3][4] = {}, H[6][4] = {};
+    double reach2[4];
+    std::fill(std::begin(reach2), std::end(reach2), std::numeric_limits<double>::infinity());
     for (std::int32_t s = g.spring_begin; s < g.spring_end; ++s) {
         const SpringLanes& sp = springs[s];
         for (int l = 0; l < 4; ++l) {
@@ -88,11 +91,36 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
             H[3][l] += ks * nx * ny;
             H[4][l] += ks * nx * nz;
             H[5][l] += ks * ny * nz;
+            if (t.guard[l] > 0 && w > 0) {
+                const double slack = std::max(0.0, w - static_cast<double>(t.guard[l]));
+                reach2[l] = std::min(reach2[l], slack * slack / (nx * nx + ny * ny + nz * nz));
+            }
         }
     }
     std::memcpy(out.f, f, sizeof(f));
     std::memcpy(out.H, H, sizeof(H));
+    std::memcpy(out.reach2, reach2, sizeof(reach2));
 }
+
+} // namespace
+
+double guarded_fraction(const LaneGroup& g, const TetLanes* tets, int l, const double* x, const double d[3])
+{
+    const double* p = x + 4 * static_cast<std::size_t>(g.vertex[l]);
+    double t_max = std::numeric_limits<double>::infinity();
+    for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
+        const TetLanes& t = tets[s];
+        if (!(t.guard[l] > 0)) continue;
+        double n[3];
+        const double w = volume_term(t, l, x, p[0], p[1], p[2], n);
+        const double nd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2]; // W(p + d) = W − N·d
+        if (!(w > 0) || !(nd > 0)) continue;
+        t_max = std::min(t_max, std::max(0.0, w - static_cast<double>(t.guard[l])) / nd);
+    }
+    return std::min(1.0, 0.9 * t_max);
+}
+
+namespace {
 
 void start_scalar(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, const double* x)
 {
@@ -221,6 +249,8 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         hyz = _mm256_fmadd_pd(kuy, uz, hyz);
     }
     const __m256d tet_scale = _mm256_add_pd(one, dh);
+    const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+    __m256d reach2 = inf;
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         const TetLanes& t = tets[s];
         __m256d nx, ny, nz;
@@ -240,7 +270,14 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         hxy = _mm256_fmadd_pd(knx, ny, hxy);
         hxz = _mm256_fmadd_pd(knx, nz, hxz);
         hyz = _mm256_fmadd_pd(kny, nz, hyz);
+        const __m256d tau = _mm256_cvtps_pd(_mm_load_ps(t.guard));
+        const __m256d guarded = _mm256_and_pd(_mm256_cmp_pd(tau, zero, _CMP_GT_OQ), _mm256_cmp_pd(w, zero, _CMP_GT_OQ));
+        const __m256d slack = _mm256_max_pd(zero, _mm256_sub_pd(w, tau));
+        const __m256d n2 = _mm256_fmadd_pd(nx, nx, _mm256_fmadd_pd(ny, ny, _mm256_mul_pd(nz, nz)));
+        const __m256d r2 = _mm256_div_pd(_mm256_mul_pd(slack, slack), n2);
+        reach2 = _mm256_min_pd(reach2, _mm256_blendv_pd(inf, r2, guarded));
     }
+    _mm256_store_pd(out.reach2, reach2);
     _mm256_store_pd(out.f[0], fx);
     _mm256_store_pd(out.f[1], fy);
     _mm256_store_pd(out.f[2], fz);

@@ -28,7 +28,7 @@ struct alignas(32) TetLanes {
     double w0[4];  ///< 6 V0
     double wt[4];  ///< 6 V at the start of the substep (relative damping)
     std::int32_t a[4], b[4], c[4];
-    std::int32_t unused[4];
+    float guard[4]; ///< the inversion guard's floor τ on W (guard_fraction · W0); 0: not guarded (padding)
 };
 
 /// Four vertices of one colour and their entries.
@@ -39,11 +39,19 @@ struct alignas(32) LaneGroup {
     std::int32_t spring_begin, spring_end, tet_begin, tet_end;
 };
 
+/// The inversion guard: a vertex's step keeps each of its guarded tets (all but slivers) that has W above the floor
+/// τ = guard_fraction · W0 above it, and does not lower one below it (W is linear in the vertex's position, so this
+/// is exact): a tet that enters the sweeps with W > 0 leaves them so. The block-descent header says the rest.
+inline constexpr double guard_fraction = 0.1;
+
 /// The elastic part of four vertices' local problems: force f = −∇E and Hessian H (xx, yy, zz, xy, xz, yz),
-/// lane by lane, with relative damping over the substep (inv_h = 1 / h).
+/// lane by lane, with relative damping over the substep (inv_h = 1 / h); and reach2, the squared length of a step
+/// in any direction that lowers none of the lane's guarded tets with W > 0 by more than (W − τ)⁺: min over them of
+/// ((W − τ)⁺ / |N|)² (infinite without such a tet). A step shorter than 0.9 × reach needs no further guard.
 struct LaneTerms {
     alignas(32) double f[3][4];
     alignas(32) double H[6][4];
+    alignas(32) double reach2[4];
 };
 
 /// Positions are given with a stride of 4 doubles (x, y, z, unused), 32-byte aligned.
@@ -53,6 +61,10 @@ using GatherFn = void (*)(const LaneGroup& g, const SpringLanes* springs, const 
 /// Sets length_t and wt of a group's entries (every lane, padding included) from positions x: the lengths and
 /// volumes at the start of the substep, for the relative damping.
 using StartFn = void (*)(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, const double* x);
+
+/// The fraction (0 … 1] of lane l's step d that the inversion guard allows: min(1, 0.9 t) with t the largest factor
+/// that lowers none of its guarded tets with W > 0 by more than (W − τ)⁺, given x before the step.
+double guarded_fraction(const LaneGroup& g, const TetLanes* tets, int l, const double* x, const double d[3]);
 
 /// The start-of-substep pass matching choose_gather().
 StartFn choose_start(GatherFn gather);

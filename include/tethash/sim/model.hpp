@@ -55,6 +55,9 @@ struct VolumeTerms {
     Tets tets;                ///< tets of the dynamic objects
     std::vector<double> rest; ///< rest signed volumes (> 0 after orientation)
     std::vector<double> k;    ///< stiffness: energy ½ k V0 ((V − V0)/V0)²
+    /// Rest volume below a tenth of the regular tet of its mean edge: the volume term is floored (softer than its
+    /// own volume would make it), and the vbd integrator restores such a tet's orientation instead of guarding it.
+    std::vector<char> sliver;
 };
 
 /// Energy split (force × length). `total()` = kinetic + elastic + volume + gravity + ground + contact.
