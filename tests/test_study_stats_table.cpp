@@ -1,4 +1,5 @@
-// The table of detector statistics (study/stats_table.hpp): every field of DetectStats exactly once.
+// The table of detector statistics (study/stats_table.hpp): every field of DetectStats exactly once;
+// the BSP tree's statistics as JSON.
 #include "tethash/study/stats_table.hpp"
 
 #include <gtest/gtest.h>
@@ -86,6 +87,18 @@ TEST(StudyStatsTable, NamesKindsAndText)
         if (std::string(f.name) == "table_size" || std::string(f.name) == "cell_size") study::write_stat(j, f, s);
     j.end_object();
     EXPECT_EQ(j.str(), R"({"cell_size": 0.125, "table_size": 4096})");
+}
+
+TEST(StudyStatsTable, EveryFieldOfBspStatsWrittenInOrder)
+{
+    static_assert(field_count<BspStats>() == 11, "BspStats changed: add the new field to study/stats_table.cpp");
+    const BspStats s{1, 2, 3, 4, 5, 6, 7.5, 8, 9, true, 11.25};
+    study::JsonWriter j;
+    j.begin_object(study::JsonWriter::inline_layout);
+    study::write_stats(j, s);
+    j.end_object();
+    EXPECT_EQ(j.str(), R"({"triangles": 1, "planes": 2, "nodes": 3, "leaves_in": 4, "leaves_out": 5, "depth": 6, )"
+                       R"("mean_depth": 7.5, "splits": 8, "bytes": 9, "flipped": true, "build_ms": 11.25})");
 }
 
 } // namespace

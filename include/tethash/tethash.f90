@@ -7,7 +7,7 @@
 module tethash
   use, intrinsic :: iso_c_binding
   implicit none
-  private :: c_strlen
+  private :: c_strlen, tethash_int32_setter
 
   integer(c_int), parameter :: TETHASH_OK = 0
   integer(c_int), parameter :: TETHASH_ERROR_NULL_ARGUMENT = 1
@@ -32,6 +32,19 @@ module tethash
     integer(c_int32_t) :: reused, threads
   end type tethash_stats
 
+  ! The setters of one int32_t parameter: tethash_detector_set_threads(detector, threads) and
+  ! tethash_detector_set_hash(detector, hash) (TETHASH_HASH_*), the value passed as `value`.
+  abstract interface
+    function tethash_int32_setter(detector, value) bind(C) result(status)
+      import :: c_ptr, c_int, c_int32_t
+      type(c_ptr), value :: detector
+      integer(c_int32_t), value :: value
+      integer(c_int) :: status
+    end function
+  end interface
+  procedure(tethash_int32_setter), bind(C, name="tethash_detector_set_threads") :: tethash_detector_set_threads
+  procedure(tethash_int32_setter), bind(C, name="tethash_detector_set_hash") :: tethash_detector_set_hash
+
   interface
     function tethash_detector_create(detector) bind(C, name="tethash_detector_create") result(status)
       import :: c_ptr, c_int
@@ -55,19 +68,6 @@ module tethash
       import :: c_ptr, c_int, c_int64_t
       type(c_ptr), value :: detector
       integer(c_int64_t), value :: buckets
-      integer(c_int) :: status
-    end function
-    function tethash_detector_set_threads(detector, threads) bind(C, name="tethash_detector_set_threads") &
-        result(status)
-      import :: c_ptr, c_int, c_int32_t
-      type(c_ptr), value :: detector
-      integer(c_int32_t), value :: threads
-      integer(c_int) :: status
-    end function
-    function tethash_detector_set_hash(detector, hash) bind(C, name="tethash_detector_set_hash") result(status)
-      import :: c_ptr, c_int, c_int32_t
-      type(c_ptr), value :: detector
-      integer(c_int32_t), value :: hash
       integer(c_int) :: status
     end function
     function tethash_detector_set_skin(detector, skin) bind(C, name="tethash_detector_set_skin") result(status)

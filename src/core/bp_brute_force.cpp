@@ -7,27 +7,27 @@ namespace tethash::detail {
 namespace {
 
 class BruteForce final : public BroadPhaseBase {
-  public:
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override { return m_sorted.memory_bytes(); }
 
     VerticesByX m_sorted;
 };
 
-BroadPhaseTimes BruteForce::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool BruteForce::build_phase(const PartitionScene& s, int /*threads*/)
 {
-    PhaseTimer timer;
     m_sorted.build(s);
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
+
+void BruteForce::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
     for_each_index(s.num_tets, 256, sinks, [&](Index t, std::vector<CandidatePair>& out) {
         Box b;
         tet_box(s, t, b.lo, b.hi);
         m_sorted.find(s, b, t, s.tet_static[t] != 0, m_static.data(), out);
     });
-    return timer.end_query();
 }
 
 } // namespace

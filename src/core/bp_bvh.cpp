@@ -23,7 +23,6 @@ namespace {
 class Bvh final : public BroadPhaseBase {
   public:
     explicit Bvh(bool refit) : m_refit(refit) {}
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
 
     static constexpr int default_leaf_size = 4;
@@ -38,6 +37,8 @@ class Bvh final : public BroadPhaseBase {
     double quality() const;
 
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     struct Node {
         Box box;
         Index right; ///< internal: the right child (the left one is the next node)
@@ -216,25 +217,25 @@ void Bvh::refit()
     ++m_refits;
 }
 
-BroadPhaseTimes Bvh::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool Bvh::build_phase(const PartitionScene& s, int threads)
 {
-    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
-    const int T = static_cast<int>(sinks.size());
     if (n == 0 || m == 0) {
         m_nodes.clear();
-        return {};
+        return false;
     }
-    tet_boxes(s, m_boxes, T);
+    tet_boxes(s, m_boxes, threads);
     if (!m_refit || s.first || m_items.size() != static_cast<std::size_t>(m)) {
         build(s);
     } else {
         refit();
         if (quality() > degradation * m_built_quality) build(s);
     }
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
 
+void Bvh::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
     const Node* nodes = m_nodes.data();
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
         Index stack[2 * default_max_depth + 8]; // depth ≤ 40: at most one pending sibling per level
@@ -253,7 +254,6 @@ BroadPhaseTimes Bvh::find(const PartitionScene& s, std::vector<CandidateSink>& s
             stack[top++] = i + 1;
         }
     });
-    return timer.end_query();
 }
 
 } // namespace

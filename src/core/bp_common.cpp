@@ -68,4 +68,14 @@ std::int64_t VerticesByX::memory_bytes() const
     return bytes_of(order) + bytes_of(xs);
 }
 
+BroadPhaseTimes BroadPhaseBase::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    PhaseTimer timer;
+    if (!build_phase(s, static_cast<int>(sinks.size()))) return {};
+    static_vertex_flags(s, m_static);
+    timer.end_build();
+    query_phase(s, sinks);
+    return timer.end_query();
+}
+
 } // namespace tethash::detail

@@ -136,13 +136,20 @@ template <class... T> std::int64_t bytes_of(const std::vector<T>&... v)
     return (std::int64_t{0} + ... + static_cast<std::int64_t>(v.capacity() * sizeof(T)));
 }
 
-/// What every broad phase keeps besides its structure: the per-vertex static flags of the last call (filled by
-/// static_vertex_flags at the end of the build), counted by memory_bytes() with the structure's own bytes.
+/// What every broad phase keeps besides its structure, and the frame of its find(): build_phase() makes (or updates)
+/// the structure, the per-vertex static flags of the call follow (counted by memory_bytes() with the structure's own
+/// bytes), then query_phase() fills the sinks; the two phases are timed apart (PhaseTimer).
 class BroadPhaseBase : public BroadPhase {
   public:
+    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) final;
     std::int64_t memory_bytes() const final { return structure_bytes() + bytes_of(m_static); }
 
   protected:
+    /// Builds or updates the structure for the scene, `threads` being the sinks' count (the team of its parallel
+    /// loops). False when there is nothing to find (no vertex or no tet): the call then returns zero times.
+    virtual bool build_phase(const PartitionScene& scene, int threads) = 0;
+    /// Appends the candidates to the sinks (BroadPhase::find), after a build that returned true.
+    virtual void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) = 0;
     /// Working memory of the structure itself.
     virtual std::int64_t structure_bytes() const = 0;
 

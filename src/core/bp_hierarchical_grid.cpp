@@ -24,13 +24,14 @@ namespace {
 
 class HierarchicalGrid final : public BroadPhaseBase {
   public:
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     /// Occupied levels (plus one when some tets exceed the top level).
     std::int64_t nodes() const override { return m_nodes; }
 
     static constexpr int max_levels = 32;
 
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     /// A tet in the table: its box, level and min-corner cell, so that a scan compares the exact cell.
     struct Entry {
         Box box;
@@ -44,6 +45,11 @@ class HierarchicalGrid final : public BroadPhaseBase {
     }
 
     std::int64_t m_nodes = 0;
+    double m_origin[3] = {0, 0, 0}; // the vertices' min corner
+    double m_inv[max_levels] = {};  // per level k: 2^−k / cell size
+    int m_used[max_levels] = {};    // the occupied levels, finest first
+    int m_num_used = 0;
+    std::uint64_t m_mask = 0; // buckets − 1 (buckets: a power of two)
     std::vector<Box> m_boxes;
     std::vector<std::int32_t> m_level;   // per tet: its level, or -1 when it exceeds the top level
     std::vector<std::uint64_t> m_bucket; // per tet: its bucket
@@ -66,31 +72,31 @@ std::uint64_t cell_hash(std::int32_t level, const std::int64_t c[3])
     return h;
 }
 
-BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool HierarchicalGrid::build_phase(const PartitionScene& s, int threads)
 {
-    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     m_nodes = 0;
+    m_num_used = 0;
     m_entries.clear();
     m_big.clear();
-    if (n == 0 || m == 0) return {};
-    const int T = static_cast<int>(sinks.size());
+    if (n == 0 || m == 0) return false;
     const int levels = s.params.levels > 0 ? std::min(s.params.levels, max_levels) : max_levels;
 
     const Box box = vertex_box(s);
-    const double* origin = box.lo;
+    std::copy(box.lo, box.lo + 3, m_origin);
+    const double* origin = m_origin;
     const double inv0 = 1.0 / s.cell_size;
-    double inv[max_levels];
+    double* inv = m_inv;
     for (int k = 0; k < max_levels; ++k)
         inv[k] = std::ldexp(inv0, -k);
 
     // Each tet's level and min-corner cell.
-    tet_boxes(s, m_boxes, T);
+    tet_boxes(s, m_boxes, threads);
     const std::uint64_t buckets = static_cast<std::uint64_t>(next_power_of_two(2 * static_cast<std::int64_t>(m)));
     m_level.resize(static_cast<std::size_t>(m));
     m_bucket.resize(static_cast<std::size_t>(m));
     m_cell.resize(3 * static_cast<std::size_t>(m));
-#pragma omp parallel for num_threads(T) if (T > 1) schedule(static)
+#pragma omp parallel for num_threads(threads) if (threads > 1) schedule(static)
     for (Index t = 0; t < m; ++t) {
         const Box& b = m_boxes[static_cast<std::size_t>(t)];
         const double extent = std::max({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]}) * inv0;
@@ -117,6 +123,7 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
     // Counting sort of the placed tets by bucket.
     std::uint32_t occupied = 0;
     m_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
+    m_mask = buckets - 1;
     for (Index t = 0; t < m; ++t) {
         const std::int32_t k = m_level[static_cast<std::size_t>(t)];
         if (k < 0) {
@@ -142,17 +149,20 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
     for (std::uint64_t b = buckets; b > 0; --b)
         m_start[b] = m_start[b - 1];
     m_start[0] = 0;
-    int used[max_levels];
-    int num_used = 0;
     for (int k = 0; k < max_levels; ++k)
-        if (occupied >> k & 1u) used[num_used++] = k;
-    m_nodes = num_used + (m_big.empty() ? 0 : 1);
-
-    static_vertex_flags(s, m_static);
+        if (occupied >> k & 1u) m_used[m_num_used++] = k;
+    m_nodes = m_num_used + (m_big.empty() ? 0 : 1);
     if (!m_big.empty()) m_sorted.build(s); // the vertices by x for the tets beyond the top level
-    timer.end_build();
+    return true;
+}
 
-    const std::uint64_t mask = buckets - 1;
+void HierarchicalGrid::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    const double* origin = m_origin;
+    const double* inv = m_inv;
+    const int* used = m_used;
+    const int num_used = m_num_used;
+    const std::uint64_t mask = m_mask;
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
         for (int u = 0; u < num_used; ++u) {
             const int k = used[u];
@@ -176,7 +186,6 @@ BroadPhaseTimes HierarchicalGrid::find(const PartitionScene& s, std::vector<Cand
         const Index t = m_big[static_cast<std::size_t>(i)];
         m_sorted.find(s, m_boxes[static_cast<std::size_t>(t)], t, s.tet_static[t] != 0, m_static.data(), out);
     });
-    return timer.end_query();
 }
 
 } // namespace

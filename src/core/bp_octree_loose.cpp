@@ -21,13 +21,14 @@ namespace {
 
 class LooseOctree final : public BroadPhaseBase {
   public:
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t nodes() const override { return static_cast<std::int64_t>(m_nodes.size()); }
 
     static constexpr int default_max_depth = 10;
     static constexpr double default_looseness = 2;
 
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     struct Node {
         Box loose;                  ///< the cell's box enlarged by the looseness (the root's: also every tet box)
         double centre[3], half;     ///< the cell itself: centre ± half
@@ -73,17 +74,15 @@ void LooseOctree::split(Index i, double looseness)
     }
 }
 
-BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool LooseOctree::build_phase(const PartitionScene& s, int threads)
 {
-    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
-    const int T = static_cast<int>(sinks.size());
     m_nodes.clear();
-    if (n == 0 || m == 0) return {};
+    if (n == 0 || m == 0) return false;
     const double looseness = s.params.looseness > 0 ? s.params.looseness : default_looseness;
     const int max_depth = s.params.max_depth > 0 ? s.params.max_depth : default_max_depth;
 
-    tet_boxes(s, m_boxes, T);
+    tet_boxes(s, m_boxes, threads);
     Node root;
     root.loose = m_boxes[0];
     for (const Box& b : m_boxes)
@@ -154,9 +153,11 @@ BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<Candidate
             for (int k = 0; k < 8; ++k)
                 node.below += m_nodes[static_cast<std::size_t>(node.children + k)].below;
     }
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
 
+void LooseOctree::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
     const Node* nodes = m_nodes.data();
     for_each_vertex(s, m_static, sinks, [&](Index v, const double* p, bool vertex_static, auto& out) {
         Index stack[8 * (40 + 1)]; // depth ≤ 40: at most 7 pending siblings per level
@@ -172,7 +173,6 @@ BroadPhaseTimes LooseOctree::find(const PartitionScene& s, std::vector<Candidate
                     stack[top++] = node.children + k;
         }
     });
-    return timer.end_query();
 }
 
 } // namespace

@@ -19,13 +19,13 @@ namespace {
 
 class SortSweep final : public BroadPhaseBase {
   public:
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
-
     /// Calls whose orders were repaired by insertion sort, and calls that sorted from scratch (first call, new
     /// axis, or an insertion sort that exceeded its budget of moves).
     BroadPhaseCounts counts() const override { return {m_full, m_incremental}; }
 
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     struct Key {
         double x;
         Index id;
@@ -69,13 +69,11 @@ template <class Key> void full_sort(std::vector<Key>& keys)
     std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return key_less(a.x, a.id, b.x, b.id); });
 }
 
-BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool SortSweep::build_phase(const PartitionScene& s, int threads)
 {
-    PhaseTimer timer;
     const Index n = s.num_vertices, m = s.num_tets;
     const double* P = s.positions;
-    if (n == 0 || m == 0) return {};
-    const int T = static_cast<int>(sinks.size());
+    if (n == 0 || m == 0) return false;
 
     // The axis of largest variance (sums relative to the first vertex: no cancellation far from the origin).
     double sum[3] = {0, 0, 0}, sq[3] = {0, 0, 0};
@@ -96,7 +94,7 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
                        m_tets.size() != static_cast<std::size_t>(m);
     m_axis = axis;
 
-    tet_boxes(s, m_boxes, T);
+    tet_boxes(s, m_boxes, threads);
     if (fresh) {
         m_points.resize(static_cast<std::size_t>(n));
         for (Index v = 0; v < n; ++v)
@@ -127,10 +125,14 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
         const double* p = P + 3 * static_cast<std::size_t>(m_points[static_cast<std::size_t>(i)].id);
         std::copy(p, p + 3, m_xyz.begin() + 3 * static_cast<std::ptrdiff_t>(i));
     }
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
 
-    // The sweep, in chunks of consecutive tets.
+void SortSweep::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    // The sweep, in chunks of consecutive tets, on the axis of the build.
+    const Index n = s.num_vertices, m = s.num_tets;
+    const int axis = m_axis;
     const Index chunk = 512;
     const Index chunks = (m + chunk - 1) / chunk;
     const int b = (axis + 1) % 3, c = (axis + 2) % 3;
@@ -154,7 +156,6 @@ BroadPhaseTimes SortSweep::find(const PartitionScene& s, std::vector<CandidateSi
             }
         }
     });
-    return timer.end_query();
 }
 
 } // namespace

@@ -10,10 +10,11 @@ namespace {
 class SplitTreeBroadPhase final : public BroadPhaseBase {
   public:
     explicit SplitTreeBroadPhase(SplitRule rule) : m_rule(rule) {}
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t nodes() const override { return m_nodes; }
 
   private:
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override;
 
     SplitRule m_rule;
@@ -24,9 +25,8 @@ class SplitTreeBroadPhase final : public BroadPhaseBase {
     std::int64_t m_nodes = 0;
 };
 
-BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool SplitTreeBroadPhase::build_phase(const PartitionScene& s, int /*threads*/)
 {
-    PhaseTimer timer;
     SplitTreeParams params;
     params.rule = m_rule;
     params.max_depth = s.params.max_depth > 0 ? s.params.max_depth : -1;
@@ -41,9 +41,11 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
     }
     m_tree.build(m_points);
     m_nodes = m_tree.stats().nodes;
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
 
+void SplitTreeBroadPhase::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
     m_found.resize(sinks.size());
     m_scratch.resize(sinks.size());
     for_each_index(s.num_tets, 64, sinks, [&](Index t, std::vector<CandidatePair>& out) {
@@ -57,7 +59,6 @@ BroadPhaseTimes SplitTreeBroadPhase::find(const PartitionScene& s, std::vector<C
         for (std::uint32_t v : found)
             add_candidate(s, static_cast<Index>(v), t, tet_static, m_static.data(), out);
     });
-    return timer.end_query();
 }
 
 std::int64_t SplitTreeBroadPhase::structure_bytes() const

@@ -19,35 +19,39 @@ namespace {
 
 class UniformGrid final : public BroadPhaseBase {
   public:
-    /// Throws Error when the grid would need more than max_cells cells or max_bytes bytes.
-    BroadPhaseTimes find(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t nodes() const override { return m_cells; }
 
     static constexpr std::int64_t max_cells = std::int64_t{1} << 28;
     static constexpr std::int64_t max_bytes = std::int64_t{1} << 31;
 
   private:
+    /// Throws Error when the grid would need more than max_cells cells or max_bytes bytes.
+    bool build_phase(const PartitionScene& scene, int threads) override;
+    void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override { return bytes_of(m_start, m_ids, m_xyz, m_cell); }
 
     std::int64_t m_cells = 0;
     std::int64_t m_dims[3] = {0, 0, 0};
+    double m_origin[3] = {0, 0, 0};   // the vertices' min corner
+    double m_inv = 1;                 // 1 / cell size
     std::vector<Index> m_start;       // cells + 1: the vertices of cell c are m_ids[m_start[c], m_start[c + 1])
     std::vector<Index> m_ids;         // vertices by cell (z fastest, then y, then x)
     std::vector<double> m_xyz;        // their positions in that order (3 per vertex)
     std::vector<std::int32_t> m_cell; // per vertex: its cell
 };
 
-BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+bool UniformGrid::build_phase(const PartitionScene& s, int /*threads*/)
 {
-    PhaseTimer timer;
     const Index n = s.num_vertices;
     const double* P = s.positions;
     m_cells = 0;
-    if (n == 0 || s.num_tets == 0) return {};
+    if (n == 0 || s.num_tets == 0) return false;
 
     const Box box = vertex_box(s);
     const double *lo = box.lo, *hi = box.hi;
     const double inv = 1.0 / s.cell_size;
+    std::copy(lo, lo + 3, m_origin);
+    m_inv = inv;
     double cells = 1;
     for (int a = 0; a < 3; ++a) {
         m_dims[a] = cell_coord(hi[a], lo[a], inv) + 1;
@@ -89,9 +93,14 @@ BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<Candidate
     for (std::int64_t c = m_cells; c > 0; --c) // the increments shifted every start by one cell: shift back
         m_start[static_cast<std::size_t>(c)] = m_start[static_cast<std::size_t>(c) - 1];
     m_start[0] = 0;
-    static_vertex_flags(s, m_static);
-    timer.end_build();
+    return true;
+}
 
+void UniformGrid::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
+{
+    const double* lo = m_origin;
+    const double inv = m_inv;
+    const std::int64_t dy = m_dims[1], dz = m_dims[2];
     for_each_index(s.num_tets, 256, sinks, [&](Index t, std::vector<CandidatePair>& out) {
         double blo[3], bhi[3];
         tet_box(s, t, blo, bhi);
@@ -112,7 +121,6 @@ BroadPhaseTimes UniformGrid::find(const PartitionScene& s, std::vector<Candidate
                 }
             }
     });
-    return timer.end_query();
 }
 
 } // namespace

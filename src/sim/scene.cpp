@@ -226,6 +226,20 @@ template <class T> Key<T> int_key(const char* name, int T::*field, int lo)
             }};
 }
 
+/// The keys of a penalty contact (the ground's, the objects' contacts): stiffness, damping and friction, each ≥ 0.
+template <class T> std::vector<Key<T>> penalty_keys()
+{
+    return {key("stiffness", &T::stiffness, &Reader::non_negative), key("damping", &T::damping, &Reader::non_negative),
+            key("friction", &T::friction, &Reader::non_negative)};
+}
+
+/// The keys `first`, then the keys `then`.
+template <class T> std::vector<Key<T>> joined(std::vector<Key<T>> first, const std::vector<Key<T>>& then)
+{
+    first.insert(first.end(), then.begin(), then.end());
+    return first;
+}
+
 /// Reads table `t` (its keys named `prefix` + key in messages) into `out` by `keys`. `more` are further keys
 /// this table may have, which `other(key, value, prefix + key)` reads; any other key is an error.
 template <class T, class Other>
@@ -378,27 +392,22 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
             }
         };
     };
-    static const std::vector<Key<Ground>> ground_keys = {
-        key("enabled", &Ground::enabled, &Reader::boolean),
-        key("height", &Ground::height, &Reader::number),
-        {"normal",
-         [](const Reader& r, const toml::node& v, const std::string& k, Ground& g) {
-             g.normal = r.vec3(v, k);
-             if (!(g.normal.norm() > 0)) r.fail(&v, k, "must not be the zero vector");
-             g.normal.normalize();
-         }},
-        key("stiffness", &Ground::stiffness, &Reader::non_negative),
-        key("damping", &Ground::damping, &Reader::non_negative),
-        key("friction", &Ground::friction, &Reader::non_negative),
-    };
-    static const std::vector<Key<ContactParams>> contact_keys = {
-        key("stiffness", &ContactParams::stiffness, &Reader::non_negative),
-        key("damping", &ContactParams::damping, &Reader::non_negative),
-        key("friction", &ContactParams::friction, &Reader::non_negative),
-        key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
-        key("margin", &ContactParams::margin, &Reader::non_negative),
-        key("speculative", &ContactParams::speculative, &Reader::boolean),
-    };
+    static const std::vector<Key<Ground>> ground_keys = joined(
+        {
+            key("enabled", &Ground::enabled, &Reader::boolean),
+            key("height", &Ground::height, &Reader::number),
+            {"normal",
+             [](const Reader& r, const toml::node& v, const std::string& k, Ground& g) {
+                 g.normal = r.vec3(v, k);
+                 if (!(g.normal.norm() > 0)) r.fail(&v, k, "must not be the zero vector");
+                 g.normal.normalize();
+             }},
+        },
+        penalty_keys<Ground>());
+    static const std::vector<Key<ContactParams>> contact_keys =
+        joined(penalty_keys<ContactParams>(), {key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
+                                               key("margin", &ContactParams::margin, &Reader::non_negative),
+                                               key("speculative", &ContactParams::speculative, &Reader::boolean)});
     const std::vector<Key<Scene>> keys = {
         key("dt", &Scene::dt, &Reader::positive),
         int_key("steps", &Scene::steps, 0),

@@ -44,11 +44,6 @@ std::string utc_now()
     return buf;
 }
 
-void write_file(const std::string& path, const JsonWriter& j)
-{
-    io::write_text_file(path, j.str() + "\n");
-}
-
 } // namespace
 
 void check_out_dir(const std::string& dir)
@@ -105,6 +100,17 @@ void write_machine(JsonWriter& j, const std::string& compiler_flags)
         .end_object();
 }
 
+void write_run_members(JsonWriter& j, const std::string& command_line, const std::string& compiler_flags)
+{
+    j.member("command", command_line).key("machine");
+    write_machine(j, compiler_flags);
+}
+
+void write_json_file(const std::string& path, const JsonWriter& j)
+{
+    io::write_text_file(path, j.str() + "\n");
+}
+
 void write_summary(JsonWriter& j, const Table& t)
 {
     const int ip = t.index_of("point");
@@ -151,9 +157,8 @@ void write_study_json(const StudyPlan& plan, const StudyResult& res, const Table
 {
     const StudyOptions& o = plan.options;
     JsonWriter j;
-    j.begin_object().member("tethash_study", 1).member("sweep", to_string(o.sweep)).member("command", o.command_line);
-    j.key("machine");
-    write_machine(j, o.compiler_flags);
+    j.begin_object().member("tethash_study", 1).member("sweep", to_string(o.sweep));
+    write_run_members(j, o.command_line, o.compiler_flags);
     j.member("points_total", points_total(plan))
         .key("shard")
         .begin_object(JsonWriter::inline_layout)
@@ -185,7 +190,7 @@ void write_study_json(const StudyPlan& plan, const StudyResult& res, const Table
     j.end_array().key("summary");
     write_summary(j, table);
     j.end_object();
-    write_file(res.json_path, j);
+    write_json_file(res.json_path, j);
 }
 
 std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, const std::string& out_dir,
@@ -262,7 +267,7 @@ std::vector<std::int64_t> merge_studies(const std::vector<std::string>& dirs, co
     j.end_array().key("summary");
     write_summary(j, merged);
     j.end_object();
-    write_file((fs::path(out_dir) / "study.json").string(), j);
+    write_json_file((fs::path(out_dir) / "study.json").string(), j);
     return missing;
 }
 

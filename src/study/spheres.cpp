@@ -4,7 +4,6 @@
 #include "report.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/file.hpp"
 #include "tethash/split_tree.hpp"
 #include "tethash/study/json.hpp"
 #include "tethash/study/table.hpp"
@@ -160,6 +159,46 @@ double ms_since(std::chrono::steady_clock::time_point t0)
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// The options of the run, as spheres.json's "options" object.
+void write_options(JsonWriter& j, const SpheresOptions& o)
+{
+    j.begin_object()
+        .member("spheres", o.spheres)
+        .member("frames", o.frames)
+        .member("radius", o.radius)
+        .member("seed", static_cast<std::int64_t>(o.seed))
+        .member("leaf_size", o.leaf_size)
+        .member("dt", o.dt)
+        .end_object();
+}
+
+/// DIR/spheres.json of a run that took `seconds`: command, machine, options, the frames done and each method's
+/// totals (res.summary).
+void write_spheres_json(const SpheresOptions& o, const SpheresResult& res, double seconds)
+{
+    JsonWriter j;
+    j.begin_object().member("tethash_spheres", 1);
+    write_run_members(j, o.command_line, o.compiler_flags);
+    j.key("options");
+    write_options(j, o);
+    j.member("frames_done", res.frames_done)
+        .member("interrupted", res.interrupted)
+        .member("rows", res.rows)
+        .member("seconds", seconds);
+    j.key("summary").begin_array(JsonWriter::block_layout);
+    for (const SpheresSummary& m : res.summary)
+        j.begin_object(JsonWriter::inline_layout)
+            .member("method", m.method)
+            .member("depth", m.depth)
+            .member("total_ms", m.total_ms)
+            .member("mean_ms", res.frames_done ? m.total_ms / res.frames_done : 0.0)
+            .member("tests", m.tests)
+            .member("collisions", m.collisions)
+            .end_object();
+    j.end_array().end_object();
+    write_json_file(res.json_path, j);
+}
+
 } // namespace
 
 void check_spheres_options(const SpheresOptions& o)
@@ -312,37 +351,9 @@ SpheresResult run_spheres(const SpheresOptions& o, const SpheresHooks& hooks)
     }
     csv.close();
 
-    JsonWriter j;
-    j.begin_object().member("tethash_spheres", 1).member("command", o.command_line);
-    j.key("machine");
-    write_machine(j, o.compiler_flags);
-    j.key("options")
-        .begin_object()
-        .member("spheres", o.spheres)
-        .member("frames", o.frames)
-        .member("radius", o.radius)
-        .member("seed", static_cast<std::int64_t>(o.seed))
-        .member("leaf_size", o.leaf_size)
-        .member("dt", o.dt)
-        .end_object()
-        .member("frames_done", res.frames_done)
-        .member("interrupted", res.interrupted)
-        .member("rows", res.rows)
-        .member("seconds", ms_since(started) / 1000);
-    j.key("summary").begin_array(JsonWriter::block_layout);
-    for (const auto& m : methods) {
-        j.begin_object(JsonWriter::inline_layout)
-            .member("method", m.name)
-            .member("depth", m.depth)
-            .member("total_ms", m.total.total_ms)
-            .member("mean_ms", res.frames_done ? m.total.total_ms / res.frames_done : 0.0)
-            .member("tests", m.total.tests)
-            .member("collisions", m.total.collisions)
-            .end_object();
+    for (const auto& m : methods)
         res.summary.push_back(m.total);
-    }
-    j.end_array().end_object();
-    io::write_text_file(res.json_path, j.str() + "\n");
+    write_spheres_json(o, res, ms_since(started) / 1000);
     return res;
 }
 

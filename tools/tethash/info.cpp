@@ -7,6 +7,7 @@
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
 #include "tethash/study/json.hpp"
+#include "tethash/study/stats_table.hpp"
 
 #include <fmt/format.h>
 
@@ -176,21 +177,9 @@ void print_surface(const std::string& path, const io::SurfaceMesh& surface, cons
     const BspStats& s = bsp.stats();
     if (json) {
         study::JsonWriter j;
-        j.begin_object()
-            .member("file", path)
-            .member("vertices", static_cast<Index>(surface.vertices.rows()))
-            .member("triangles", s.triangles)
-            .member("planes", s.planes)
-            .member("nodes", s.nodes)
-            .member("leaves_in", s.leaves_in)
-            .member("leaves_out", s.leaves_out)
-            .member("depth", s.depth)
-            .member("mean_depth", s.mean_depth)
-            .member("splits", s.splits)
-            .member("bytes", s.bytes)
-            .member("flipped", s.flipped)
-            .member("build_ms", s.build_ms)
-            .end_object();
+        j.begin_object().member("file", path).member("vertices", static_cast<Index>(surface.vertices.rows()));
+        study::write_stats(j, s);
+        j.end_object();
         fmt::print("{}\n", j.str());
         return;
     }

@@ -2,8 +2,10 @@
 /// \file study/stats_table.hpp
 /// The detector's statistics (detect.hpp: DetectStats) as one table: each field's name (the study's CSV column,
 /// the key of `tethash detect --stats`), unit, kind and where it is shown. The study, the `detect` command and
-/// tethash_bench list the statistics from here, in this order.
+/// tethash_bench list the statistics from here, in this order. The BSP tree's statistics (bsp.hpp: BspStats) are
+/// written to JSON from a field list too (`tethash info --json` on a surface).
 
+#include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/study/json.hpp"
 
@@ -84,5 +86,9 @@ inline constexpr std::array<StatField, 28> k_detect_stats = {{
 std::string stat_text(const StatField& field, const DetectStats& stats);
 /// The member "name": value (an integer for counts, a number that round-trips otherwise).
 void write_stat(JsonWriter& j, const StatField& field, const DetectStats& stats);
+
+/// Every field of a BSP tree's statistics as a member "name": value, in declaration order, named as the field:
+/// counts as integers, `flipped` as true or false.
+void write_stats(JsonWriter& j, const BspStats& stats);
 
 } // namespace tethash::study
