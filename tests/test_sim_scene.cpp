@@ -35,6 +35,7 @@ integrator = "vbd"
 solver = "ldlt"
 iterations = 7
 acceleration = 0.75
+inversion_guard = true
 tolerance = 1e-8
 gravity = [0, -9.8, 0]
 [ground]
@@ -81,6 +82,7 @@ box_max = [1, 1, 1]
     EXPECT_EQ(s.solver, LinearSolver::ldlt);
     EXPECT_EQ(s.iterations, 7);
     EXPECT_EQ(s.acceleration, 0.75);
+    EXPECT_TRUE(s.inversion_guard);
     EXPECT_EQ(s.gravity.y(), -9.8);
     EXPECT_TRUE(s.ground.enabled);
     EXPECT_NEAR(s.ground.normal.y(), 1.0, 1e-15);
@@ -137,6 +139,7 @@ TEST(SimScene, WrongTypesAndValuesNameKeyAndLine)
         {"[[object]]\nname = \"x\"\n", "object[0]", "s.toml:"},
         {"dt = = 1\n", "TOML", "s.toml:1"},
         {"\nacceleration = 1\n" + kObject, "'acceleration'", "s.toml:2"},
+        {"inversion_guard = 1\n" + kObject, "'inversion_guard'", "s.toml:1"},
         {"[detector]\nthreads = 100000\n" + kObject, "detector.threads", "s.toml:2"},
         {"[detector]\ntable_size = \"x0\"\n" + kObject, "detector.table_size", "s.toml:2"},
         {"[detector]\nskin = \"x-1\"\n" + kObject, "detector.skin", "s.toml:2"},

@@ -16,12 +16,13 @@
 // the start of each iteration (Jacobi across the contact's five nodes), so no two threads ever read a position
 // another one writes.
 //
-// No tet ends a substep inverted where it can be helped: a vertex's step never lowers one of its tets (slivers
-// aside) below a tenth of its rest volume, or further once there (the inversion guard, exact since the volume is
-// linear in the vertex; vertex_stencils.hpp); the sweeps start from a state that inverts no such tet (corners taken
-// back to where the substep started); and what is still inverted at the end (slivers, whose guard would lock a
-// flat tet's corners and the body with them, or a tet the acceleration inverted) is turned back corner by corner.
-// Before, the hand's drop ended with 3 inverted tets, P1's with 36, the raptor's 45 and the crumpling mat's 518.
+// With `inversion_guard`, no tet ends a substep inverted where it can be helped: a vertex's step never lowers one of
+// its tets (slivers aside) below a tenth of its rest volume, or further once there (the inversion guard, exact since
+// the volume is linear in the vertex; vertex_stencils.hpp); the sweeps start from a state that inverts no such tet
+// (corners taken back to where the substep started); and what is still inverted at the end (slivers, whose guard would
+// lock a flat tet's corners and the body with them, or a tet the acceleration inverted) is turned back corner by
+// corner. Without it, the hand's drop ends with 3 inverted tets, P1's with 36, the raptor's 45 and the crumpling mat's
+// 518; with it 2, 2, 0 and 0, but squeezed regions are held back (Scene::inversion_guard says what it costs).
 #include "integrator.hpp"
 #include "vertex_stencils.hpp"
 
@@ -327,7 +328,7 @@ void BlockDescent::setup()
                     tl.c[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][2]));
                     tl.k36[l] = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
                     tl.w0[l] = tl.wt[l] = 6.0 * v0;
-                    tl.guard[l] = model.volumes.sliver[static_cast<size_t>(t)]
+                    tl.guard[l] = !m_ctx.scene.inversion_guard || model.volumes.sliver[static_cast<size_t>(t)]
                                       ? 0.0F
                                       : static_cast<float>(detail::guard_fraction * 6.0 * v0);
                 }
@@ -657,7 +658,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
             xp[4 * i + static_cast<size_t>(r)] = yr;
         }
     }
-    start_without_inversions(xp);
+    if (m_ctx.scene.inversion_guard) start_without_inversions(xp);
     gather_contacts();
 
     const double* xtp = m_xt.data();
@@ -702,7 +703,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (largest <= stop) break;
     }
-    restore_inverted(xp);
+    if (m_ctx.scene.inversion_guard) restore_inverted(xp);
     const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;

@@ -419,6 +419,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         key("tolerance", &Scene::tolerance, &Reader::positive),
         key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
         key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
+        key("inversion_guard", &Scene::inversion_guard, &Reader::boolean),
         key("gravity", &Scene::gravity, &Reader::vec3),
     };
     read_table(

@@ -201,7 +201,7 @@ int main(int argc, char** argv)
     double seconds = 0.5;
     int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0;
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
-    bool no_speculative = false;
+    bool no_speculative = false, inversion_guard = false;
     bool no_peer = false;
     app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
     app.add_option("--scenes", filter, "only scenes whose name contains this");
@@ -221,6 +221,7 @@ int main(int argc, char** argv)
     app.add_option("--margin", margin, "contact margin, as a fraction of the mean edge (0: off); default: scene's")
         ->check(CLI::NonNegativeNumber);
     app.add_flag("--no-speculative", no_speculative, "no speculative contacts (proximity.hpp)");
+    app.add_flag("--inversion-guard", inversion_guard, "vbd: keep tets the right way out (scene key inversion_guard)");
     app.add_flag("--no-peer", no_peer, "do not run the peer (Bullet soft bodies) even when built with it");
     app.add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
     try {
@@ -305,6 +306,7 @@ int main(int argc, char** argv)
                     if (rho >= 0) scene.acceleration = rho;
                     if (margin >= 0) scene.contact.margin = margin;
                     if (no_speculative) scene.contact.speculative = false;
+                    if (inversion_guard) scene.inversion_guard = true;
                     if (skin >= 0) {
                         scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
                         scene.detect.skin = skin;
