@@ -203,27 +203,31 @@ int main(int argc, char** argv)
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
     bool no_speculative = false, inversion_guard = false;
     bool no_peer = false;
-    app.add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
-    app.add_option("--scenes", filter, "only scenes whose name contains this");
-    app.add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")->delimiter(',');
-    app.add_option("--dt", dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
-    app.add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
-    app.add_option("--threads", threads, "detector and solver threads")->capture_default_str();
-    app.add_option("--csv", csv, "write the rows as CSV to this file");
-    app.add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
-    app.add_option("--max-substeps", max_substeps,
-                   "refine a step that inverts tets or blows up into up to this many substeps; 1 = never; "
-                   "0 = the scene default");
-    app.add_option("--sweep-tolerance", sweep_tolerance,
-                   "vbd early stop (fraction of the mean edge); default: scene's");
-    app.add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1); default: scene's");
-    app.add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size; default: scene's");
-    app.add_option("--margin", margin, "contact margin, as a fraction of the mean edge (0: off); default: scene's")
+    // Three sections in --help: what runs, what each scene is made to do differently, and the peer.
+    CLI::Option_group* runs = app.add_option_group("Runs");
+    runs->add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
+    runs->add_option("--scenes", filter, "only scenes whose name contains this");
+    runs->add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")
+        ->delimiter(',');
+    runs->add_option("--dt", dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
+    runs->add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
+    runs->add_option("--threads", threads, "detector and solver threads")->capture_default_str();
+    runs->add_option("--csv", csv, "write the rows as CSV to this file");
+    CLI::Option_group* overrides = app.add_option_group("Scene overrides", "each defaults to the scene's own value");
+    overrides->add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
+    overrides->add_option("--max-substeps", max_substeps,
+                          "refine a step that inverts tets or blows up into up to this many substeps; 1 = never; "
+                          "0 = the scene default");
+    overrides->add_option("--sweep-tolerance", sweep_tolerance, "vbd early stop (fraction of the mean edge)");
+    overrides->add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1)");
+    overrides->add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size");
+    overrides->add_option("--margin", margin, "contact margin, as a fraction of the mean edge (0: off)")
         ->check(CLI::NonNegativeNumber);
-    app.add_flag("--no-speculative", no_speculative, "no speculative contacts (proximity.hpp)");
-    app.add_flag("--inversion-guard", inversion_guard, "vbd: keep tets the right way out (scene key inversion_guard)");
-    app.add_flag("--no-peer", no_peer, "do not run the peer (Bullet soft bodies) even when built with it");
-    app.add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
+    overrides->add_flag("--no-speculative", no_speculative, "no speculative contacts (proximity.hpp)");
+    overrides->add_flag("--inversion-guard", inversion_guard, "vbd: keep tets the right way out (inversion_guard)");
+    CLI::Option_group* peer = app.add_option_group("Peer", "Bullet's soft bodies, when built with libbullet-dev");
+    peer->add_flag("--no-peer", no_peer, "do not run the peer even when built with it");
+    peer->add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
