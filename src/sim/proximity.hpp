@@ -8,7 +8,7 @@
 // (1.5 × their travel relative to their objects' mean motion, plus the objects' relative travel): such a contact
 // starts with a negative depth and pushes only if the gap closes below δ within the substep (a speculative contact;
 // vbd sees it close in its iterations, the other integrators push positive depths only).
-// Faces are hashed into a uniform grid of the mean edge; each vertex looks at the cells its reach covers (one cell
+// Faces are hashed into a uniform grid of two mean edges; each vertex looks at the cells its reach covers (one cell
 // when nothing moves relative to its object). Deterministic: one thread, fixed order.
 
 #include "tethash/detect.hpp"
