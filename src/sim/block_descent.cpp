@@ -23,7 +23,9 @@
 // lock a flat tet's corners and the body with them, or a tet the acceleration inverted) is turned back corner by
 // corner. Without it, the hand's drop ends with 3 inverted tets, P1's with 36, the raptor's 45 and the crumpling mat's
 // 518; with it 2, 2, 0 and 0, but squeezed regions are held back (Scene::inversion_guard says what it costs).
+#include "incidences.hpp"
 #include "integrator.hpp"
+#include "inversion_guard.hpp"
 #include "vertex_stencils.hpp"
 
 #include <Eigen/Geometry>
@@ -46,58 +48,6 @@ using detail::LaneGroup;
 using detail::LaneTerms;
 using detail::SpringLanes;
 using detail::TetLanes;
-
-/// The rows of an index matrix (springs' edges, tets) at each vertex, in compressed form: vertex i's are
-/// entries[start[i] .. start[i + 1]), in row order, each the row or, with `with_column`, cols · row + column.
-struct Incidences {
-    std::vector<std::int32_t> start, entries;
-};
-
-template <class IndexMatrix> Incidences incidences(const IndexMatrix& m, size_t num_vertices, bool with_column)
-{
-    const Index rows = static_cast<Index>(m.rows());
-    const int cols = static_cast<int>(m.cols());
-    Incidences out;
-    out.start.assign(num_vertices + 1, 0);
-    out.entries.resize(static_cast<size_t>(rows * cols));
-    for (Index r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c)
-            ++out.start[static_cast<size_t>(m(r, c)) + 1];
-    for (size_t i = 0; i < num_vertices; ++i)
-        out.start[i + 1] += out.start[i];
-    std::vector<std::int32_t> fill(out.start.begin(), out.start.end() - 1);
-    for (Index r = 0; r < rows; ++r)
-        for (int c = 0; c < cols; ++c)
-            out.entries[static_cast<size_t>(fill[static_cast<size_t>(m(r, c))]++)] =
-                static_cast<std::int32_t>(with_column ? cols * r + c : r);
-    return out;
-}
-
-/// W = 6 V of the tet with corners c in positions x (stride 4).
-double tet_w(const double* x, const std::int32_t* c)
-{
-    const Eigen::Vector3d p0(x + 4 * static_cast<size_t>(c[0]));
-    return (Eigen::Vector3d(x + 4 * static_cast<size_t>(c[1])) - p0)
-        .dot((Eigen::Vector3d(x + 4 * static_cast<size_t>(c[2])) - p0)
-                 .cross(Eigen::Vector3d(x + 4 * static_cast<size_t>(c[3])) - p0));
-}
-
-/// ∇ of W (tet_w) with respect to corner a.
-Eigen::Vector3d volume_gradient(const double* x, const std::int32_t* c, int a)
-{
-    auto p = [&](int k) { return Eigen::Vector3d(x + 4 * static_cast<size_t>(c[k])); };
-    const Eigen::Vector3d e1 = p(1) - p(0), e2 = p(2) - p(0), e3 = p(3) - p(0);
-    switch (a) {
-    case 1:
-        return e2.cross(e3);
-    case 2:
-        return e3.cross(e1);
-    case 3:
-        return e1.cross(e2);
-    default:
-        return -(e2.cross(e3) + e3.cross(e1) + e1.cross(e2));
-    }
-}
 
 /// One incidence of a vertex in a contact's stencil.
 struct VertexContact {
@@ -136,7 +86,7 @@ int automatic_sweeps(double h)
 
 class BlockDescent final : public StepIntegrator {
   public:
-    explicit BlockDescent(const StepContext& ctx) : m_ctx(ctx) { setup(); }
+    explicit BlockDescent(const StepContext& ctx) : m_ctx(ctx), m_inversions(ctx.model) { setup(); }
 
     int substep(Positions& x, Positions& v, double h) override;
 
@@ -151,19 +101,6 @@ class BlockDescent final : public StepIntegrator {
     void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
     /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
     void accelerate(int n, double rho, double& omega, double* x);
-    /// The sweeps' starting point without inverted tets (the inversion guard keeps only what starts positive): the
-    /// free corners of every tet (not a sliver) that x inverts go back to their start-of-substep positions, then
-    /// those of the tets this inverts, and so on (each vertex once).
-    void start_without_inversions(double* x);
-    /// Gives the tets still inverted after the sweeps (slivers, which are not guarded: the guard would hold a flat
-    /// tet's corners to within its height of where they are, and the body with them; or a tet the acceleration
-    /// inverted) their orientation back: one corner moves along the volume's gradient to W = guard_fraction · W0,
-    /// the corner with the shortest way first, each move shortened so that the corner's other tets keep half of
-    /// what they have above the guard's floor; a few passes, since such tets share corners.
-    void restore_inverted(double* x);
-    /// The fraction (0 … 1] of a move d of vertex v that keeps each of its tets (slivers aside) with W > 0 above
-    /// half of min(W, guard_fraction · W0).
-    double corner_move_allowed(const double* x, size_t v, const double d[3]) const;
 
     StepContext m_ctx;
     // Fixed set-up, built once: the free vertices of each colour in groups of four lanes (vertex_stencils.hpp),
@@ -197,11 +134,7 @@ class BlockDescent final : public StepIntegrator {
     std::vector<ActiveContact> m_contacts;
     std::vector<std::int32_t> m_vc_start; ///< vertex id → incidences
     std::vector<VertexContact> m_vc;
-    // Inversion checks of whole states: the tets' corners, the tets at each vertex, scratch.
-    std::vector<std::int32_t> m_tet_corners; ///< 4 per tet, oriented so that the rest volume is positive
-    Incidences m_tets_at;
-    std::vector<std::int32_t> m_bad; ///< inverted tets found
-    std::vector<char> m_taken;       ///< vertex id → taken back to its start
+    InversionGuard m_inversions; ///< whole-state checks of the inversion guard (inversion_guard.hpp)
 };
 
 void BlockDescent::setup()
@@ -212,13 +145,8 @@ void BlockDescent::setup()
 
     // Vertex → springs (by id), then a greedy colouring of the free vertices over the edge graph (every pair of
     // vertices of a tet is an edge, so one colour shares no spring and no tet).
-    const Incidences springs_at = incidences(model.springs.edges, un, false);
-    const Incidences tets_at = incidences(model.volumes.tets, un, true);
-    m_tets_at = incidences(model.volumes.tets, un, false);
-    m_tet_corners.resize(static_cast<size_t>(model.volumes.tets.rows()) * 4);
-    for (Index t = 0; t < model.volumes.tets.rows(); ++t)
-        for (int a = 0; a < 4; ++a)
-            m_tet_corners[static_cast<size_t>(4 * t + a)] = static_cast<std::int32_t>(model.volumes.tets(t, a));
+    const detail::Incidences springs_at = detail::incidences(model.springs.edges, un, false);
+    const detail::Incidences tets_at = detail::incidences(model.volumes.tets, un, true);
     const std::vector<std::int32_t>& adj_start = springs_at.start;
     const std::vector<std::int32_t>& adj_spring = springs_at.entries;
     const std::vector<std::int32_t>& tet_adj_start = tets_at.start;
@@ -525,88 +453,6 @@ void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
     terms.H[5][l] = H.yz;
 }
 
-void BlockDescent::start_without_inversions(double* x)
-{
-    const Model& model = m_ctx.model;
-    const size_t nt = m_tet_corners.size() / 4;
-    m_bad.clear();
-    for (size_t t = 0; t < nt; ++t)
-        if (!model.volumes.sliver[t] && !(tet_w(x, &m_tet_corners[4 * t]) > 0))
-            m_bad.push_back(static_cast<std::int32_t>(t));
-    if (m_bad.empty()) return;
-    m_taken.assign(model.mass.size(), 0);
-    while (!m_bad.empty()) {
-        const size_t t = static_cast<size_t>(m_bad.back());
-        m_bad.pop_back();
-        if (model.volumes.sliver[t] || tet_w(x, &m_tet_corners[4 * t]) > 0) continue;
-        for (int a = 0; a < 4; ++a) {
-            const size_t v = static_cast<size_t>(m_tet_corners[4 * t + static_cast<size_t>(a)]);
-            if (m_taken[v] || model.fixed[v]) continue;
-            m_taken[v] = 1;
-            for (Index r = 0; r < 3; ++r)
-                x[4 * v + static_cast<size_t>(r)] = m_xt(static_cast<Index>(v), r);
-            for (std::int32_t e = m_tets_at.start[v]; e < m_tets_at.start[v + 1]; ++e)
-                m_bad.push_back(m_tets_at.entries[static_cast<size_t>(e)]);
-        }
-    }
-}
-
-double BlockDescent::corner_move_allowed(const double* x, size_t v, const double d[3]) const
-{
-    const Model& model = m_ctx.model;
-    double t_max = std::numeric_limits<double>::infinity();
-    for (std::int32_t e = m_tets_at.start[v]; e < m_tets_at.start[v + 1]; ++e) {
-        const size_t t = static_cast<size_t>(m_tets_at.entries[static_cast<size_t>(e)]);
-        if (model.volumes.sliver[t]) continue;
-        const std::int32_t* c = &m_tet_corners[4 * t];
-        int a = 0;
-        while (static_cast<size_t>(c[a]) != v)
-            ++a;
-        const Eigen::Vector3d g = volume_gradient(x, c, a);
-        const double w = tet_w(x, c), nd = g.dot(Eigen::Vector3d(d[0], d[1], d[2]));
-        if (!(w > 0) || !(nd < 0)) continue;
-        const double floor = 0.5 * std::min(w, detail::guard_fraction * 6.0 * model.volumes.rest[t]);
-        t_max = std::min(t_max, (w - floor) / -nd);
-    }
-    return std::min(1.0, 0.9 * t_max);
-}
-
-void BlockDescent::restore_inverted(double* x)
-{
-    const Model& model = m_ctx.model;
-    m_bad.clear();
-    const size_t nt = m_tet_corners.size() / 4;
-    for (size_t t = 0; t < nt; ++t)
-        if (!(tet_w(x, &m_tet_corners[4 * t]) > 0)) m_bad.push_back(static_cast<std::int32_t>(t));
-    for (int pass = 0; pass < 8 && !m_bad.empty(); ++pass) {
-        bool inverted = false;
-        for (const std::int32_t t : m_bad) {
-            const std::int32_t* c = &m_tet_corners[4 * static_cast<size_t>(t)];
-            const double w = tet_w(x, c);
-            if (w > 0) continue;
-            inverted = true;
-            // One corner moves (its other tets guarded as in the sweeps): the one with the shortest way back.
-            const double target = detail::guard_fraction * 6.0 * model.volumes.rest[static_cast<size_t>(t)];
-            int order[4] = {0, 1, 2, 3};
-            Eigen::Vector3d g[4];
-            for (int a = 0; a < 4; ++a)
-                g[a] = volume_gradient(x, c, a);
-            std::sort(order, order + 4, [&](int p, int q) { return g[p].squaredNorm() > g[q].squaredNorm(); });
-            for (const int a : order) {
-                const size_t v = static_cast<size_t>(c[a]);
-                if (model.fixed[v] || !(g[a].squaredNorm() > 0)) continue;
-                const Eigen::Vector3d step = (target - w) / g[a].squaredNorm() * g[a];
-                const double d[3] = {step.x(), step.y(), step.z()};
-                const double f = corner_move_allowed(x, v, d);
-                for (size_t r = 0; r < 3; ++r)
-                    x[4 * v + r] += f * d[r];
-                if (tet_w(x, c) > 0) break;
-            }
-        }
-        if (!inverted) return;
-    }
-}
-
 void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
 {
     omega = n == 1 ? 1.0 : n == 2 ? 2.0 / (2.0 - rho * rho) : 4.0 / (4.0 - rho * rho * omega);
@@ -658,7 +504,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
             xp[4 * i + static_cast<size_t>(r)] = yr;
         }
     }
-    if (m_ctx.scene.inversion_guard) start_without_inversions(xp);
+    if (m_ctx.scene.inversion_guard) m_inversions.start_without_inversions(xp, m_xt);
     gather_contacts();
 
     const double* xtp = m_xt.data();
@@ -703,7 +549,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (largest <= stop) break;
     }
-    if (m_ctx.scene.inversion_guard) restore_inverted(xp);
+    if (m_ctx.scene.inversion_guard) m_inversions.restore_inverted(xp);
     const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
