@@ -90,11 +90,9 @@ std::int64_t count_inverted_non_slivers(const Model& m, const Positions& x)
     std::int64_t n = 0;
     for (Index t = 0; t < m.volumes.tets.rows(); ++t) {
         if (m.volumes.sliver[static_cast<size_t>(t)]) continue;
-        const Eigen::Vector3d a = x.row(m.volumes.tets(t, 0)).transpose();
-        const double w =
-            (x.row(m.volumes.tets(t, 1)).transpose() - a)
-                .dot((x.row(m.volumes.tets(t, 2)).transpose() - a).cross(x.row(m.volumes.tets(t, 3)).transpose() - a));
-        n += w > 0 ? 0 : 1;
+        const std::array<Index, 4> tet{m.volumes.tets(t, 0), m.volumes.tets(t, 1), m.volumes.tets(t, 2),
+                                       m.volumes.tets(t, 3)};
+        n += signed_volume(x, tet) > 0 ? 0 : 1;
     }
     return n;
 }

@@ -129,12 +129,12 @@ struct Stencils {
     }
 };
 
-GatherFn scalar_gather()
+GatherFn scalar_gather(bool inversion_guard = false)
 {
     const char* old = std::getenv("TETHASH_SIMD");
     const std::string saved = old ? old : "";
     setenv("TETHASH_SIMD", "scalar", 1);
-    GatherFn fn = choose_gather();
+    GatherFn fn = choose_gather(inversion_guard);
     if (old)
         setenv("TETHASH_SIMD", saved.c_str(), 1);
     else
@@ -323,9 +323,15 @@ TEST(SimVertexStencils, InversionGuardLowersNoTetBelowItsFloor)
     int shortened = 0, steps = 0;
     for (unsigned seed = 1; seed <= 60; ++seed) {
         Stencils s(seed, 4);
-        for (GatherFn fn : {choose_gather(), scalar_gather()}) {
+        for (const bool scalar : {false, true}) {
+            const GatherFn fn = scalar ? scalar_gather(true) : choose_gather(true);
             const LaneTerms t = s.gather(fn);
+            // The gather without the guard (the default path) gives the same terms and no reach.
+            const LaneTerms plain = s.gather(scalar ? scalar_gather() : choose_gather());
+            EXPECT_EQ(std::memcmp(plain.f, t.f, sizeof(t.f)), 0) << gather_kernel_name(fn) << " seed " << seed;
+            EXPECT_EQ(std::memcmp(plain.H, t.H, sizeof(t.H)), 0) << gather_kernel_name(fn) << " seed " << seed;
             for (int l = 0; l < 4; ++l) {
+                EXPECT_TRUE(std::isinf(plain.reach2[l])) << gather_kernel_name(fn) << " seed " << seed;
                 double expect = std::numeric_limits<double>::infinity();
                 for (const TetLanes& e : s.tets) {
                     double n = 0;
@@ -340,7 +346,7 @@ TEST(SimVertexStencils, InversionGuardLowersNoTetBelowItsFloor)
                 }
             }
         }
-        const LaneTerms t = s.gather(scalar_gather());
+        const LaneTerms t = s.gather(scalar_gather(true));
         for (int l = 0; l < 4; ++l) {
             const double len = 2 * (u(rng) + 1);
             double d[3] = {u(rng), u(rng), u(rng)};

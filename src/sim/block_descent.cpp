@@ -265,7 +265,7 @@ void BlockDescent::setup()
         }
         m_colour_start.push_back(static_cast<std::int32_t>(m_groups.size()));
     }
-    m_gather = detail::choose_gather();
+    m_gather = detail::choose_gather(m_ctx.scene.inversion_guard);
     m_start = detail::choose_start(m_gather);
     m_solve = detail::choose_solve(m_gather);
     if (model.ground.enabled) {

@@ -34,13 +34,6 @@ double volume_and_gradient(const Positions& x, const Index* t, Eigen::Matrix<dou
     return ba.dot(ca.cross(da)) / 6.0;
 }
 
-/// The signed volume of tet t (volume_and_gradient's, without the gradient).
-double signed_volume(const Positions& x, const Index* t)
-{
-    const Vec3 a = row(x, t[0]);
-    return (row(x, t[1]) - a).dot((row(x, t[2]) - a).cross(row(x, t[3]) - a)) / 6.0;
-}
-
 /// Volume of the regular tet of edge length l: l³ / (6 √2).
 double regular_tet_volume(double l)
 {
@@ -321,8 +314,10 @@ Energy Model::energy(const Positions& x, const Positions& v) const
         const double s = len - springs.rest[static_cast<size_t>(e)];
         en.spring += 0.5 * springs.k[static_cast<size_t>(e)] * s * s;
     }
+    const PositionsRef xr(x);
     for (Index t = 0; t < volumes.tets.rows(); ++t) {
-        const double vol = signed_volume(x, &volumes.tets(t, 0));
+        const double vol =
+            signed_volume(xr, {volumes.tets(t, 0), volumes.tets(t, 1), volumes.tets(t, 2), volumes.tets(t, 3)});
         const double v0 = volumes.rest[static_cast<size_t>(t)];
         en.volume += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
     }

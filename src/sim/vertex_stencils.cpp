@@ -34,6 +34,7 @@ inline double volume_term(const TetLanes& t, int l, const double* x, double px, 
     return (a[0] - px) * n[0] + (a[1] - py) * n[1] + (a[2] - pz) * n[2];
 }
 
+template <bool Guard>
 void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLanes* tets, const double* x, double inv_h,
                    LaneTerms& out)
 {
@@ -91,7 +92,7 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
             H[3][l] += ks * nx * ny;
             H[4][l] += ks * nx * nz;
             H[5][l] += ks * ny * nz;
-            if (t.guard[l] > 0 && w > 0) {
+            if (Guard && t.guard[l] > 0 && w > 0) {
                 const double slack = std::max(0.0, w - static_cast<double>(t.guard[l]));
                 reach2[l] = std::min(reach2[l], slack * slack / (nx * nx + ny * ny + nz * nz));
             }
@@ -209,6 +210,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline __m256d face_normal_an
                            _mm256_fmadd_pd(_mm256_sub_pd(ay, yi), ny, _mm256_mul_pd(_mm256_sub_pd(az, zi), nz)));
 }
 
+template <bool Guard>
 __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const SpringLanes* springs,
                                                      const TetLanes* tets, const double* x, double inv_h,
                                                      LaneTerms& out)
@@ -270,12 +272,15 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         hxy = _mm256_fmadd_pd(knx, ny, hxy);
         hxz = _mm256_fmadd_pd(knx, nz, hxz);
         hyz = _mm256_fmadd_pd(kny, nz, hyz);
-        const __m256d tau = _mm256_cvtps_pd(_mm_load_ps(t.guard));
-        const __m256d guarded = _mm256_and_pd(_mm256_cmp_pd(tau, zero, _CMP_GT_OQ), _mm256_cmp_pd(w, zero, _CMP_GT_OQ));
-        const __m256d slack = _mm256_max_pd(zero, _mm256_sub_pd(w, tau));
-        const __m256d n2 = _mm256_fmadd_pd(nx, nx, _mm256_fmadd_pd(ny, ny, _mm256_mul_pd(nz, nz)));
-        const __m256d r2 = _mm256_div_pd(_mm256_mul_pd(slack, slack), n2);
-        reach2 = _mm256_min_pd(reach2, _mm256_blendv_pd(inf, r2, guarded));
+        if constexpr (Guard) {
+            const __m256d tau = _mm256_cvtps_pd(_mm_load_ps(t.guard));
+            const __m256d guarded =
+                _mm256_and_pd(_mm256_cmp_pd(tau, zero, _CMP_GT_OQ), _mm256_cmp_pd(w, zero, _CMP_GT_OQ));
+            const __m256d slack = _mm256_max_pd(zero, _mm256_sub_pd(w, tau));
+            const __m256d n2 = _mm256_fmadd_pd(nx, nx, _mm256_fmadd_pd(ny, ny, _mm256_mul_pd(nz, nz)));
+            const __m256d r2 = _mm256_div_pd(_mm256_mul_pd(slack, slack), n2);
+            reach2 = _mm256_min_pd(reach2, _mm256_blendv_pd(inf, r2, guarded));
+        }
     }
     _mm256_store_pd(out.reach2, reach2);
     _mm256_store_pd(out.f[0], fx);
@@ -340,7 +345,7 @@ __attribute__((target("avx2,fma"))) int solve_avx2(const LaneTerms& t, double d[
 
 /// The kernels that go together, the scalar ones last (what an unknown gather is matched with).
 struct KernelSet {
-    GatherFn gather;
+    GatherFn gather, guarded_gather;
     StartFn start;
     SolveFn solve;
     const char* name;
@@ -348,15 +353,15 @@ struct KernelSet {
 
 constexpr KernelSet k_kernel_sets[] = {
 #ifdef TETHASH_X86
-    {gather_avx2, start_avx2, solve_avx2, "avx2"},
+    {gather_avx2<false>, gather_avx2<true>, start_avx2, solve_avx2, "avx2"},
 #endif
-    {gather_scalar, start_scalar, solve_scalar, "scalar"},
+    {gather_scalar<false>, gather_scalar<true>, start_scalar, solve_scalar, "scalar"},
 };
 
 const KernelSet& kernels_of(GatherFn gather)
 {
     for (const KernelSet& k : k_kernel_sets)
-        if (k.gather == gather) return k;
+        if (k.gather == gather || k.guarded_gather == gather) return k;
     return k_kernel_sets[std::size(k_kernel_sets) - 1];
 }
 
@@ -372,15 +377,18 @@ StartFn choose_start(GatherFn gather)
     return kernels_of(gather).start;
 }
 
-GatherFn choose_gather()
+GatherFn choose_gather(bool inversion_guard)
 {
+    const KernelSet* set = &k_kernel_sets[std::size(k_kernel_sets) - 1]; // the scalar kernels
     const char* env = std::getenv("TETHASH_SIMD");
-    if (env && std::strcmp(env, "scalar") == 0) return gather_scalar;
 #ifdef TETHASH_X86
     __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return gather_avx2;
+    if (!(env && std::strcmp(env, "scalar") == 0) && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        set = &k_kernel_sets[0];
+#else
+    (void)env;
 #endif
-    return gather_scalar;
+    return inversion_guard ? set->guarded_gather : set->gather;
 }
 
 const char* gather_kernel_name(GatherFn fn)

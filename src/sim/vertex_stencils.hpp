@@ -77,7 +77,8 @@ using SolveFn = int (*)(const LaneTerms& t, double d[3][4]);
 SolveFn choose_solve(GatherFn gather);
 
 /// The gather for this processor (AVX2 + FMA or one lane at a time; TETHASH_SIMD=scalar forces the latter).
-GatherFn choose_gather();
+/// Without `inversion_guard` it leaves LaneTerms::reach2 infinite and spends nothing on it (the default path).
+GatherFn choose_gather(bool inversion_guard = false);
 
 /// "avx2" or "scalar": what choose_gather() returns.
 const char* gather_kernel_name(GatherFn fn);
