@@ -83,7 +83,6 @@ std::string run_for(Simulation& sim, double seconds)
     return {};
 }
 
-/// Mean drop (start z minus current z) of the vertices whose start position satisfies `selected`.
 /// Tets of the model inverted in positions x that are not slivers (Model::VolumeTerms::sliver).
 std::int64_t count_inverted_non_slivers(const Model& m, const Positions& x)
 {
@@ -121,6 +120,7 @@ DropRun run_drop(Simulation& sim, double dt)
     return r;
 }
 
+/// Mean drop (start z minus current z) of the vertices whose start position satisfies `selected`.
 template <class Selected> double mean_drop(const Positions& start, const Positions& now, Selected selected)
 {
     double sum = 0;
@@ -313,9 +313,10 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
     // at dt 1/240 and 1/60 the run completes, reaches the ground, ends with at most 1 % inverted tets and (at
     // 1/240) no vertex folded through a distant part of its body at any frame of 1/60 s. Screw and P1 (a lattice of
     // thin struts that collapses under its weight) need refined steps for it at 1/60 (P1 also at 1/240): without
-    // refinement (max_substeps 1) they crumple, and the run must say so. With Scene::inversion_guard no tet but
-    // slivers ends inverted, and every mesh holds without refined steps (P1's pressed struts: at most one far
-    // self-penetration at a frame).
+    // refinement (max_substeps 1) they crumple, and the run must say so. The tets a step leaves inverted are turned
+    // back after it: no tet ends inverted but a few of P1's (a tenth of a percent; 36 at 1/240 before). With
+    // Scene::inversion_guard no tet but slivers ends inverted, and every mesh holds without refined steps (P1's
+    // pressed struts: at most one far self-penetration at a frame).
     int ran = 0;
     for (const char* name : {"octopus-low.mesh", "armadillo_4k.node", "screw.msh", "P1.msh"}) {
         const auto path = test::shared_mesh(name);
@@ -331,7 +332,10 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
                 const Positions start = sim.positions();
                 const DropRun run = run_drop(sim, dt);
                 EXPECT_EQ(run.failure, "") << what;
-                EXPECT_LE(count_inverted(sim.mesh(), start), mesh.num_tets() / 100) << what;
+                const std::int64_t allowed = guard                           ? mesh.num_tets() / 100
+                                             : std::string(name) == "P1.msh" ? mesh.num_tets() / 1000
+                                                                             : 0;
+                EXPECT_LE(count_inverted(sim.mesh(), start), allowed) << what;
                 EXPECT_TRUE(sim.positions().allFinite()) << what;
                 EXPECT_LT(sim.positions().col(2).minCoeff(), 0.05) << what << ": did not land";
                 if (guard) {
@@ -351,6 +355,26 @@ TEST(SimBlockDescent, SharedMeshesDropAt240And60WithoutCrumpling)
             }
     }
     if (ran == 0) GTEST_SKIP() << "../shared/meshes absent";
+}
+
+TEST(SimBlockDescent, HandDropEndsWithNoInvertedTet)
+{
+    // The hand dropped 0.2 m at 1/240 lands on its palm: slivers of its skin (rest volume 0.03-0.2 % of a regular
+    // tet of their mean edge) are pressed flat on the ground, and three ended inverted before the tets a step
+    // leaves inverted were turned back after it. Now none at the end, none folded through a distant part of the
+    // hand at any frame, and it rests where it rested (mean height 7 cm: the moves are a sliver's height).
+    const auto path = test::shared_mesh("hand.mesh");
+    if (!path) GTEST_SKIP() << "../shared/meshes absent";
+    const TetMesh mesh = io::read_mesh(path->string());
+    Simulation sim(drop(mesh, 1.0 / 240));
+    const Positions start = sim.positions();
+    const DropRun run = run_drop(sim, 1.0 / 240);
+    ASSERT_EQ(run.failure, "");
+    EXPECT_EQ(count_inverted(sim.mesh(), start), 0);
+    EXPECT_EQ(run.worst_far, 0);
+    const double mean_z = sim.positions().col(2).mean();
+    EXPECT_GT(mean_z, 0.06);
+    EXPECT_LT(mean_z, 0.08);
 }
 
 TEST(SimBlockDescent, TwoArmadillosThrownIntoEachOther)
@@ -383,7 +407,7 @@ TEST(SimBlockDescent, TwoArmadillosThrownIntoEachOther)
         if (i % 4 == 3) worst_far = std::max(worst_far, far.count(sim.positions()));
     }
     EXPECT_GT(between, 0); // they did collide
-    EXPECT_LE(count_inverted(sim.mesh(), start), 2 * mesh.num_tets() / 100);
+    EXPECT_EQ(count_inverted(sim.mesh(), start), 0);
     // No vertex inside a distant part of its own body, at the end or at any frame of 1/60 s (the margin contacts
     // meet the claws and ears before they cross a thin part).
     EXPECT_EQ(count_far_self_penetrations(sim.mesh(), start), 0);

@@ -16,13 +16,18 @@
 // the start of each iteration (Jacobi across the contact's five nodes), so no two threads ever read a position
 // another one writes.
 //
+// After each step (finish_step), the tets it left inverted are turned back corner by corner, positions only, in
+// moves of at most a twentieth of the mean edge that press no other tet of the corner towards inversion
+// (inversion_guard.hpp): slivers pressed flat on the ground, the odd tet of an impact. The refinement of steps and
+// the crumple check read the count before it, so a crumpling body is still refined or stopped. Without it, the
+// hand's drop at 1/240 ends with 3 inverted tets (slivers on the ground), P1's with 36, the raptor's 45 and the
+// crumpling mat's 518 (docs/simulator.md has what it leaves).
+//
 // With `inversion_guard`, no tet ends a substep inverted where it can be helped: a vertex's step never lowers one of
 // its tets (slivers aside) below a tenth of its rest volume, or further once there (the inversion guard, exact since
-// the volume is linear in the vertex; vertex_stencils.hpp); the sweeps start from a state that inverts no such tet
-// (corners taken back to where the substep started); and what is still inverted at the end (slivers, whose guard would
-// lock a flat tet's corners and the body with them, or a tet the acceleration inverted) is turned back corner by
-// corner. Without it, the hand's drop ends with 3 inverted tets, P1's with 36, the raptor's 45 and the crumpling mat's
-// 518; with it 2, 2, 0 and 0, but squeezed regions are held back (Scene::inversion_guard says what it costs).
+// the volume is linear in the vertex; vertex_stencils.hpp), and the sweeps start from a state that inverts no such
+// tet (corners taken back to where the substep started); but squeezed regions are held back
+// (Scene::inversion_guard says what it costs).
 #include "incidences.hpp"
 #include "integrator.hpp"
 #include "inversion_guard.hpp"
@@ -89,6 +94,7 @@ class BlockDescent final : public StepIntegrator {
     explicit BlockDescent(const StepContext& ctx) : m_ctx(ctx), m_inversions(ctx.model) { setup(); }
 
     int substep(Positions& x, Positions& v, double h) override;
+    void finish_step(Positions& x, std::int64_t inverted) override;
 
   private:
     void setup();
@@ -549,7 +555,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (largest <= stop) break;
     }
-    if (m_ctx.scene.inversion_guard) m_inversions.restore_inverted(xp);
+    if (m_ctx.scene.inversion_guard) m_inversions.restore_in_substep(xp);
     const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
@@ -559,6 +565,22 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         }
     }
     return sweeps;
+}
+
+void BlockDescent::finish_step(Positions& x, std::int64_t inverted)
+{
+    // With the guard each substep ended with restore_in_substep (its slivers may stay inverted: turned back here
+    // too, its pressed struts at 1/60 ended with a non-sliver inverted).
+    if (inverted == 0 || m_ctx.scene.inversion_guard) return;
+    // Positions only: the velocities keep what the step gave them, so the moves add no kinetic energy.
+    const size_t un = static_cast<size_t>(x.rows());
+    m_x4.resize(un);
+    for (size_t i = 0; i < un; ++i)
+        m_x4[i] = {x(static_cast<Index>(i), 0), x(static_cast<Index>(i), 1), x(static_cast<Index>(i), 2), 0.0};
+    m_inversions.restore_after_step(m_x4.data()->c);
+    for (size_t i = 0; i < un; ++i)
+        for (int r = 0; r < 3; ++r)
+            x(static_cast<Index>(i), r) = m_x4[i].c[r];
 }
 
 } // namespace

@@ -76,13 +76,13 @@ void InversionGuard::start_without_inversions(double* x, const Positions& start)
     }
 }
 
-double InversionGuard::corner_move_allowed(const double* x, std::size_t v, const double d[3]) const
+double InversionGuard::corner_move_allowed(const double* x, std::size_t v, const double d[3], bool hold_slivers) const
 {
     const Model& model = m_model;
     double t_max = std::numeric_limits<double>::infinity();
     for (std::int32_t e = m_tets_at.start[v]; e < m_tets_at.start[v + 1]; ++e) {
         const size_t t = static_cast<size_t>(m_tets_at.entries[static_cast<size_t>(e)]);
-        if (model.volumes.sliver[t]) continue;
+        if (!hold_slivers && model.volumes.sliver[t]) continue;
         const std::int32_t* c = &m_corners[4 * t];
         int a = 0;
         while (static_cast<size_t>(c[a]) != v)
@@ -96,14 +96,25 @@ double InversionGuard::corner_move_allowed(const double* x, std::size_t v, const
     return std::min(1.0, 0.9 * t_max);
 }
 
-void InversionGuard::restore_inverted(double* x)
+std::int64_t InversionGuard::restore_after_step(double* x)
+{
+    return restore_inverted(x, restore_move_edges, true);
+}
+
+std::int64_t InversionGuard::restore_in_substep(double* x)
+{
+    return restore_inverted(x, std::numeric_limits<double>::infinity(), false);
+}
+
+std::int64_t InversionGuard::restore_inverted(double* x, double longest_move, bool hold_slivers)
 {
     const Model& model = m_model;
     m_bad.clear();
     const size_t nt = m_corners.size() / 4;
     for (size_t t = 0; t < nt; ++t)
         if (!(tet_w(x, &m_corners[4 * t]) > 0)) m_bad.push_back(static_cast<std::int32_t>(t));
-    for (int pass = 0; pass < 8 && !m_bad.empty(); ++pass) {
+    const auto found = static_cast<std::int64_t>(m_bad.size());
+    for (int pass = 0; pass < restore_passes && !m_bad.empty(); ++pass) {
         bool inverted = false;
         for (const std::int32_t t : m_bad) {
             const std::int32_t* c = &m_corners[4 * static_cast<size_t>(t)];
@@ -120,16 +131,20 @@ void InversionGuard::restore_inverted(double* x)
             for (const int a : order) {
                 const size_t v = static_cast<size_t>(c[a]);
                 if (model.fixed[v] || !(g[a].squaredNorm() > 0)) continue;
-                const Eigen::Vector3d step = (target - w) / g[a].squaredNorm() * g[a];
+                Eigen::Vector3d step = (target - w) / g[a].squaredNorm() * g[a];
+                const double longest =
+                    longest_move * model.object_mean_edge[static_cast<size_t>(model.vertex_object[v])];
+                if (step.norm() > longest) step *= longest / step.norm();
                 const double d[3] = {step.x(), step.y(), step.z()};
-                const double f = corner_move_allowed(x, v, d);
+                const double f = corner_move_allowed(x, v, d, hold_slivers);
                 for (size_t r = 0; r < 3; ++r)
                     x[4 * v + r] += f * d[r];
                 if (tet_w(x, c) > 0) break;
             }
         }
-        if (!inverted) return;
+        if (!inverted) break;
     }
+    return found;
 }
 
 } // namespace tethash::sim

@@ -230,6 +230,9 @@ void Simulation::step()
         if (s.inverted > allowed && refine()) continue;
         break;
     }
+    // vbd turns back what the step left inverted (positions only); the count above, which the refinement and the
+    // crumple check read, is the step's own.
+    s.integrator->finish_step(x, s.inverted);
     if (substeps > s.refined) {
         s.refined = substeps;
         s.refined_until = s.t + 0.05;
