@@ -6,7 +6,91 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define TETHASH_X86 1
+#endif
+
+namespace tethash::sim::detail {
+
+namespace {
+
+std::int32_t box_filter_scalar(const float* const box[6], std::int32_t begin, std::int32_t end, const float q[6],
+                               std::int32_t* hits)
+{
+    std::int32_t n = 0;
+    for (std::int32_t e = begin; e < end; ++e) {
+        const size_t u = static_cast<size_t>(e);
+        if ((q[3] < box[0][u]) | (q[0] > box[3][u]) | (q[4] < box[1][u]) | (q[1] > box[4][u]) | (q[5] < box[2][u]) |
+            (q[2] > box[5][u]))
+            continue;
+        hits[n++] = e;
+    }
+    return n;
+}
+
+#ifdef TETHASH_X86
+/// Eight entries at a time (the columns are padded by eight, so the last group's loads stay inside).
+__attribute__((target("avx2"))) std::int32_t box_filter_avx2(const float* const box[6], std::int32_t begin,
+                                                             std::int32_t end, const float q[6], std::int32_t* hits)
+{
+    const __m256 qlo0 = _mm256_set1_ps(q[0]), qlo1 = _mm256_set1_ps(q[1]), qlo2 = _mm256_set1_ps(q[2]);
+    const __m256 qhi0 = _mm256_set1_ps(q[3]), qhi1 = _mm256_set1_ps(q[4]), qhi2 = _mm256_set1_ps(q[5]);
+    std::int32_t n = 0;
+    for (std::int32_t e = begin; e < end; e += 8) {
+        const size_t u = static_cast<size_t>(e);
+        __m256 miss = _mm256_cmp_ps(qhi0, _mm256_loadu_ps(box[0] + u), _CMP_LT_OQ);
+        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo0, _mm256_loadu_ps(box[3] + u), _CMP_GT_OQ));
+        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qhi1, _mm256_loadu_ps(box[1] + u), _CMP_LT_OQ));
+        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo1, _mm256_loadu_ps(box[4] + u), _CMP_GT_OQ));
+        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qhi2, _mm256_loadu_ps(box[2] + u), _CMP_LT_OQ));
+        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo2, _mm256_loadu_ps(box[5] + u), _CMP_GT_OQ));
+        unsigned meet = ~static_cast<unsigned>(_mm256_movemask_ps(miss)) & 0xffu;
+        if (end - e < 8) meet &= (1u << (end - e)) - 1;
+        while (meet) {
+            hits[n++] = e + __builtin_ctz(meet);
+            meet &= meet - 1;
+        }
+    }
+    return n;
+}
+#endif
+
+BoxFilter choose_box_filter()
+{
+    const char* env = std::getenv("TETHASH_SIMD");
+    if (env && std::strcmp(env, "scalar") == 0) return box_filter_scalar;
+#ifdef TETHASH_X86
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2")) return box_filter_avx2;
+#endif
+    return box_filter_scalar;
+}
+
+const BoxFilter chosen_box_filter = choose_box_filter();
+
+} // namespace
+
+std::vector<std::pair<const char*, BoxFilter>> box_filters()
+{
+    std::vector<std::pair<const char*, BoxFilter>> all{{"scalar", box_filter_scalar}};
+#ifdef TETHASH_X86
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2")) all.emplace_back("avx2", box_filter_avx2);
+#endif
+    return all;
+}
+
+const char* box_filter_name()
+{
+    return chosen_box_filter == box_filter_scalar ? "scalar" : "avx2";
+}
+
+} // namespace tethash::sim::detail
 
 namespace tethash::sim {
 
@@ -247,10 +331,22 @@ void Proximity::hash_faces(const Positions& x)
     for (size_t b = 0; b < buckets; ++b)
         m_bucket_start[b + 1] += m_bucket_start[b];
     // Each bucket holds its faces' boxes in a row: a query reads them in order.
-    m_cells.resize(m_entries.size());
+    const size_t ne = m_entries.size();
+    for (int k = 0; k < 3; ++k) {
+        m_cell_box[k].assign(ne + 8, std::numeric_limits<float>::infinity());
+        m_cell_box[3 + k].assign(ne + 8, -std::numeric_limits<float>::infinity());
+    }
+    m_cell_face.resize(ne);
     m_stamp.assign(m_bucket_start.begin(), m_bucket_start.end() - 1); // the fill cursor first
-    for (const auto& e : m_entries)
-        m_cells[static_cast<size_t>(m_stamp[e.first]++)] = m_box[static_cast<size_t>(e.second)];
+    for (const auto& e : m_entries) {
+        const size_t at = static_cast<size_t>(m_stamp[e.first]++);
+        const Cell& b = m_box[static_cast<size_t>(e.second)];
+        for (int k = 0; k < 3; ++k) {
+            m_cell_box[k][at] = b.lo[k];
+            m_cell_box[3 + k][at] = b.hi[k];
+        }
+        m_cell_face[at] = b.face;
+    }
     m_stamp.assign(nf, -1);
 }
 
@@ -265,6 +361,8 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
     const size_t objects = m_margin.size();
     const double inv_cell = 1.0 / (cell_edges * m_edge);
     std::vector<Best>& best = m_best;
+    const float* const columns[6] = {m_cell_box[0].data(), m_cell_box[1].data(), m_cell_box[2].data(),
+                                     m_cell_box[3].data(), m_cell_box[4].data(), m_cell_box[5].data()};
     for (Index p : m_vertices) {
         const Index op = model.vertex_object[static_cast<size_t>(p)];
         const Vec3 xp = x.row(p).transpose();
@@ -284,22 +382,22 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
             hi[k] = static_cast<std::int64_t>(std::floor((xp[k] + rq) * inv_cell));
         }
         const bool one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
-        // The query box in single precision, rounded outwards like the faces' boxes.
-        float qlo[3], qhi[3];
+        // The query box in single precision, rounded outwards like the faces' boxes: lo x, y, z, hi x, y, z.
+        float qbox[6];
         for (int k = 0; k < 3; ++k) {
-            qlo[k] = round_down(xp[k] - rq);
-            qhi[k] = round_up(xp[k] + rq);
+            qbox[k] = round_down(xp[k] - rq);
+            qbox[3 + k] = round_up(xp[k] + rq);
         }
         for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
             for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
                 for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
                     const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
-                    for (std::int32_t e = m_bucket_start[bk]; e < m_bucket_start[bk + 1]; ++e) {
-                        const Cell& b = m_cells[static_cast<size_t>(e)];
-                        if ((qhi[0] < b.lo[0]) | (qlo[0] > b.hi[0]) | (qhi[1] < b.lo[1]) | (qlo[1] > b.hi[1]) |
-                            (qhi[2] < b.lo[2]) | (qlo[2] > b.hi[2]))
-                            continue;
-                        const std::int32_t f = b.face;
+                    const std::int32_t begin = m_bucket_start[bk], end = m_bucket_start[bk + 1];
+                    if (m_hits.size() < static_cast<size_t>(end - begin))
+                        m_hits.resize(static_cast<size_t>(end - begin));
+                    const std::int32_t hits = detail::chosen_box_filter(columns, begin, end, qbox, m_hits.data());
+                    for (std::int32_t hit = 0; hit < hits; ++hit) {
+                        const std::int32_t f = m_cell_face[static_cast<size_t>(m_hits[static_cast<size_t>(hit)])];
                         const Face& fc = m_faces[static_cast<size_t>(f)];
                         bool near_rest = false; // the corners decide whether the face is local (below)
                         if (fc.object == op) {

@@ -22,6 +22,18 @@
 
 namespace tethash::sim {
 
+namespace detail {
+/// The grid's box filter: the entries [begin, end) of a bucket (columns lo x, y, z, hi x, y, z, padded by eight
+/// entries) whose box meets the query box q (lo x, y, z, hi x, y, z), in order, into `hits`; returns their count.
+/// A comparison with NaN meets (the closest point decides).
+using BoxFilter = std::int32_t (*)(const float* const box[6], std::int32_t begin, std::int32_t end, const float q[6],
+                                   std::int32_t* hits);
+/// Every kernel this machine runs, scalar first (AVX2: eight entries at a time, chosen at run time).
+std::vector<std::pair<const char*, BoxFilter>> box_filters();
+/// The kernel Proximity uses: "avx2" where the processor has it, unless TETHASH_SIMD=scalar.
+const char* box_filter_name();
+} // namespace detail
+
 class Proximity {
   public:
     /// `margin_edges`: δ of each object as a fraction of its mean edge. `reach_edges`: a face of the vertex's own
@@ -88,8 +100,12 @@ class Proximity {
         std::int32_t face;
     };
 
-    std::vector<Cell> m_box;   ///< per face
-    std::vector<Cell> m_cells; ///< per bucket entry, in bucket order
+    std::vector<Cell> m_box; ///< per face
+    /// Per bucket entry, in bucket order, column by column (lo x, y, z, hi x, y, z: a query tests eight at once),
+    /// and padded by eight entries that no box meets.
+    std::vector<float> m_cell_box[6];
+    std::vector<std::int32_t> m_cell_face;
+    std::vector<std::int32_t> m_hits; ///< entries of one bucket whose box meets the query's
     std::vector<std::int32_t> m_bucket_start, m_stamp;
     std::uint32_t m_mask = 0;
     std::vector<std::pair<std::uint32_t, std::int32_t>> m_entries;
