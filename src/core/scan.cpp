@@ -2,12 +2,12 @@
 // survivors extracted by bit scan), or one at a time. The AVX2 version is compiled with a target attribute
 // and chosen at run time, so one build runs everywhere and uses AVX2 where present.
 #include "scan.hpp"
+#include "simd.hpp"
 
 #include "tethash/predicates.hpp"
 
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -330,11 +330,8 @@ using ScanFn = std::int32_t (*)(const VertexTable&, const ScanRange*, std::int32
 
 ScanFn choose()
 {
-    const char* env = std::getenv("TETHASH_SIMD");
-    if (env && std::strcmp(env, "scalar") == 0) return scan_ranges_scalar;
 #ifdef TETHASH_X86
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2")) return scan_ranges_avx2;
+    if (avx2_kernels()) return scan_ranges_avx2;
 #endif
     return scan_ranges_scalar;
 }

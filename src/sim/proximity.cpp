@@ -1,5 +1,7 @@
 #include "proximity.hpp"
 
+#include "core/simd.hpp"
+
 #include "tethash/geometry.hpp"
 
 #include <Eigen/Geometry>
@@ -7,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -62,11 +63,8 @@ __attribute__((target("avx2"))) std::int32_t box_filter_avx2(const float* const 
 
 BoxFilter choose_box_filter()
 {
-    const char* env = std::getenv("TETHASH_SIMD");
-    if (env && std::strcmp(env, "scalar") == 0) return box_filter_scalar;
 #ifdef TETHASH_X86
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2")) return box_filter_avx2;
+    if (tethash::detail::avx2_kernels()) return box_filter_avx2;
 #endif
     return box_filter_scalar;
 }

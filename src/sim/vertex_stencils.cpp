@@ -4,6 +4,8 @@
 // f += k36 ((W − W0) + d/h (W − W_t)) N, H += k36 (1 + d/h) N Nᵀ.
 #include "vertex_stencils.hpp"
 
+#include "core/simd.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -380,13 +382,8 @@ StartFn choose_start(GatherFn gather)
 GatherFn choose_gather(bool inversion_guard)
 {
     const KernelSet* set = &k_kernel_sets[std::size(k_kernel_sets) - 1]; // the scalar kernels
-    const char* env = std::getenv("TETHASH_SIMD");
 #ifdef TETHASH_X86
-    __builtin_cpu_init();
-    if (!(env && std::strcmp(env, "scalar") == 0) && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-        set = &k_kernel_sets[0];
-#else
-    (void)env;
+    if (tethash::detail::avx2_kernels(true)) set = &k_kernel_sets[0];
 #endif
     return inversion_guard ? set->guarded_gather : set->gather;
 }
