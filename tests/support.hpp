@@ -160,6 +160,17 @@ inline std::optional<std::string> python_with(const std::string& modules)
     return std::nullopt;
 }
 
+/// .ci/run repeats the kernels' tests with TETHASH_SIMD=scalar (the path of machines without AVX2): a kernel
+/// family's chosen `kernel` must then be the scalar one, else one of the two.
+inline void expect_kernel_follows_tethash_simd(const std::string& kernel)
+{
+    const char* env = std::getenv("TETHASH_SIMD");
+    if (env && std::string(env) == "scalar")
+        EXPECT_EQ(kernel, "scalar");
+    else
+        EXPECT_TRUE(kernel == "avx2" || kernel == "scalar") << kernel;
+}
+
 /// Path of a mesh in ../shared/meshes, or nullopt if the folder or the file is absent.
 inline std::optional<std::filesystem::path> shared_mesh(const std::string& name)
 {

@@ -49,12 +49,13 @@ double w(const Model& m, const std::vector<double>& x, Index t)
     return (p(1) - p(0)).dot((p(2) - p(0)).cross(p(3) - p(0)));
 }
 
-std::int64_t inverted(const Model& m, const std::vector<double>& x)
+/// The tets inverted in x, by row (what Simulation hands the integrator after a step).
+std::vector<std::int32_t> inverted_tets(const Model& m, const std::vector<double>& x)
 {
-    std::int64_t n = 0;
+    std::vector<std::int32_t> out;
     for (Index t = 0; t < m.volumes.tets.rows(); ++t)
-        n += w(m, x, t) > 0 ? 0 : 1;
-    return n;
+        if (!(w(m, x, t) > 0)) out.push_back(static_cast<std::int32_t>(t));
+    return out;
 }
 
 /// Moves corner 0 of tet t through its opposite face, to W = −depth · W0.
@@ -78,15 +79,15 @@ TEST(SimInversionGuard, RestoreAfterStepTurnsBackWithoutInvertingOthers)
 {
     BoxState s = box();
     const Model& m = s.model;
-    ASSERT_EQ(inverted(m, s.x), 0);
+    ASSERT_TRUE(inverted_tets(m, s.x).empty());
     const Index t = m.volumes.tets.rows() / 2;
     push_through(m, s.x, t, 0.05); // a shallow inversion: a few small moves undo it
-    const std::int64_t before = inverted(m, s.x);
-    ASSERT_GT(before, 0);
+    const std::vector<std::int32_t> before = inverted_tets(m, s.x);
+    ASSERT_FALSE(before.empty());
     const std::vector<double> pushed = s.x;
     InversionGuard guard(m);
-    EXPECT_EQ(guard.restore_after_step(s.x.data()), before);
-    EXPECT_EQ(inverted(m, s.x), 0);
+    guard.restore_after_step(s.x.data(), before);
+    EXPECT_TRUE(inverted_tets(m, s.x).empty());
     // A shallow inversion takes one short move per corner: none longer than restore_move_edges × the mean edge
     // (without that bound the corner would go to a tenth of its rest volume at once, 0.12 of an edge).
     const double longest = InversionGuard::restore_move_edges * m.object_mean_edge[0];
@@ -109,11 +110,15 @@ TEST(SimInversionGuard, RestoreAfterStepLeavesFixedVerticesAlone)
     const size_t corner = static_cast<size_t>(s.model.volumes.tets(t, 0));
     s.model.fixed[corner] = 1;
     InversionGuard guard(s.model);
-    ASSERT_GT(guard.restore_after_step(s.x.data()), 0);
+    const std::vector<std::int32_t> before = inverted_tets(s.model, s.x);
+    ASSERT_FALSE(before.empty());
+    guard.restore_after_step(s.x.data(), before);
     EXPECT_GT(w(s.model, s.x, t), w(s.model, pushed, t)); // on its way back (small moves: not all the way)
     for (int r = 0; r < 3; ++r)
         EXPECT_EQ(s.x[4 * corner + static_cast<size_t>(r)], pushed[4 * corner + static_cast<size_t>(r)]);
     // Nothing that was the right way out before the moves is inverted after them.
     for (Index u = 0; u < s.model.volumes.tets.rows(); ++u)
-        if (w(s.model, pushed, u) > 0) EXPECT_GT(w(s.model, s.x, u), 0) << "tet " << u;
+        if (w(s.model, pushed, u) > 0) {
+            EXPECT_GT(w(s.model, s.x, u), 0) << "tet " << u;
+        }
 }

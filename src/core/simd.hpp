@@ -5,8 +5,10 @@
 
 namespace tethash::detail {
 
-/// True when the AVX2 kernels may run: the processor has AVX2 (and FMA, when `fma`) and TETHASH_SIMD is not
-/// "scalar". Read by each kernel family once, when it chooses its kernel.
+/// The processor has AVX2 (and FMA, when `fma`): the AVX2 kernels can run (tests compare them with the scalar ones).
+bool cpu_has_avx2(bool fma = false);
+/// True when the AVX2 kernels may run: cpu_has_avx2(fma) and TETHASH_SIMD is not "scalar". Read by each kernel
+/// family once, when it chooses its kernel.
 bool avx2_kernels(bool fma = false);
 
 } // namespace tethash::detail

@@ -94,7 +94,7 @@ class BlockDescent final : public StepIntegrator {
     explicit BlockDescent(const StepContext& ctx) : m_ctx(ctx), m_inversions(ctx.model) { setup(); }
 
     int substep(Positions& x, Positions& v, double h) override;
-    void finish_step(Positions& x, std::int64_t inverted) override;
+    void finish_step(Positions& x, const std::vector<std::int32_t>& inverted) override;
 
   private:
     void setup();
@@ -567,17 +567,17 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     return sweeps;
 }
 
-void BlockDescent::finish_step(Positions& x, std::int64_t inverted)
+void BlockDescent::finish_step(Positions& x, const std::vector<std::int32_t>& inverted)
 {
     // With the guard each substep ended with restore_in_substep (its slivers may stay inverted: turned back here
     // too, its pressed struts at 1/60 ended with a non-sliver inverted).
-    if (inverted == 0 || m_ctx.scene.inversion_guard) return;
+    if (inverted.empty() || m_ctx.scene.inversion_guard) return;
     // Positions only: the velocities keep what the step gave them, so the moves add no kinetic energy.
     const size_t un = static_cast<size_t>(x.rows());
     m_x4.resize(un);
     for (size_t i = 0; i < un; ++i)
         m_x4[i] = {x(static_cast<Index>(i), 0), x(static_cast<Index>(i), 1), x(static_cast<Index>(i), 2), 0.0};
-    m_inversions.restore_after_step(m_x4.data()->c);
+    m_inversions.restore_after_step(m_x4.data()->c, inverted);
     for (size_t i = 0; i < un; ++i)
         for (int r = 0; r < 3; ++r)
             x(static_cast<Index>(i), r) = m_x4[i].c[r];

@@ -56,18 +56,18 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
         m_object_height.push_back(hi_h[o] > lo_h[o] ? hi_h[o] - lo_h[o] : 0.0);
 }
 
-std::int64_t count_inverted_tets(const Model& model, const Positions& x)
+std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out)
 {
+    out.clear();
     const Index nt = static_cast<Index>(model.volumes.tets.rows());
-    std::int64_t inverted = 0;
     for (Index t = 0; t < nt; ++t) {
         const auto tet = model.volumes.tets.row(t);
         const Eigen::Vector3d a = x.row(tet(0)).transpose();
         const double w =
             (x.row(tet(1)).transpose() - a).dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
-        inverted += w > 0 ? 0 : 1;
+        if (!(w > 0)) out.push_back(static_cast<std::int32_t>(t));
     }
-    return inverted;
+    return static_cast<std::int64_t>(out.size());
 }
 
 std::string FailureCheck::check_inverted(const Model& model, const Scene& scene, std::int64_t inverted, double h,

@@ -23,7 +23,7 @@ class FailureCheck {
     std::string check_substep(const Model& model, const Positions& x, const Positions& v, double t_end) const;
     /// Empty when the internal energy after a step is below 1000 × the reference; else what is wrong.
     std::string check_energy(double internal) const;
-    /// Called after every step ending at time t with the inverted tets then (count_inverted_tets). Empty unless the
+    /// Called after every step ending at time t with the inverted tets then (find_inverted_tets). Empty unless the
     /// body crumpled: more than 1 % of the dynamic tets inverted (signed volume ≤ 0; rest volumes are positive) for 0.1
     /// s of simulated time without a break, or more than 10 % at once (an impact inverts a few tets for a few steps;
     /// they recover). Else how many, and the likely cause: a material too soft to carry its own weight, a much denser
@@ -45,8 +45,9 @@ class FailureCheck {
     std::vector<double> m_object_height; ///< per object: extent along gravity at start (0: static or none)
 };
 
-/// Tets of the model's volume terms (the dynamic ones) whose signed volume at x is ≤ 0.
-std::int64_t count_inverted_tets(const Model& model, const Positions& x);
+/// Tets of the model's volume terms (the dynamic ones) whose signed volume at x is ≤ 0, by row, into `out`
+/// (cleared first); returns their count.
+std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out);
 
 /// Short number for messages (3 significant digits).
 std::string short_number(double v);

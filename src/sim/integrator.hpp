@@ -6,7 +6,9 @@
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace tethash::sim {
 
@@ -25,9 +27,9 @@ class StepIntegrator {
     /// Advances positions x and velocities v (n × 3; fixed vertices untouched) by one substep h. Returns the
     /// solver iterations it took (0 for a direct method).
     virtual int substep(Positions& x, Positions& v, double h) = 0;
-    /// After a step is taken (no refinement to follow), with the count of tets it leaves inverted: a last change
-    /// of positions only (velocities stay). Nothing by default.
-    virtual void finish_step(Positions& /*x*/, std::int64_t /*inverted*/) {}
+    /// After a step is taken (no refinement to follow), with the tets it leaves inverted (rows of the model's volume
+    /// terms): a last change of positions only (velocities stay). Nothing by default.
+    virtual void finish_step(Positions& /*x*/, const std::vector<std::int32_t>& /*inverted*/) {}
 };
 
 std::unique_ptr<StepIntegrator> make_symplectic_euler(const StepContext& ctx);

@@ -96,24 +96,24 @@ double InversionGuard::corner_move_allowed(const double* x, std::size_t v, const
     return std::min(1.0, 0.9 * t_max);
 }
 
-std::int64_t InversionGuard::restore_after_step(double* x)
+void InversionGuard::restore_after_step(double* x, const std::vector<std::int32_t>& inverted)
 {
-    return restore_inverted(x, restore_move_edges, true);
+    m_bad.assign(inverted.begin(), inverted.end());
+    restore_inverted(x, restore_move_edges, true);
 }
 
-std::int64_t InversionGuard::restore_in_substep(double* x)
+void InversionGuard::restore_in_substep(double* x)
 {
-    return restore_inverted(x, std::numeric_limits<double>::infinity(), false);
-}
-
-std::int64_t InversionGuard::restore_inverted(double* x, double longest_move, bool hold_slivers)
-{
-    const Model& model = m_model;
     m_bad.clear();
     const size_t nt = m_corners.size() / 4;
     for (size_t t = 0; t < nt; ++t)
         if (!(tet_w(x, &m_corners[4 * t]) > 0)) m_bad.push_back(static_cast<std::int32_t>(t));
-    const auto found = static_cast<std::int64_t>(m_bad.size());
+    restore_inverted(x, std::numeric_limits<double>::infinity(), false);
+}
+
+void InversionGuard::restore_inverted(double* x, double longest_move, bool hold_slivers)
+{
+    const Model& model = m_model;
     for (int pass = 0; pass < restore_passes && !m_bad.empty(); ++pass) {
         bool inverted = false;
         for (const std::int32_t t : m_bad) {
@@ -142,9 +142,8 @@ std::int64_t InversionGuard::restore_inverted(double* x, double longest_move, bo
                 if (tet_w(x, c) > 0) break;
             }
         }
-        if (!inverted) break;
+        if (!inverted) return;
     }
-    return found;
 }
 
 } // namespace tethash::sim

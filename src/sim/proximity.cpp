@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -77,8 +76,7 @@ std::vector<std::pair<const char*, BoxFilter>> box_filters()
 {
     std::vector<std::pair<const char*, BoxFilter>> all{{"scalar", box_filter_scalar}};
 #ifdef TETHASH_X86
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2")) all.emplace_back("avx2", box_filter_avx2);
+    if (tethash::detail::cpu_has_avx2()) all.emplace_back("avx2", box_filter_avx2);
 #endif
     return all;
 }

@@ -76,9 +76,10 @@ class SimulationImpl {
     std::int64_t steps_done = 0;
     double t = 0;
     double dt_limit = std::numeric_limits<double>::infinity();
-    Positions x_save, v_save;  // last good step (rollback on failure)
-    std::int64_t inverted = 0; // inverted dynamic tets after the last step
-    int refined = 1;           // substeps of the last refined step, kept until refined_until
+    Positions x_save, v_save;                // last good step (rollback on failure)
+    std::int64_t inverted = 0;               // inverted dynamic tets after the last step
+    std::vector<std::int32_t> inverted_tets; // which (scratch of each step)
+    int refined = 1;                         // substeps of the last refined step, kept until refined_until
     double refined_until = 0;
 
     explicit SimulationImpl(const Scene& s);
@@ -124,7 +125,7 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     StepStats first;
     contacts.update(mesh().positions, v, scene.dt / scene.substeps, first);
     failure.setup(model, mesh().positions, v, contacts.energy());
-    inverted = count_inverted_tets(model, mesh().positions);
+    inverted = find_inverted_tets(model, mesh().positions, inverted_tets);
     integrator = make_integrator(StepContext{scene, mesh(), model, contacts});
 }
 
@@ -226,13 +227,13 @@ void Simulation::step()
             if (refine()) continue;
             fail(bad);
         }
-        s.inverted = count_inverted_tets(s.model, x);
+        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets);
         if (s.inverted > allowed && refine()) continue;
         break;
     }
     // vbd turns back what the step left inverted (positions only); the count above, which the refinement and the
     // crumple check read, is the step's own.
-    s.integrator->finish_step(x, s.inverted);
+    s.integrator->finish_step(x, s.inverted_tets);
     if (substeps > s.refined) {
         s.refined = substeps;
         s.refined_until = s.t + 0.05;
