@@ -126,7 +126,9 @@ TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)
 TEST(CliSimulate, ExplicitStabilityWarningIsPrintedUpFront)
 {
     const auto dir = temp_dir();
-    write_text(dir / "s.toml", kSmall);
+    std::string text = kSmall; // the sphere above the box (they overlap in kSmall, which is warned about)
+    text.replace(text.find("translate = [0.1, 0, 0.7]"), 25, "translate = [0.1, 0, 0.8]");
+    write_text(dir / "s.toml", text);
     // dt above the limit: warned before the first step (the run itself survives one step).
     auto r = run_tethash("simulate " + quote(dir / "s.toml") +
                          " --integrator symplectic_euler --dt 0.002 --steps 1 --out " + quote(dir / "a"));
@@ -203,7 +205,7 @@ TEST(CliSimulate, APreviousRunsFramesAreRemovedWithANote)
     write_text(dir / "out" / "frame_1.vtu", "not of the pattern");
     r = run_tethash("simulate " + quote(dir / "s.toml") + " --steps 2 --out " + quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
-    EXPECT_NE(r.err.find("removed 12 files of a previous run"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("removed 13 files of a previous run"), std::string::npos) << r.err; // + run.json
     int frames = 0;
     for (const auto& e : std::filesystem::directory_iterator(dir / "out"))
         frames += e.path().filename().string().rfind("frame_0", 0) == 0;
@@ -231,4 +233,102 @@ TEST(CliSimulate, CtrlCStopsAfterTheStepAndSaysTheFramesAreValid)
     const std::string pvd = read_text(dir / "out" / "scene.pvd");
     EXPECT_NE(pvd.find("</VTKFile>"), std::string::npos) << pvd;
     EXPECT_NE(pvd.find("frame_00010.vtu"), std::string::npos);
+}
+
+TEST(CliSimulate, CtrlCEndsALongStepWithinIt)
+{
+    // One step of 100,000 substeps takes minutes: Ctrl-C must end it within the step (rolled back to its start),
+    // not after it, and the run says where it stopped.
+    const auto dir = temp_dir();
+    const std::string cmd = "set -m; " + quote(TETHASH_EXE) + " simulate --steps 2 --dt 0.1 --substeps 100000 --out " +
+                            quote(dir / "out") + " >/dev/null 2>" + quote(dir / "err") +
+                            " & p=$!; for i in $(seq 100); do [ -e " + quote(dir / "out" / "scene.pvd") +
+                            " ] && break; sleep 0.1; done; sleep 0.5; s=$(date +%s%N); kill -INT $p; wait $p; c=$?; "
+                            "e=$(date +%s%N); echo $c $(( (e - s) / 1000000 ))";
+    write_text(dir / "run.sh", cmd + "\n");
+    const auto r = run_shell("bash " + quote(dir / "run.sh"));
+    ASSERT_EQ(r.out.substr(0, 4), "130 ") << r.out << r.err;
+    EXPECT_LT(std::stoi(r.out.substr(4)), 5000) << "ms from Ctrl-C to the end: " << r.out;
+    const std::string err = read_text(dir / "err");
+    EXPECT_NE(err.find("interrupted after step 0 of 2"), std::string::npos) << err;
+    EXPECT_NE(read_text(dir / "out" / "run.json").find("\"status\": \"interrupted\""), std::string::npos);
+}
+
+TEST(CliSimulate, SaysWhatCannotBeTrustedAndStrictMakesItAnError)
+{
+    // A box resting on the ground with at most one sweep a substep: its substeps stop unconverged. The run says so
+    // in its warnings, its summary and run.json, exits 0; with --strict it exits 1.
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", R"(dt = "1/240"
+steps = 20
+max_iterations = 1
+[ground]
+[[object]]
+generate = { shape = "box", resolution = 3, size = 0.2 }
+translate = [0, 0, 0.1005]
+)");
+    auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("substeps stopped at max_iterations unconverged"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("health: "), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("0 unconverged of"), std::string::npos) << r.out;
+    const std::string json = read_text(dir / "out" / "run.json");
+    EXPECT_NE(json.find("\"status\": \"untrusted\""), std::string::npos) << json;
+    EXPECT_NE(json.find("unconverged"), std::string::npos) << json;
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --strict --out " + quote(dir / "out"));
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("--strict"), std::string::npos) << r.err;
+    // The same box left to converge: trusted, status 0 with --strict, no warning.
+    std::string text = read_text(dir / "s.toml");
+    text.replace(text.find("max_iterations = 1"), 18, "max_iterations = 100");
+    write_text(dir / "t.toml", text);
+    r = run_tethash("simulate " + quote(dir / "t.toml") + " --strict --out " + quote(dir / "out2"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    EXPECT_NE(read_text(dir / "out2" / "run.json").find("\"status\": \"ok\""), std::string::npos);
+}
+
+TEST(CliSimulate, SetUpNamesSizesThatLookWrongAndObjectsBelowTheGround)
+{
+    const auto dir = temp_dir();
+    const auto run = [&](const std::string& object) {
+        write_text(dir / "s.toml", "dt = \"1/240\"\nsteps = 1\n[ground]\n[[object]]\nname = \"thing\"\n" + object);
+        return run_tethash("simulate " + quote(dir / "s.toml") + " --out " + quote(dir / "out"));
+    };
+    auto r =
+        run("generate = { shape = \"sphere\", resolution = 2, size = 0.5 }\nscale = 100\ntranslate = [0, 0, 30]\n");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("'thing' is 50 m across: if its mesh is in millimetres, give it scale = 0.001"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("object sizes (longest extent): thing 50 m"), std::string::npos) << r.out;
+    r = run("generate = { shape = \"sphere\", resolution = 2, size = 0.002 }\ntranslate = [0, 0, 0.01]\n");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("'thing' is 2 mm across: check its scale"), std::string::npos) << r.err;
+    r = run("generate = { shape = \"sphere\", resolution = 2, size = 0.5 }\ntranslate = [0, 0, 0.1]\n");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("'thing' starts 0.15 m below the ground"), std::string::npos) << r.err;
+    r = run("generate = { shape = \"sphere\", resolution = 2, size = 0.5 }\ntranslate = [0, 0, 1]\n");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    // The explicit stability limit concerns symplectic_euler only.
+    EXPECT_EQ(r.out.find("explicit stability limit"), std::string::npos) << r.out;
+    r = run_tethash("simulate " + quote(dir / "s.toml") + " --integrator symplectic_euler --dt 1e-5 --out " +
+                    quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("explicit stability limit"), std::string::npos) << r.out;
+}
+
+TEST(CliSimulate, ATimeStepFarBeyondTheSceneIsRefused)
+{
+    // dt = 1e9 asked for a million sweeps a substep and ignored Ctrl-C: now it is refused up front with the scene's
+    // own time scale; ten times that is the most accepted.
+    const auto dir = temp_dir();
+    auto r = run_tethash("simulate --dt 1e9 --out " + quote(dir / "out"));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find("dt 1e+09 s is far beyond what this scene can show"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "frame_00000.vtu"));
+    r = run_tethash("simulate --dt 0.05 --steps 2 --out " + quote(dir / "out"));
+    EXPECT_EQ(r.status, 0) << r.err;
 }

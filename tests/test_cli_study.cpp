@@ -63,7 +63,8 @@ const std::map<std::string, std::vector<const char*>> k_columns = {
      {"integrator", "dt", "substeps", "status", "err_rms", "err_max", "max_penetration", "energy_drift",
       "wall_s_per_sim_s", "ref_dt"}},
     {"stability",
-     {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction", "far_self", "ms_per_step"}},
+     {"integrator", "young", "dt", "mass_ratio", "verdict", "status", "inverted_fraction", "far_self", "ms_per_step",
+      "size", "energy_growth", "volume_ratio", "unconverged_substeps", "problems"}},
 };
 
 /// Runs `tethash study SWEEP ARGS --out DIR/s`, which must succeed, and returns its DIR/s/study.csv, which must
@@ -186,7 +187,8 @@ material = { density = 500, young = 1e4 }
 TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
 {
     // Two copies of a small box thrown into each other: every cell of the matrix either completes with at most
-    // 1 % inverted tets ("ok") or stops with the simulator's message ("stopped", naming the step); "crumpled"
+    // 1 % inverted tets ("ok"), completes with a problem its run's health names ("untrusted": energy gained, volume
+    // lost, iterations unconverged), or stops with the simulator's message ("stopped", naming the step); "crumpled"
     // (completed but garbage) must never appear.
     const auto dir = test::temp_dir();
     meshing::GenerateParams p;
@@ -205,6 +207,10 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
         if (verdict == "ok") {
             ++ok;
             EXPECT_LE(std::stod(row[t.index_of("inverted_fraction")]), 0.01);
+            EXPECT_EQ(row[t.index_of("problems")], "");
+        } else if (verdict == "untrusted") {
+            EXPECT_EQ(status, "ok");
+            EXPECT_NE(row[t.index_of("problems")], "");
         } else {
             EXPECT_EQ(verdict, "stopped") << status;
             EXPECT_NE(status.find("step"), std::string::npos) << status;
@@ -212,19 +218,21 @@ TEST(CliStudy, StabilitySweepCellsFinishUncrumpledOrStopWithTheReason)
             ++stopped;
         }
     }
-    // The implicit integrators complete the stiff, equal-mass cells; young 1e3 cannot carry a 1 m body's weight
-    // (ρ g h / E ≈ 10) and must stop saying so.
+    // vbd completes the stiff equal-mass cells and can be trusted there at 1/240 (implicit Euler, linearised once a
+    // step, gains energy at such impacts: untrusted); young 1e3 cannot carry a 1 m body's weight (ρ g h / E ≈ 10)
+    // and must stop saying so.
     for (const auto& row : t.rows) {
         const std::string integ = row[t.index_of("integrator")], young = row[t.index_of("young")];
-        if (integ != "symplectic_euler" && young == "1000000000" && row[t.index_of("mass_ratio")] == "1") {
-            EXPECT_EQ(row[t.index_of("verdict")], "ok") << integ;
+        if (integ == "vbd" && young == "1000000000" && row[t.index_of("dt")].substr(0, 5) == "0.004" &&
+            row[t.index_of("mass_ratio")] == "1") {
+            EXPECT_EQ(row[t.index_of("verdict")], "ok") << row[t.index_of("problems")];
         }
         if (young == "1000" && row[t.index_of("verdict")] == "stopped" &&
             row[t.index_of("status")].find("crumpled") != std::string::npos) {
             EXPECT_NE(row[t.index_of("status")].find("cannot carry its own weight"), std::string::npos);
         }
     }
-    EXPECT_GT(ok, 4);
+    EXPECT_GE(ok, 2);
     EXPECT_GT(stopped, 0);
 }
 

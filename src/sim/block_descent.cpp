@@ -10,11 +10,25 @@
 // as a corner of the penetrated tet). Damping is relative: springs on their rate of length change, volume terms
 // on the rate of volume change, contacts on the relative normal velocity; rigid motion is never damped.
 //
-// What makes it robust on real meshes (measured on hand.mesh; docs/simulator.md): the iterations start from y;
-// each local Newton step is clamped to a fifth of the object's mean edge (without it the same settings gave 0 or
-// ~1,700 inverted tets depending on round-off); contact terms use the contacts' relative displacement taken at
-// the start of each iteration (Jacobi across the contact's five nodes), so no two threads ever read a position
-// another one writes.
+// What makes it robust on real meshes (measured on hand.mesh; docs/simulator.md): each local Newton step is clamped
+// to a fifth of the object's mean edge (without it the same settings gave 0 or ~1,700 inverted tets depending on
+// round-off); contact terms use the contacts' relative displacement taken at the start of each iteration (Jacobi
+// across the contact's five nodes), so no two threads ever read a position another one writes.
+//
+// What makes it right at every size (docs/simulator.md, "Convergence"): the sweeps needed grow with ω h (ω the
+// material's frequency at the mean edge, which grows as the body shrinks), so a fixed count left small bodies
+// unconverged: they sagged flat and ended drops with up to 230 times their start energy. Now
+// - every third sweep a coarse space (a lattice over each object, coarse_space.hpp) corrects the long waves that
+//   sweeps carry one ring of vertices at a time, its length chosen by a line search;
+// - sweeps run until converged: the last sweep's moves, measured in the local Hessians' norm (twice the energy
+//   they take out), are below `convergence` of the largest sweep's and below energy_tolerance of the energy the
+//   scene has to spend, or stalled in a cycle of contact switches below it; at most max_iterations, counted
+//   unconverged otherwise;
+// - the iterations start from x + h v + h² ã (ã the vertex's last acceleration along gravity, clamped to [0, g]),
+//   not from y: a resting body does not start each substep pressed g h² into the ground;
+// - a vertex that stepped into a contact within the substep and steps out of one goes half the way to its surface
+//   (leaving_fraction): the contacts' damping jumps at the surface, and the sweeps flipped resting vertices across it
+//   for ever.
 //
 // After each step (finish_step), the tets it left inverted are turned back corner by corner, positions only, in
 // moves of at most a twentieth of the mean edge that press no other tet of the corner towards inversion
@@ -28,6 +42,7 @@
 // the volume is linear in the vertex; vertex_stencils.hpp), and the sweeps start from a state that inverts no such
 // tet (corners taken back to where the substep started); but squeezed regions are held back
 // (Scene::inversion_guard says what it costs).
+#include "coarse_space.hpp"
 #include "incidences.hpp"
 #include "integrator.hpp"
 #include "inversion_guard.hpp"
@@ -80,20 +95,26 @@ struct Sym3 {
     }
 };
 
-/// Sweeps per substep when the scene leaves it to the integrator: 6 up to h = 1/240 s (6 Chebyshev sweeps measured
-/// closer to the converged step than 10 plain ones on the hand), then 6 √(240 h): a longer step moves the low
-/// frequencies further, and Gauss–Seidel reaches them slowly (at 1/60 with 6 sweeps, 6 of the 10 shared-mesh
-/// drops crumpled; with 12, octocat and quintupleTorus complete, docs/simulator.md).
-int automatic_sweeps(double h)
-{
-    return static_cast<int>(std::ceil(6.0 * std::sqrt(std::max(1.0, 240.0 * h)) - 1e-9));
-}
+/// Sweeps between two corrections of the coarse space (coarse_space.hpp): on the hand at 15 cm and 1 m, every second
+/// sweep cost more than it saved (two residual passes per correction), every fourth converged in more sweeps.
+constexpr int sweeps_per_correction = 3;
+/// An automatic substep has converged when, besides `convergence`, its last sweep took out less than this fraction of
+/// the energy the scene has to spend (energy_scale). At 5 cm the relative test alone stopped the hand, octocat and the
+/// raptor with 1.9×, 4.5× and 7× their start energy at the end of a drop (the sweeps' remaining error is stiff: it
+/// stores (ω h)² times the energy its length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much.
+constexpr double energy_tolerance = 1e-3;
+/// The coarse correction moves no vertex further than this many times its sweep clamp (a fifth of its object's mean
+/// edge), the whole correction shortened alike; its length along that direction is then the line search's.
+constexpr double coarse_reach = 1.0;
+/// Sweeps an automatic substep takes at least.
+constexpr int min_sweeps_automatic = 3;
 
 class BlockDescent final : public StepIntegrator {
   public:
     explicit BlockDescent(const StepContext& ctx) : m_ctx(ctx), m_inversions(ctx.model) { setup(); }
 
     int substep(Positions& x, Positions& v, double h) override;
+    bool converged() const override { return m_converged; }
     void finish_step(Positions& x, const std::vector<std::int32_t>& inverted) override;
 
   private:
@@ -101,8 +122,31 @@ class BlockDescent final : public StepIntegrator {
     void start_substep(const double* x4);
     void gather_contacts();
     /// One Newton step on each real lane of group g (its elastic terms gathered four lanes at a time, then
-    /// inertia, ground and contacts lane by lane). Returns the largest step over its lane's clamp length (0 … 1).
-    double solve_group(std::int32_t g, double* x4, double h) const;
+    /// inertia, ground and contacts lane by lane). Returns the largest step over its lane's clamp length (0 … 1);
+    /// adds Σ dᵀ H d of its lanes' moves to `moved` (d the move, H the vertex's local Hessian).
+    double solve_group(std::int32_t g, double* x4, double h, double& moved) const;
+    /// One Gauss–Seidel sweep over the colours (each colour's groups in parallel). The mass-weighted size of its
+    /// moves is summed per group, then in group order, so it is the same at any thread count.
+    struct Sweep {
+        double largest = 0; ///< largest step over its vertex's clamp length
+        double moved = 0;   ///< Σ dᵀ H d over the sweep's moves: twice the energy they took out (to second order)
+    };
+    Sweep sweep(double* x4, double h);
+    /// The energy the scene has at (x, v) to spend: kinetic, plus every free mass falling over the free vertices'
+    /// extent along gravity (and to the ground where there is one); a sweep whose moves, as velocities, carry a
+    /// small part of it has not much left to change.
+    double energy_scale(const Positions& x, const Positions& v) const;
+    /// Contacts' relative displacements since the start of the substep, at x4 (once per sweep: Jacobi across them).
+    void refresh_contacts(const double* x4);
+    /// The lattice's correction (coarse_space.hpp) at x4: the residual −∇G and the ground's and contacts' own
+    /// Hessian blocks per vertex, the coarse Newton step (the matrix factorised on the first call of a substep),
+    /// added to x4 (shortened so that no vertex moves more than its clamp length). False if it could not be made.
+    bool coarse_correction(double* x4, double h, bool first);
+    /// r (3n) = −∇G at x4 over the free vertices; with `extra`, m_extra the ground's and contacts' Hessian blocks.
+    void residual(const double* x4, double h, std::vector<double>& r, bool extra);
+    /// The fraction of the step ds of vertex u that leaves none of its pressing contacts (ground or contact) for
+    /// more than half the way to the surface: 1 when no step leaves one.
+    double leaving_fraction(size_t u, const double* x4, const double* ds) const;
     /// Adds lane l's inertia, ground and contact terms to its elastic ones.
     void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
     /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
@@ -129,7 +173,13 @@ class BlockDescent final : public StepIntegrator {
     };
     std::vector<Point4> m_x4;             ///< the positions the sweeps work on (stride 4: aligned row loads)
     std::vector<double> m_y;              ///< inertial target, flat 3n
+    std::vector<double> m_accel;          ///< per vertex, flat 3n: its acceleration over the last substep
     std::vector<double> m_prev1, m_prev2; ///< the iterates of the two previous sweeps (Chebyshev acceleration)
+    std::vector<double> m_group_moved;    ///< per group: Σ dᵀ H d of the current sweep
+    std::vector<double> m_moved_history;  ///< Σ dᵀ H d of each sweep of the substep
+    bool m_converged = true;              ///< the last substep's sweeps met the tolerance
+    mutable std::vector<char> m_entered; ///< vertex id → it stepped into a contact in this substep (leaving_fraction)
+    double m_energy_ref = 0;             ///< the energy the scene has to spend (energy_scale at the first substep)
     // Contacts of the substep: per contact depth, direction, weighted stiffness and damping, relative
     // displacement since the start (refreshed each iteration); per vertex its incidences.
     struct ActiveContact {
@@ -140,6 +190,10 @@ class BlockDescent final : public StepIntegrator {
     std::vector<ActiveContact> m_contacts;
     std::vector<std::int32_t> m_vc_start; ///< vertex id → incidences
     std::vector<VertexContact> m_vc;
+    detail::CoarseSpace m_coarse;
+    std::vector<double> m_residual, m_residual_end, m_extra, m_dx; ///< per vertex: −∇G (3) at x and x + dx, ground
+                                                                   ///< and contact Hessian (6), the lattice's step (3)
+    std::vector<std::int32_t> m_with_extra;
     InversionGuard m_inversions; ///< whole-state checks of the inversion guard (inversion_guard.hpp)
 };
 
@@ -271,6 +325,11 @@ void BlockDescent::setup()
         }
         m_colour_start.push_back(static_cast<std::int32_t>(m_groups.size()));
     }
+    std::vector<double> damping;
+    for (const ObjectSpec& o : m_ctx.scene.objects)
+        damping.push_back(o.material.damping);
+    if (m_ctx.scene.coarse_space)
+        m_coarse.build(model, m_ctx.mesh.positions, damping, m_ctx.scene.dt / std::max(1, m_ctx.scene.substeps));
     m_gather = detail::choose_gather(m_ctx.scene.inversion_guard);
     m_start = detail::choose_start(m_gather);
     m_solve = detail::choose_solve(m_gather);
@@ -339,7 +398,7 @@ void BlockDescent::gather_contacts()
         }
 }
 
-double BlockDescent::solve_group(std::int32_t gi, double* x, double h) const
+double BlockDescent::solve_group(std::int32_t gi, double* x, double h, double& moved) const
 {
     const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
     assert(grp.lanes >= 1 && grp.lanes <= 4 && grp.spring_end <= static_cast<std::int32_t>(m_springs.size()) &&
@@ -367,11 +426,55 @@ double BlockDescent::solve_group(std::int32_t gi, double* x, double h) const
             const double ds[3] = {scale * d[0][l], scale * d[1][l], scale * d[2][l]};
             scale *= detail::guarded_fraction(grp, m_tets.data(), l, x, ds);
         }
+        {
+            const double ds[3] = {scale * d[0][l], scale * d[1][l], scale * d[2][l]};
+            scale *= leaving_fraction(u, x, ds);
+        }
         for (size_t r = 0; r < 3; ++r)
             x[4 * u + r] += scale * d[r][l];
+        {
+            // The move in the local Hessian's norm, dᵀ H d: twice the energy the local step takes out (the
+            // mass-weighted length undercounts it by 1 + (ω h)², the stiffness's share, which is what grows on small
+            // bodies).
+            const double a = d[0][l], b = d[1][l], c = d[2][l];
+            const double dhd = terms.H[0][l] * a * a + terms.H[1][l] * b * b + terms.H[2][l] * c * c +
+                               2 * (terms.H[3][l] * a * b + terms.H[4][l] * a * c + terms.H[5][l] * b * c);
+            moved += scale * scale * dhd;
+        }
         largest = std::max(largest, relative);
     }
     return largest;
+}
+
+double BlockDescent::leaving_fraction(size_t u, const double* x, const double* ds) const
+{
+    // A contact's damping pushes while the vertex is inside and stops at the surface: its force jumps there, and a
+    // Newton step from inside that takes the vertex out meets no force on the other side, so the next one takes it
+    // back in: the sweeps flip a resting vertex across the surface for ever (measured on the shared meshes: the
+    // same move every second sweep, and the velocity the substep ends with is what the flip left). So a vertex that
+    // entered a contact within this substep and then steps out of one goes half the way to the surface instead: it
+    // settles at the surface and the sweeps converge. A vertex that did not enter in this substep leaves freely.
+    double t = 1.0;
+    bool entered = false;
+    const bool flipping = m_entered[u] != 0;
+    auto cut = [&](double before, double after) {
+        if (before > 0 && after < 0 && flipping) t = std::min(t, 0.5 * before / (before - after));
+        if (before <= 0 && after > 0) entered = true;
+    };
+    if (!m_ground_k.empty()) {
+        const Ground& g = m_ctx.model.ground;
+        const double pen =
+            g.height - (g.normal.x() * x[4 * u] + g.normal.y() * x[4 * u + 1] + g.normal.z() * x[4 * u + 2]);
+        cut(pen, pen - (g.normal.x() * ds[0] + g.normal.y() * ds[1] + g.normal.z() * ds[2]));
+    }
+    for (std::int32_t s = m_vc_start[u]; s < m_vc_start[u + 1]; ++s) {
+        const VertexContact& vc = m_vc[static_cast<size_t>(s)];
+        const ActiveContact& c = m_contacts[static_cast<size_t>(vc.contact)];
+        const double depth = c.depth - (c.n[0] * c.rel[0] + c.n[1] * c.rel[1] + c.n[2] * c.rel[2]);
+        cut(depth, depth - vc.coef * (c.n[0] * ds[0] + c.n[1] * ds[1] + c.n[2] * ds[2]));
+    }
+    if (entered) m_entered[u] = 1;
+    return t;
 }
 
 void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms, const double* x, double h) const
@@ -483,6 +586,166 @@ void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
     }
 }
 
+double BlockDescent::energy_scale(const Positions& x, const Positions& v) const
+{
+    const Model& model = m_ctx.model;
+    const double g = model.gravity.norm();
+    const Eigen::Vector3d down = g > 0 ? Eigen::Vector3d(model.gravity / g) : Eigen::Vector3d::Zero();
+    double kinetic = 0, mass = 0, lo = INFINITY, hi = -INFINITY;
+    for (const std::int32_t i : m_order) {
+        const size_t u = static_cast<size_t>(i);
+        kinetic += 0.5 * model.mass[u] * v.row(i).squaredNorm();
+        mass += model.mass[u];
+        const double along = down.dot(x.row(i).transpose());
+        lo = std::min(lo, along);
+        hi = std::max(hi, along);
+    }
+    double drop = hi > lo ? hi - lo : 0.0;
+    if (model.ground.enabled && g > 0) {
+        // The ground's plane, along gravity: how far the lowest free vertex is above it.
+        const double above =
+            model.ground.normal.dot(-down) > 0.1
+                ? (model.ground.height - model.ground.normal.dot(x.row(m_order.empty() ? 0 : m_order[0]).transpose()))
+                : 0.0;
+        drop += std::max(0.0, -above);
+    }
+    const double e = kinetic + mass * g * drop;
+    return e > 0 ? e : std::max(1e-300, mass * 1e-12);
+}
+
+void BlockDescent::refresh_contacts(const double* xp)
+{
+    const double* xtp = m_xt.data();
+    for (ActiveContact& c : m_contacts) {
+        c.rel[0] = c.rel[1] = c.rel[2] = 0;
+        for (int s = 0; s < 5; ++s) {
+            const size_t j = static_cast<size_t>(c.node[s]);
+            for (int r = 0; r < 3; ++r)
+                c.rel[r] += c.coef[s] * (xp[4 * j + static_cast<size_t>(r)] - xtp[3 * j + static_cast<size_t>(r)]);
+        }
+    }
+}
+
+void BlockDescent::residual(const double* xp, double h, std::vector<double>& r, bool extra)
+{
+    const Model& model = m_ctx.model;
+    const size_t un = model.mass.size();
+    r.assign(3 * un, 0.0);
+    if (extra) m_extra.assign(6 * un, 0.0);
+    const double inv_h2 = 1.0 / (h * h);
+    const std::int32_t groups = static_cast<std::int32_t>(m_groups.size());
+    // Every group's terms at x4, none moved: the residual and, if asked, the blocks the ground and the contacts add
+    // to the vertex's Hessian (its total less the elastic part and the inertia).
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(m_threads) schedule(static) if (m_threads > 1)
+#endif
+    for (std::int32_t gi = 0; gi < groups; ++gi) {
+        const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
+        LaneTerms terms;
+        m_gather(grp, m_springs.data(), m_tets.data(), xp, 1.0 / h, terms);
+        double elastic[6][4];
+        for (int q = 0; q < 6; ++q)
+            for (int l = 0; l < 4; ++l)
+                elastic[q][l] = terms.H[q][l];
+        for (int l = 0; l < grp.lanes; ++l) {
+            add_lane_terms(grp, l, terms, xp, h);
+            const size_t u = static_cast<size_t>(grp.vertex[l]);
+            for (size_t q = 0; q < 3; ++q)
+                r[3 * u + q] = terms.f[q][l];
+            if (!extra) continue;
+            const double m_h2 = model.mass[u] * inv_h2;
+            // What the ground and the contacts added (0 where they add nothing: the sum less its parts leaves
+            // round-off, which would list every vertex).
+            bool any = false;
+            double e[6];
+            for (size_t q = 0; q < 6; ++q) {
+                const double base = elastic[q][l] + (q < 3 ? m_h2 : 0.0);
+                e[q] = terms.H[q][l] - base;
+                any = any || std::abs(e[q]) > 1e-9 * (std::abs(base) + m_h2);
+            }
+            for (size_t q = 0; q < 6; ++q)
+                m_extra[6 * u + q] = any ? e[q] : 0.0;
+        }
+    }
+}
+
+bool BlockDescent::coarse_correction(double* xp, double h, bool first)
+{
+    const size_t un = m_ctx.model.mass.size();
+    refresh_contacts(xp);
+    residual(xp, h, m_residual, first);
+    if (first) {
+        m_with_extra.clear();
+        for (size_t i = 0; i < un; ++i)
+            if (m_extra[6 * i] != 0 || m_extra[6 * i + 1] != 0 || m_extra[6 * i + 2] != 0)
+                m_with_extra.push_back(static_cast<std::int32_t>(i));
+        if (!m_coarse.prepare(h, xp, m_extra, m_with_extra)) return false;
+    }
+    m_coarse.correct(m_residual, m_dx);
+    double over = 1.0;
+    for (const std::int32_t i : m_order) {
+        const size_t u = static_cast<size_t>(i);
+        const double len2 =
+            m_dx[3 * u] * m_dx[3 * u] + m_dx[3 * u + 1] * m_dx[3 * u + 1] + m_dx[3 * u + 2] * m_dx[3 * u + 2];
+        over = std::max(over, std::sqrt(len2) / (coarse_reach * m_max_step[u]));
+    }
+    if (!std::isfinite(over)) return false;
+    // The lattice's matrix is the start state's, turned: not the exact Hessian of the state (compressed springs,
+    // friction, contacts that came or went). The step's length along its direction is the secant minimum of G
+    // between x and x + dx (exact for a quadratic), so the correction never undoes what the sweeps did.
+    double slope0 = 0;
+    for (const std::int32_t i : m_order) {
+        const size_t u = static_cast<size_t>(i);
+        for (size_t q = 0; q < 3; ++q) {
+            m_dx[3 * u + q] /= over;
+            slope0 += m_residual[3 * u + q] * m_dx[3 * u + q];
+        }
+    }
+    if (!(slope0 > 0)) return true; // not a descent direction here: no correction this time
+    for (const std::int32_t i : m_order)
+        for (size_t q = 0; q < 3; ++q)
+            xp[4 * static_cast<size_t>(i) + q] += m_dx[3 * static_cast<size_t>(i) + q];
+    refresh_contacts(xp);
+    residual(xp, h, m_residual_end, false);
+    double slope1 = 0;
+    for (const std::int32_t i : m_order)
+        for (size_t q = 0; q < 3; ++q)
+            slope1 += m_residual_end[3 * static_cast<size_t>(i) + q] * m_dx[3 * static_cast<size_t>(i) + q];
+    const double alpha = slope0 > slope1 ? std::min(1.0, slope0 / (slope0 - slope1)) : 1.0;
+    if (alpha < 1.0)
+        for (const std::int32_t i : m_order)
+            for (size_t q = 0; q < 3; ++q)
+                xp[4 * static_cast<size_t>(i) + q] -= (1.0 - alpha) * m_dx[3 * static_cast<size_t>(i) + q];
+    return true;
+}
+
+BlockDescent::Sweep BlockDescent::sweep(double* xp, double h)
+{
+    const int colours = static_cast<int>(m_colour_start.size()) - 1;
+    m_group_moved.assign(m_groups.size(), 0.0);
+    double* moved = m_group_moved.data();
+    Sweep out;
+    for (int c = 0; c < colours; ++c) {
+        const std::int32_t begin = m_colour_start[static_cast<size_t>(c)],
+                           end = m_colour_start[static_cast<size_t>(c) + 1];
+#ifdef TETHASH_HAVE_OPENMP
+        if (m_threads > 1 && end - begin > 64) {
+            double colour_largest = 0;
+#pragma omp parallel for num_threads(m_threads) schedule(static) reduction(max : colour_largest)
+            for (std::int32_t g = begin; g < end; ++g)
+                colour_largest = std::max(colour_largest, solve_group(g, xp, h, moved[g]));
+            out.largest = std::max(out.largest, colour_largest);
+            continue;
+        }
+#endif
+        for (std::int32_t g = begin; g < end; ++g)
+            out.largest = std::max(out.largest, solve_group(g, xp, h, moved[g]));
+    }
+    for (double m : m_group_moved)
+        out.moved += m;
+    return out;
+}
+
 int BlockDescent::substep(Positions& x, Positions& v, double h)
 {
     const Model& model = m_ctx.model;
@@ -495,73 +758,100 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         m_x4[i] = {x(static_cast<Index>(i), 0), x(static_cast<Index>(i), 1), x(static_cast<Index>(i), 2), 0.0};
     double* xp = m_x4.data()->c;
     start_substep(xp);
-    // Inertial target y = x + h v + h² g; the iterations start from it.
     m_y.resize(3 * un);
+    const bool automatic = m_ctx.scene.iterations <= 0;
+    const double inv_h = 1.0 / h;
+    if (!(m_energy_ref > 0)) m_energy_ref = energy_scale(x, v);
+    // Chebyshev acceleration: the scene's ρ, or automatic: none with the coarse space (its corrections carry the
+    // long waves the acceleration was for), 0.9 without.
+    const double rho = m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
+    // Inertial target y = x + h v + h² g. The iterations start from x + h v + h² ã, ã the part of the vertex's
+    // acceleration over the previous substep along gravity, clamped to [0, |g|] (the VBD paper's adaptive start, per
+    // vertex; g at the first substep): y in free fall, x + h v for a body at rest. Starting from y, a resting body
+    // began every substep g h² lower, pressed into the ground (at 1/60 that is 2.7 mm: an edge of a 5 cm body), and
+    // the sweeps spent themselves lifting it back. The clamp matters: the whole last acceleration extrapolated an
+    // impact's rebound into the next start, and where the sweeps stopped short that bias put energy in (a 5 cm
+    // octopus ended a drop with 47 times its start energy).
     const Eigen::Vector3d& g = model.gravity;
+    const double g_norm = g.norm();
+    const Eigen::Vector3d down = g_norm > 0 ? Eigen::Vector3d(g / g_norm) : Eigen::Vector3d::Zero();
+    const bool first = m_accel.size() != 3 * un;
+    if (first) m_accel.assign(3 * un, 0.0);
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) {
             for (int r = 0; r < 3; ++r)
                 m_y[3 * i + static_cast<size_t>(r)] = x(static_cast<Index>(i), r);
             continue;
         }
-        for (int r = 0; r < 3; ++r) {
-            const double yr = x(static_cast<Index>(i), r) + h * v(static_cast<Index>(i), r) + h * h * g[r];
-            m_y[3 * i + static_cast<size_t>(r)] = yr;
-            xp[4 * i + static_cast<size_t>(r)] = yr;
+        if (first)
+            for (size_t r = 0; r < 3; ++r)
+                m_accel[3 * i + r] = g[static_cast<Index>(r)];
+        const double along = std::clamp(
+            down.x() * m_accel[3 * i] + down.y() * m_accel[3 * i + 1] + down.z() * m_accel[3 * i + 2], 0.0, g_norm);
+        for (size_t r = 0; r < 3; ++r) {
+            const Index ri = static_cast<Index>(r);
+            const double xr = x(static_cast<Index>(i), ri) + h * v(static_cast<Index>(i), ri);
+            m_y[3 * i + r] = xr + h * h * g[ri];
+            xp[4 * i + r] = automatic ? xr + h * h * along * down[ri] : m_y[3 * i + r];
         }
     }
     if (m_ctx.scene.inversion_guard) m_inversions.start_without_inversions(xp, m_xt);
     gather_contacts();
+    m_entered.assign(un, 0);
 
-    const double* xtp = m_xt.data();
-    const int colours = static_cast<int>(m_colour_start.size()) - 1;
-    const int max_sweeps = m_ctx.scene.iterations > 0 ? m_ctx.scene.iterations : automatic_sweeps(h);
+    // Automatic: sweep until a sweep moves the vertices by less than `convergence` of what the largest sweep of the
+    // substep moved them (mass-weighted), or they hardly move at all; at least min_sweeps, at most max_iterations
+    // (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
+    const int min_sweeps =
+        automatic ? std::min(min_sweeps_automatic, m_ctx.scene.max_iterations) : m_ctx.scene.iterations;
+    const int max_sweeps = automatic ? m_ctx.scene.max_iterations : m_ctx.scene.iterations;
+    const double tol2 = m_ctx.scene.convergence * m_ctx.scene.convergence;
     // Stop when no vertex moved more than this fraction of its clamp length (a fifth of its object's mean edge).
     const double stop = 5 * m_ctx.scene.sweep_tolerance;
     int sweeps = 0;
-    const double rho = m_ctx.scene.acceleration;
-    double omega = 1;
+    double omega = 1, moved_max = 0;
+    m_moved_history.clear();
+    m_converged = !automatic;
     if (rho > 0) {
         m_prev2.assign(xp, xp + 4 * un);
         m_prev1 = m_prev2;
     }
+    bool use_coarse = !m_coarse.empty();
+    bool first_coarse = true;
     while (sweeps < max_sweeps) {
-        for (ActiveContact& c : m_contacts) {
-            c.rel[0] = c.rel[1] = c.rel[2] = 0;
-            for (int s = 0; s < 5; ++s) {
-                const size_t j = static_cast<size_t>(c.node[s]);
-                for (int r = 0; r < 3; ++r)
-                    c.rel[r] += c.coef[s] * (xp[4 * j + static_cast<size_t>(r)] - xtp[3 * j + static_cast<size_t>(r)]);
-            }
-        }
-        double largest = 0;
-        for (int c = 0; c < colours; ++c) {
-            const std::int32_t begin = m_colour_start[static_cast<size_t>(c)],
-                               end = m_colour_start[static_cast<size_t>(c) + 1];
-#ifdef TETHASH_HAVE_OPENMP
-            if (m_threads > 1 && end - begin > 64) {
-                double colour_largest = 0;
-#pragma omp parallel for num_threads(m_threads) schedule(static) reduction(max : colour_largest)
-                for (std::int32_t g = begin; g < end; ++g)
-                    colour_largest = std::max(colour_largest, solve_group(g, xp, h));
-                largest = std::max(largest, colour_largest);
-                continue;
-            }
-#endif
-            for (std::int32_t g = begin; g < end; ++g)
-                largest = std::max(largest, solve_group(g, xp, h));
-        }
+        if (m_ctx.interrupted()) break; // Ctrl-C: the simulation rolls the step back
+        refresh_contacts(xp);
+        const Sweep sw = sweep(xp, h);
         ++sweeps;
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
-        if (largest <= stop) break;
+        if (sw.largest <= stop) break;
+        moved_max = std::max(moved_max, sw.moved);
+        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * m_energy_ref;
+        // A contact or friction that switches between sweeps and corrections can hold the moves in a cycle (seen
+        // at 1 m: the same six moves over and over, each far below the energy tolerance): once the moves stop
+        // shrinking over a cycle of corrections, more sweeps change nothing.
+        constexpr size_t cycle = 2 * sweeps_per_correction;
+        m_moved_history.push_back(sw.moved);
+        const bool stalled =
+            m_moved_history.size() > cycle && sw.moved >= 0.9 * m_moved_history[m_moved_history.size() - 1 - cycle];
+        if (automatic && sweeps >= min_sweeps &&
+            (((sw.moved <= tol2 * moved_max || stalled) && small_energy) || 0.5 * sw.moved <= 1e-14 * m_energy_ref)) {
+            m_converged = true;
+            break;
+        }
+        if (use_coarse && sweeps % sweeps_per_correction == 0 && sweeps < max_sweeps) {
+            use_coarse = coarse_correction(xp, h, first_coarse);
+            first_coarse = false;
+        }
     }
     if (m_ctx.scene.inversion_guard) m_inversions.restore_in_substep(xp);
-    const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
         for (int r = 0; r < 3; ++r) {
+            const double v_old = v(static_cast<Index>(i), r);
             x(static_cast<Index>(i), r) = xp[4 * i + static_cast<size_t>(r)];
             v(static_cast<Index>(i), r) = (x(static_cast<Index>(i), r) - m_xt(static_cast<Index>(i), r)) * inv_h;
+            m_accel[3 * i + static_cast<size_t>(r)] = (v(static_cast<Index>(i), r) - v_old) * inv_h;
         }
     }
     return sweeps;

@@ -6,6 +6,7 @@
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
 
+#include <csignal>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -19,6 +20,10 @@ struct StepContext {
     const TetMesh& mesh;
     const Model& model;
     const ContactResponse& contacts;
+    /// The simulation's interrupt flag (Simulation::set_interrupt_flag; may point to nullptr): iterative
+    /// integrators stop iterating once it is set, and the step is rolled back.
+    const volatile std::sig_atomic_t* const* interrupt = nullptr;
+    bool interrupted() const { return interrupt && *interrupt && **interrupt; }
 };
 
 class StepIntegrator {
@@ -27,6 +32,8 @@ class StepIntegrator {
     /// Advances positions x and velocities v (n × 3; fixed vertices untouched) by one substep h. Returns the
     /// solver iterations it took (0 for a direct method).
     virtual int substep(Positions& x, Positions& v, double h) = 0;
+    /// Whether the last substep's iterations met their tolerance (a direct or explicit method always does).
+    virtual bool converged() const { return true; }
     /// After a step is taken (no refinement to follow), with the tets it leaves inverted (rows of the model's volume
     /// terms): a last change of positions only (velocities stay). Nothing by default.
     virtual void finish_step(Positions& /*x*/, const std::vector<std::int32_t>& /*inverted*/) {}

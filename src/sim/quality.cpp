@@ -18,6 +18,15 @@ std::int64_t count_inverted(const TetMesh& mesh, const PositionsRef& start)
     return count;
 }
 
+double total_volume(const Model& model, const PositionsRef& x)
+{
+    double sum = 0;
+    const Tets& tets = model.volumes.tets;
+    for (Index t = 0; t < tets.rows(); ++t)
+        sum += signed_volume(x, {tets(t, 0), tets(t, 1), tets(t, 2), tets(t, 3)});
+    return sum;
+}
+
 std::int64_t count_far_self_penetrations(const TetMesh& mesh, const PositionsRef& start, double reach)
 {
     return FarSelfPenetrations(mesh, start, reach).count(mesh.positions);

@@ -8,7 +8,9 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -35,6 +37,22 @@ constexpr tethash::detail::EnumName<LinearSolver> k_solver_names[] = {{LinearSol
                                                                       {LinearSolver::ldlt, "ldlt"}};
 
 } // namespace
+
+bool parse_seconds(const std::string& text, double& out)
+{
+    const auto number = [](const std::string& t, double& v) {
+        if (t.empty() || std::isspace(static_cast<unsigned char>(t[0]))) return false;
+        char* end = nullptr;
+        v = std::strtod(t.c_str(), &end);
+        return end == t.c_str() + t.size();
+    };
+    const std::size_t slash = text.find('/');
+    if (slash == std::string::npos) return number(text, out);
+    double a = 0, b = 0;
+    if (!number(text.substr(0, slash), a) || !number(text.substr(slash + 1), b) || !(b != 0)) return false;
+    out = a / b;
+    return true;
+}
 
 Integrator parse_integrator(const std::string& name)
 {
@@ -122,6 +140,19 @@ class Reader {
     {
         const double v = number(n, key);
         if (!(v >= 0) || !std::isfinite(v)) fail(&n, key, "must be ≥ 0 and finite, found " + fmt(v));
+        return v;
+    }
+    /// A time in seconds: a positive number, or a string with a number or a fraction such as "1/240" (the grammar of
+    /// the command line's --dt).
+    double seconds(const toml::node& n, const std::string& key) const
+    {
+        if (!n.is_string()) return positive(n, key);
+        const std::string text = *n.value<std::string>();
+        double v = 0;
+        if (!parse_seconds(text, v) || !(v > 0) || !std::isfinite(v))
+            fail(&n, key,
+                 "must be a positive time in seconds: a number or a fraction such as \"1/240\", found \"" + text +
+                     "\"");
         return v;
     }
     double fraction_below_one(const toml::node& n, const std::string& key) const
@@ -409,13 +440,16 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                                                key("margin", &ContactParams::margin, &Reader::non_negative),
                                                key("speculative", &ContactParams::speculative, &Reader::boolean)});
     const std::vector<Key<Scene>> keys = {
-        key("dt", &Scene::dt, &Reader::positive),
+        key("dt", &Scene::dt, &Reader::seconds),
         int_key("steps", &Scene::steps, 0),
         int_key("substeps", &Scene::substeps, 1),
         int_key("max_substeps", &Scene::max_substeps, 0),
         {"integrator", named(parse_integrator, &Scene::integrator)},
         {"solver", named(parse_linear_solver, &Scene::solver)},
         int_key("iterations", &Scene::iterations, 0),
+        int_key("max_iterations", &Scene::max_iterations, 1),
+        key("convergence", &Scene::convergence, &Reader::fraction_below_one),
+        key("coarse_space", &Scene::coarse_space, &Reader::boolean),
         key("tolerance", &Scene::tolerance, &Reader::positive),
         key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
         key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),

@@ -9,6 +9,7 @@
 #include "obstacles.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/sim/quality.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -81,8 +82,21 @@ class SimulationImpl {
     std::vector<std::int32_t> inverted_tets; // which (scratch of each step)
     int refined = 1;                         // substeps of the last refined step, kept until refined_until
     double refined_until = 0;
+    RunHealth health;
+    double volume0 = 0; // volume of the dynamic tets at the start
+    const volatile std::sig_atomic_t* interrupt = nullptr;
 
     explicit SimulationImpl(const Scene& s);
+    std::string object_name(size_t k) const
+    {
+        return scene.objects[k].name.empty() ? "object " + std::to_string(k) : "'" + scene.objects[k].name + "'";
+    }
+    /// Set-up warnings: sizes that look like a wrong unit or scale, objects below the ground or inside others.
+    void check_placement();
+    /// The health figures that do not change during the run.
+    void start_health();
+    /// Throws Error for a dt far beyond the scene's own time scale.
+    void check_time_step();
     TetMesh& mesh() { return objects.mesh; }
     const TetMesh& mesh() const { return objects.mesh; }
     void automatic_ground();
@@ -126,7 +140,107 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     contacts.update(mesh().positions, v, scene.dt / scene.substeps, first);
     failure.setup(model, mesh().positions, v, contacts.energy());
     inverted = find_inverted_tets(model, mesh().positions, inverted_tets);
-    integrator = make_integrator(StepContext{scene, mesh(), model, contacts});
+    integrator = make_integrator(StepContext{scene, mesh(), model, contacts, &interrupt});
+    check_placement();
+    start_health();
+    check_time_step();
+}
+
+void SimulationImpl::check_time_step()
+{
+    // A step far longer than the scene's own time: the smallest dynamic object falls its own size under gravity in
+    // sqrt(2 L / g) (or crosses it at its speed). Ten times that is refused: such a step cannot show the motion it
+    // skips, and its iterations would only converge at great cost (a user's dt = 1e9 asked for a million sweeps).
+    const double g = model.gravity.norm();
+    double shortest = INFINITY, size_of = 0;
+    for (size_t k = 0; k < objects.vertices.size(); ++k) {
+        const auto [first, count] = objects.vertices[k];
+        if (objects.is_static[k] || count == 0) continue;
+        const auto box = bounding_box(mesh().positions.middleRows(first, count));
+        const double size = (box.second - box.first).maxCoeff();
+        double speed = 0;
+        for (Index i = first; i < first + count; ++i)
+            speed = std::max(speed, v.row(i).norm());
+        double t_own = INFINITY;
+        if (g > 0) t_own = std::sqrt(2 * size / g);
+        if (speed > 0) t_own = std::min(t_own, size / speed);
+        if (t_own < shortest) {
+            shortest = t_own;
+            size_of = size;
+        }
+    }
+    if (std::isfinite(shortest) && shortest > 0 && scene.dt > 10 * shortest)
+        throw Error("dt " + short_number(scene.dt) + " s is far beyond what this scene can show: its smallest moving " +
+                    "object (" + short_number(size_of) + " m) falls or moves its own size in " +
+                    short_number(shortest) + " s, and a step of more than 10 times that (" +
+                    short_number(10 * shortest) + " s) is refused; use a dt of at most that, or substeps");
+}
+
+void SimulationImpl::check_placement()
+{
+    const Positions& x = mesh().positions;
+    const Ground& g = model.ground;
+    std::vector<std::int64_t> inside(scene.objects.size() * scene.objects.size(), 0);
+    const size_t nobj = objects.vertices.size();
+    for (const Contact& c : contacts.contacts())
+        if (c.vertex_object != c.tet_object && static_cast<size_t>(c.vertex_object) < nobj &&
+            static_cast<size_t>(c.tet_object) < nobj)
+            ++inside[static_cast<size_t>(c.vertex_object) * nobj + static_cast<size_t>(c.tet_object)];
+    for (size_t k = 0; k < nobj; ++k) {
+        const auto [first, count] = objects.vertices[k];
+        if (count == 0) continue;
+        const auto box = bounding_box(x.middleRows(first, count));
+        const double size = (box.second - box.first).maxCoeff();
+        if (size > 20.0)
+            warnings.push_back(object_name(k) + " is " + short_number(size) +
+                               " m across: if its mesh is in millimetres, give it scale = 0.001 (scene sizes are in "
+                               "metres; the material's stiffness and the contacts are set for them)");
+        else if (size < 5e-3)
+            warnings.push_back(object_name(k) + " is " + short_number(1e3 * size) +
+                               " mm across: check its scale (scene sizes are in metres)");
+        if (g.enabled && !objects.is_static[k]) {
+            double deepest = 0;
+            for (Index i = first; i < first + count; ++i)
+                deepest = std::max(deepest, g.height - g.normal.dot(x.row(i).transpose()));
+            if (deepest > 1e-9 * std::max(1.0, size))
+                warnings.push_back(object_name(k) + " starts " + short_number(deepest) +
+                                   " m below the ground: the ground pushes it out at the first step");
+        }
+        for (size_t o = 0; o < nobj; ++o)
+            if (const std::int64_t n = inside[k * nobj + o]; n > 0)
+                warnings.push_back(object_name(k) + " starts with " + std::to_string(n) +
+                                   (n == 1 ? " vertex inside " : " vertices inside ") + object_name(o) +
+                                   ": the contacts push them apart at the first step");
+    }
+}
+
+void SimulationImpl::start_health()
+{
+    health = RunHealth{};
+    const Energy e = model.energy(mesh().positions, v);
+    health.energy_start = e.total() + contacts.energy();
+    health.energy_end = health.energy_start;
+    health.energy_scale = failure.energy_ref();
+    health.tets = static_cast<std::int64_t>(model.volumes.tets.rows());
+    health.inverted_end = inverted;
+    volume0 = total_volume(model, mesh().positions);
+    // What each object's weight squeezes: density · g · height / young (a strain).
+    const double gn = model.gravity.norm();
+    for (size_t k = 0; k < objects.vertices.size(); ++k) {
+        const auto [first, count] = objects.vertices[k];
+        if (objects.is_static[k] || count == 0 || !(gn > 0)) continue;
+        double lo = INFINITY, hi = -INFINITY;
+        for (Index i = first; i < first + count; ++i) {
+            const double z = -model.gravity.dot(mesh().positions.row(i).transpose()) / gn;
+            lo = std::min(lo, z);
+            hi = std::max(hi, z);
+        }
+        const Material& m = objects.materials[k];
+        const double young = m.stiffness > 0 && k < model.object_mean_edge.size() && model.object_mean_edge[k] > 0
+                                 ? m.stiffness / model.object_mean_edge[k]
+                                 : m.young;
+        if (young > 0) health.weight_strain = std::max(health.weight_strain, m.density * gn * (hi - lo) / young);
+    }
 }
 
 void SimulationImpl::automatic_ground()
@@ -201,6 +315,7 @@ void Simulation::step()
         substeps *= 2;
         return true;
     };
+    double energy_now = 0;
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
@@ -215,13 +330,21 @@ void Simulation::step()
             }
             const auto t0 = Clock::now();
             st.solver_iterations += s.integrator->substep(x, s.v, h);
+            if (!s.integrator->converged()) ++st.unconverged;
             st.ms_integrate += ms_since(t0);
+            if (s.interrupt && *s.interrupt) {
+                x = s.x_save;
+                s.v = s.v_save;
+                throw Interrupted("interrupted during step " + std::to_string(step_no) + " (t = " + short_number(s.t) +
+                                  " s); the state is that of the step's start");
+            }
             bad = s.failure.check_substep(s.model, x, s.v, s.t + (sub + 1) * h);
             if (!bad.empty()) break;
         }
         if (bad.empty()) {
             const Energy e = s.model.energy(x, s.v);
             bad = s.failure.check_energy(e.internal() + s.contacts.energy());
+            energy_now = e.total() + s.contacts.energy();
         }
         if (!bad.empty()) {
             if (refine()) continue;
@@ -252,6 +375,19 @@ void Simulation::step()
     }
     st.mean_depth = st.contacts == 0 ? 0.0 : sum / static_cast<double>(st.contacts);
     s.stats = st;
+    RunHealth& hl = s.health;
+    ++hl.steps;
+    hl.substeps += substeps;
+    if (substeps > s.scene.substeps) ++hl.refined_steps;
+    hl.unconverged_substeps += st.unconverged;
+    hl.energy_end = energy_now;
+    if (hl.energy_scale > 0)
+        hl.energy_growth = std::max(hl.energy_growth, (energy_now - hl.energy_start) / hl.energy_scale);
+    if (s.volume0 > 0) {
+        hl.volume_end = total_volume(s.model, x) / s.volume0;
+        hl.volume_ratio = std::min(hl.volume_ratio, hl.volume_end);
+    }
+    hl.inverted_end = s.inverted;
     ++s.steps_done;
     s.t += s.scene.dt;
 }
@@ -367,6 +503,55 @@ double Simulation::explicit_dt_limit() const
 const std::vector<std::string>& Simulation::warnings() const
 {
     return m_impl->warnings;
+}
+
+std::vector<double> Simulation::object_sizes() const
+{
+    std::vector<double> out;
+    for (const auto& [first, count] : m_impl->objects.vertices) {
+        if (count == 0) {
+            out.push_back(0);
+            continue;
+        }
+        const auto box = bounding_box(m_impl->mesh().positions.middleRows(first, count));
+        out.push_back((box.second - box.first).maxCoeff());
+    }
+    return out;
+}
+
+const RunHealth& Simulation::health() const
+{
+    return m_impl->health;
+}
+
+void Simulation::set_interrupt_flag(const volatile std::sig_atomic_t* flag)
+{
+    m_impl->interrupt = flag;
+}
+
+std::vector<std::string> RunHealth::problems() const
+{
+    std::vector<std::string> out;
+    auto percent = [](double f) { return short_number(100 * f) + " %"; };
+    if (energy_growth > energy_slack)
+        out.push_back("the energy rose " + percent(energy_growth) +
+                      " of what the scene had to spend above its start (a passive scene must lose energy): the "
+                      "steps were not converged; lower `convergence` or dt");
+    if (volume_ratio < 1 - volume_slack && weight_strain < volume_slack)
+        out.push_back("the bodies lost " + percent(1 - volume_ratio) +
+                      " of their volume at the worst step (their weight squeezes them by " + percent(weight_strain) +
+                      " only)");
+    if (unconverged_substeps > 0)
+        out.push_back(std::to_string(unconverged_substeps) + " of " + std::to_string(substeps) +
+                      " substeps stopped at max_iterations unconverged: raise max_iterations or lower dt");
+    if (refined_steps > 0)
+        out.push_back(std::to_string(refined_steps) + " of " + std::to_string(steps) +
+                      " steps were taken again in more substeps (tets inverted or a blow-up at dt): dt is large for "
+                      "the material or the impacts");
+    if (tets > 0 && inverted_end * 1000 > tets)
+        out.push_back(std::to_string(inverted_end) + " of " + std::to_string(tets) + " tets (" +
+                      percent(static_cast<double>(inverted_end) / static_cast<double>(tets)) + ") end inverted");
+    return out;
 }
 
 io::Fields Simulation::output_fields() const

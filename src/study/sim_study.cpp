@@ -33,6 +33,7 @@ struct SimPlan {
     std::string ref_integrator;
     double ref_energy_drift = 0;
     double ref_max_penetration = 0;
+    double size = 0; ///< the scene's extent (longest side of the reference's first sample's box): errors relative to it
 };
 
 void SimPlanDeleter::operator()(SimPlan* p) const
@@ -57,6 +58,7 @@ const std::vector<std::string> k_sim_columns = {
     "status",
     "err_rms",
     "err_max",
+    "err_rms_rel",
     "max_penetration",
     "final_contacts",
     "energy_start",
@@ -226,6 +228,10 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
             throw RunFailure("reference run (" + std::string(sim::to_string(ref.integrator)) + ", dt " +
                              fmt_double(sp.ref_dt) + "): " + r.status);
         sp.ref_samples = std::move(r.samples);
+        if (!sp.ref_samples->empty()) {
+            const auto [lo, hi] = bounding_box(sp.ref_samples->front());
+            sp.size = (hi - lo).maxCoeff();
+        }
         sp.ref_integrator = sim::to_string(ref.integrator);
         sp.ref_energy_drift = r.e1 - r.e0;
         sp.ref_max_penetration = r.max_pen;
@@ -239,7 +245,7 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
         RunOutcome out = simulate(sp, pt, hooks.stop);
         if (out.status == "interrupted") break;
         if (r < 0) continue;
-        std::string err_rms, err_max;
+        std::string err_rms, err_max, err_rel;
         if (out.samples.size() == sp.ref_samples->size()) {
             double sum = 0, mx = 0;
             std::int64_t count = 0;
@@ -252,7 +258,9 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
                     ++count;
                 }
             }
-            err_rms = fmt_double(count ? std::sqrt(sum / static_cast<double>(count)) : 0.0);
+            const double rms = count ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
+            err_rms = fmt_double(rms);
+            if (sp.size > 0) err_rel = fmt_double(rms / sp.size);
             err_max = fmt_double(std::sqrt(mx));
         }
         const double drift = out.e1 - out.e0;
@@ -270,6 +278,7 @@ std::vector<Row> run_sim_point(StudyPlan& plan, std::int64_t index, const RunHoo
                         out.status,
                         err_rms,
                         err_max,
+                        err_rel,
                         fmt_double(out.max_pen),
                         std::to_string(out.contacts),
                         fmt_double(out.e0),

@@ -41,8 +41,11 @@ struct Row {
     double ms_mean = 0;  ///< mean ms per step: the cost that counts where some steps were refined
     double substeps = 1; ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
+    std::int64_t unconverged = 0;  ///< substeps whose sweeps reached their cap
     std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
     double mean_z = 0;             ///< mean height of the vertices at the end (how far the body sagged or sank)
+    double energy_ratio = 0;       ///< total energy at the end / at the start (a passive drop must stay ≤ 1)
+    double volume_ratio = 0;       ///< volume of the dynamic tets at the end / at the start
     bool stable = false;
     std::string failure;
 };
@@ -62,13 +65,15 @@ double median(std::vector<double> v)
     return v[v.size() / 2];
 }
 
-sim::ObjectSpec placed(const TetMesh& mesh, double lift)
+/// The mesh scaled to `size` (its longest extent, m), centred over the origin, its lowest point `lift` × size above
+/// the ground.
+sim::ObjectSpec placed(const TetMesh& mesh, double lift, double size)
 {
     const auto [lo, hi] = bounding_box(mesh.positions);
     sim::ObjectSpec o;
-    const double s = 1.0 / (hi - lo).maxCoeff();
+    const double s = size / (hi - lo).maxCoeff();
     o.scale = Eigen::Vector3d::Constant(s);
-    o.translate = Eigen::Vector3d(-s * 0.5 * (lo.x() + hi.x()), -s * 0.5 * (lo.y() + hi.y()), lift - s * lo.z());
+    o.translate = Eigen::Vector3d(-s * 0.5 * (lo.x() + hi.x()), -s * 0.5 * (lo.y() + hi.y()), lift * size - s * lo.z());
     o.data = mesh;
     o.material.density = 1000;
     o.material.young = 1e5;
@@ -86,6 +91,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
     sim::FarSelfPenetrations far(s.mesh(), start);
+    const double energy0 = s.energy().total(), volume0 = sim::total_volume(s.model(), start);
     std::vector<double> ms, det, dep, prox, resp, integ, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
@@ -104,6 +110,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
             sw.push_back(st.solver_iterations);
             con.push_back(static_cast<double>(st.contacts));
             sub.push_back(st.substeps);
+            r.unconverged += st.unconverged;
         }
     } catch (const RunFailure& e) {
         r.failure = e.what();
@@ -123,6 +130,8 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.far_self = far.count(s.positions());
     r.far_self_max = std::max(r.far_self_max, r.far_self);
     r.mean_z = s.mesh().positions.col(2).mean();
+    r.energy_ratio = s.energy().total() / energy0;
+    r.volume_ratio = sim::total_volume(s.model(), s.positions()) / volume0;
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
     return r;
 }
@@ -171,12 +180,12 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
 void print(const Row& r)
 {
     std::printf(
-        "%-26s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %7.4f "
-        "%10.3g  %s\n",
+        "%-30s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %8.4g "
+        "%7.3g %6.3f %6lld %10.3g  %s\n",
         r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
         r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
-        static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max), r.mean_z,
-        r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
+        static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max), r.mean_z, r.energy_ratio,
+        r.volume_ratio, static_cast<long long>(r.unconverged), r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
     std::fflush(stdout);
 }
 
@@ -198,8 +207,11 @@ int main(int argc, char** argv)
     CLI::App app{"tethash_sim_bench: the simulator on the shared real meshes (drops and a collision)"};
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
+    std::vector<double> sizes{1.0};
     double seconds = 0.5;
-    int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0;
+    int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
+    double convergence = -1;
+    bool no_coarse = false;
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
     bool no_speculative = false, inversion_guard = false;
     bool no_peer = false;
@@ -210,6 +222,11 @@ int main(int argc, char** argv)
     runs->add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")
         ->delimiter(',');
     runs->add_option("--dt", dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
+    runs->add_option("--size", sizes,
+                     "body sizes (longest extent, m), comma-separated; drops start 0.2 sizes above the ground, the "
+                     "two armadillos 1.4 sizes apart")
+        ->delimiter(',')
+        ->check(CLI::PositiveNumber);
     runs->add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
     runs->add_option("--threads", threads, "detector and solver threads")->capture_default_str();
     runs->add_option("--csv", csv, "write the rows as CSV to this file");
@@ -218,6 +235,9 @@ int main(int argc, char** argv)
     overrides->add_option("--max-substeps", max_substeps,
                           "refine a step that inverts tets or blows up into up to this many substeps; 1 = never; "
                           "0 = the scene default");
+    overrides->add_option("--convergence", convergence, "vbd automatic sweeps: relative tolerance in [0, 1)");
+    overrides->add_option("--max-iterations", max_iterations, "vbd automatic sweeps: the cap per substep");
+    overrides->add_flag("--no-coarse", no_coarse, "vbd: sweeps alone, without the coarse space's corrections");
     overrides->add_option("--sweep-tolerance", sweep_tolerance, "vbd early stop (fraction of the mean edge)");
     overrides->add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1)");
     overrides->add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size");
@@ -271,31 +291,40 @@ int main(int argc, char** argv)
         const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node",    "screw.msh",
                                                 "P1.msh",           "raptorTetra_8418.vtu", "32770_octocat.msh",
                                                 "hand.mesh",        "mat100x100t40.msh",    "quintupleTorus.veg"};
+        // A size's scenes are named with it ("drop hand 5cm") unless only 1 m is run (the rows' historic names).
+        auto size_name = [&](double size) {
+            if (sizes.size() == 1 && size == 1.0) return std::string();
+            return size < 1 ? fmt::format(" {:g}cm", 100 * size) : fmt::format(" {:g}m", size);
+        };
         for (const std::string& file : files) {
             const std::filesystem::path p = std::filesystem::path(meshes_dir) / file;
             if (!std::filesystem::exists(p)) continue;
             const TetMesh mesh = io::read_mesh(p.string());
-            sim::Scene s;
-            s.objects.push_back(placed(mesh, 0.2));
-            s.ground.enabled = true;
-            s.output.every = 0;
-            scenes.emplace_back("drop " + p.stem().string(), s);
-            if (file == "armadillo_4k.node") {
-                sim::Scene two;
-                for (int k = 0; k < 2; ++k) {
-                    sim::ObjectSpec o = placed(mesh, 0.3);
-                    o.translate.x() += k == 0 ? -0.7 : 0.7;
-                    o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
-                    two.objects.push_back(o);
+            for (double size : sizes) {
+                sim::Scene s;
+                s.objects.push_back(placed(mesh, 0.2, size));
+                s.ground.enabled = true;
+                s.output.every = 0;
+                scenes.emplace_back("drop " + p.stem().string() + size_name(size), s);
+                if (file == "armadillo_4k.node") {
+                    sim::Scene two;
+                    for (int k = 0; k < 2; ++k) {
+                        sim::ObjectSpec o = placed(mesh, 0.3, size);
+                        o.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
+                        o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
+                        two.objects.push_back(o);
+                    }
+                    two.ground.enabled = true;
+                    two.output.every = 0;
+                    scenes.emplace_back("two armadillos at 2 m/s" + size_name(size), two);
                 }
-                two.ground.enabled = true;
-                two.output.every = 0;
-                scenes.emplace_back("two armadillos at 2 m/s", two);
             }
         }
-        std::printf("%-26s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %7s %10s  %s\n",
-                    "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
-                    "integr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "dt/ms", "failure");
+        std::printf(
+            "%-30s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  %s\n",
+            "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
+            "integr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "E1/E0", "V1/V0", "unconv",
+            "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!filter.empty() && name.find(filter) == std::string::npos) continue;
@@ -307,6 +336,9 @@ int main(int argc, char** argv)
                     if (iterations > 0) scene.iterations = iterations;
                     if (max_substeps > 0) scene.max_substeps = max_substeps;
                     if (sweep_tolerance >= 0) scene.sweep_tolerance = sweep_tolerance;
+                    if (convergence >= 0) scene.convergence = convergence;
+                    if (max_iterations > 0) scene.max_iterations = max_iterations;
+                    if (no_coarse) scene.coarse_space = false;
                     if (rho >= 0) scene.acceleration = rho;
                     if (margin >= 0) scene.contact.margin = margin;
                     if (no_speculative) scene.contact.speculative = false;
@@ -349,13 +381,14 @@ int main(int argc, char** argv)
                 if (!out) throw Error("--csv: cannot write '" + tmp + "'");
                 out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
                        "ms_response,ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,"
-                       "stable,failure\n";
+                       "energy_ratio,volume_ratio,unconverged,stable,failure\n";
                 for (const Row& r : rows)
                     out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},"
-                                       "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{},\"{}\"\n",
+                                       "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},\"{}\"\n",
                                        r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect,
                                        r.depth, r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts,
-                                       r.inverted, r.far_self, r.far_self_max, r.mean_z, r.stable ? 1 : 0, r.failure);
+                                       r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio, r.volume_ratio,
+                                       r.unconverged, r.stable ? 1 : 0, r.failure);
             }
             std::filesystem::rename(tmp, csv);
         }

@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -25,27 +24,13 @@ namespace {
 volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void on_interrupt(int)
 {
+    // The first Ctrl-C ends the run after the current step (the step in progress stops at its next sweep or
+    // substep and is rolled back); a second one ends the process at once.
     g_interrupted = 1;
+    std::signal(SIGINT, SIG_DFL);
 }
 
-/// "1/240", "0.004", "4e-3": seconds; false when the text is not a number or a fraction of two numbers.
-bool parse_seconds(const std::string& text, double& out)
-{
-    const auto number = [](const std::string& t, double& v) {
-        if (t.empty() || std::isspace(static_cast<unsigned char>(t[0]))) return false;
-        char* end = nullptr;
-        v = std::strtod(t.c_str(), &end);
-        return end == t.c_str() + t.size();
-    };
-    const std::size_t slash = text.find('/');
-    if (slash == std::string::npos) return number(text, out);
-    double a = 0, b = 0;
-    if (!number(text.substr(0, slash), a) || !number(text.substr(slash + 1), b) || !(b != 0)) return false;
-    out = a / b;
-    return true;
-}
-
-/// Removes frame_NNNNN.vtu and scene.pvd from `dir`; returns how many files it removed.
+/// Removes frame_NNNNN.vtu, scene.pvd and run.json from `dir`; returns how many files it removed.
 int remove_previous_frames(const std::string& dir)
 {
     int removed = 0;
@@ -55,7 +40,7 @@ int remove_previous_frames(const std::string& dir)
         const bool frame =
             name.size() == 15 && name.compare(0, 6, "frame_") == 0 && name.compare(11, 4, ".vtu") == 0 &&
             std::all_of(name.begin() + 6, name.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
-        if ((frame || name == "scene.pvd") && entry.is_regular_file()) {
+        if ((frame || name == "scene.pvd" || name == "run.json") && entry.is_regular_file()) {
             std::error_code rm;
             if (std::filesystem::remove(entry.path(), rm))
                 ++removed;
@@ -75,7 +60,42 @@ struct SimulateOptions {
     std::string integrator;
     std::string threads; ///< "" = the scene's
     std::string out = "out";
+    bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
 };
+
+/// DIR/run.json: what the run was and how far it can be trusted (written at the end, or when interrupted).
+void write_run_json(const std::string& dir, const sim::Simulation& sim, const std::string& status, double wall)
+{
+    const sim::RunHealth& h = sim.health();
+    std::string problems;
+    for (const std::string& p : h.problems()) {
+        std::string q;
+        for (char c : p)
+            q += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
+        problems += (problems.empty() ? "" : ", ") + ("\"" + q + "\"");
+    }
+    std::string scene = sim.scene().source;
+    for (size_t i = 0; i < scene.size(); ++i)
+        if (scene[i] == '"' || scene[i] == '\\') scene.insert(i++, 1, '\\');
+    const std::string text = fmt::format(
+        "{{\n  \"scene\": \"{}\",\n  \"status\": \"{}\",\n  \"integrator\": \"{}\",\n  \"dt\": {:.9g},\n"
+        "  \"steps\": {},\n  \"substeps\": {},\n  \"refined_steps\": {},\n  \"unconverged_substeps\": {},\n"
+        "  \"energy_start\": {:.9g},\n  \"energy_end\": {:.9g},\n  \"energy_scale\": {:.9g},\n"
+        "  \"energy_growth\": {:.6g},\n  \"volume_ratio_min\": {:.6g},\n  \"volume_ratio_end\": {:.6g},\n"
+        "  \"inverted_tets_end\": {},\n  \"tets\": {},\n  \"wall_seconds\": {:.4g},\n  \"problems\": [{}]\n}}\n",
+        scene, status, sim::to_string(sim.scene().integrator), sim.scene().dt, h.steps, h.substeps, h.refined_steps,
+        h.unconverged_substeps, h.energy_start, h.energy_end, h.energy_scale, h.energy_growth, h.volume_ratio,
+        h.volume_end, h.inverted_end, h.tets, wall, problems);
+    const std::filesystem::path path = std::filesystem::path(dir) / "run.json";
+    const std::filesystem::path tmp = path.string() + ".partial";
+    {
+        std::FILE* f = std::fopen(tmp.string().c_str(), "wb");
+        if (!f) throw Error("--out: cannot write '" + tmp.string() + "'");
+        const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+        if (std::fclose(f) != 0 || !ok) throw Error("--out: cannot write '" + tmp.string() + "'");
+    }
+    std::filesystem::rename(tmp, path);
+}
 
 void run_simulate(const SimulateOptions& o)
 {
@@ -87,7 +107,7 @@ void run_simulate(const SimulateOptions& o)
     if (!o.dt.empty()) {
         // One grammar with the scene file and the studies: seconds, or a fraction such as 1/240.
         double dt = 0;
-        if (!parse_seconds(o.dt, dt) || !(dt > 0) || !std::isfinite(dt))
+        if (!sim::parse_seconds(o.dt, dt) || !(dt > 0) || !std::isfinite(dt))
             throw Error("--dt must be a positive, finite time in seconds (e.g. 0.004 or 1/240), found '" + o.dt + "'");
         scene.dt = dt;
     }
@@ -111,6 +131,7 @@ void run_simulate(const SimulateOptions& o)
     const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
 
     sim::Simulation sim(scene);
+    sim.set_interrupt_flag(&g_interrupted);
     for (const std::string& w : sim.warnings())
         std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
 
@@ -142,11 +163,22 @@ void run_simulate(const SimulateOptions& o)
         static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
         static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
         scene.steps, threads);
-    std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
+    {
+        std::string sizes;
+        const std::vector<double> size = sim.object_sizes();
+        for (size_t k = 0; k < size.size(); ++k)
+            sizes += fmt::format("{}{} {:.4g} m", k ? ", " : "",
+                                 scene.objects[k].name.empty() ? fmt::format("object {}", k) : scene.objects[k].name,
+                                 size[k]);
+        std::fprintf(stdout, "object sizes (longest extent): %s\n", sizes.c_str());
+    }
+    if (scene.integrator == sim::Integrator::symplectic_euler)
+        std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
     std::fflush(stdout);
 
     const bool tty = stderr_is_terminal();
-    double ms_detect = 0, ms_depth = 0, ms_response = 0, ms_integrate = 0, max_depth = 0, depth_sum = 0;
+    double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, max_depth = 0,
+           depth_sum = 0;
     std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0;
     const auto start = std::chrono::steady_clock::now();
     auto last_print = start;
@@ -164,11 +196,16 @@ void run_simulate(const SimulateOptions& o)
     try {
         for (int s = 0; s < scene.steps; ++s) {
             if (g_interrupted) break;
-            sim.step();
+            try {
+                sim.step();
+            } catch (const sim::Interrupted&) {
+                break; // rolled back to the last complete step
+            }
             done = s + 1;
             const sim::StepStats& st = sim.last_stats();
             ms_detect += st.ms_detect;
             ms_depth += st.ms_depth;
+            ms_proximity += st.ms_proximity;
             ms_response += st.ms_response;
             ignored += st.ignored_local;
             ms_integrate += st.ms_integrate;
@@ -184,26 +221,37 @@ void run_simulate(const SimulateOptions& o)
             const auto now = std::chrono::steady_clock::now();
             const double secs = std::chrono::duration<double>(now - start).count();
             const double rate = secs > 0 ? (s + 1) / secs : 0.0;
+            // What the run should not hide, as it happens: energy gained, substeps unconverged, steps refined.
+            std::string note;
+            const sim::RunHealth& hl = sim.health();
+            if (hl.energy_growth > sim::RunHealth::energy_slack)
+                note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
+            if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
+            if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
             if (tty) {
                 if (std::chrono::duration<double>(now - last_print).count() > 0.1 || s + 1 == scene.steps) {
                     const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, scene.steps));
-                    std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g   ",
+                    std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g%s   ",
                                  std::string(static_cast<size_t>(filled), '#').c_str(),
                                  std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps,
-                                 rate, static_cast<long long>(st.contacts), st.max_depth);
+                                 rate, static_cast<long long>(st.contacts), st.max_depth, note.c_str());
                     last_print = now;
                 }
             } else if ((s + 1) % plain_every == 0 || s + 1 == scene.steps) {
-                std::fprintf(stderr, "step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g\n", s + 1, scene.steps,
-                             rate, static_cast<long long>(st.contacts), st.max_depth);
+                std::fprintf(stderr, "step %d/%d  %.1f steps/s  contacts %lld  max pen %.3g%s\n", s + 1, scene.steps,
+                             rate, static_cast<long long>(st.contacts), st.max_depth, note.c_str());
             }
         }
     } catch (const RunFailure&) {
         if (tty) std::fprintf(stderr, "\n");
+        write_run_json(o.out, sim, "failed",
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         throw;
     }
     if (tty) std::fprintf(stderr, "\n");
     if (g_interrupted) {
+        write_run_json(o.out, sim, "interrupted",
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         std::fprintf(stderr,
                      "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
                      "series: %s\n",
@@ -216,8 +264,10 @@ void run_simulate(const SimulateOptions& o)
     const int n = std::max(1, scene.steps);
     const sim::Energy e1 = sim.energy();
     std::fprintf(stdout,
-                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, response %.3f, integration %.3f)\n",
-                 scene.steps, wall, 1e3 * wall / n, ms_detect / n, ms_depth / n, ms_response / n, ms_integrate / n);
+                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, proximity %.3f, response %.3f, "
+                 "integration %.3f)\n",
+                 scene.steps, wall, 1e3 * wall / n, ms_detect / n, ms_depth / n, ms_proximity / n, ms_response / n,
+                 ms_integrate / n);
     std::fprintf(stdout, "contacts per step: %.1f (plus %.1f local self-contacts left to the elastic terms)\n",
                  static_cast<double>(contacts) / n, static_cast<double>(ignored) / n);
     if (iterations)
@@ -234,8 +284,24 @@ void run_simulate(const SimulateOptions& o)
                  "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
                  "contact %.4g)\n",
                  e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
+    const sim::RunHealth& health = sim.health();
+    std::fprintf(stdout,
+                 "health: energy end/start %.4g (most gained %.3g %% of what the scene had to spend), volume end/start "
+                 "%.4f (least %.4f), %lld unconverged of %lld substeps, %lld refined steps, %lld tets inverted\n",
+                 health.energy_start != 0 ? health.energy_end / health.energy_start : 1.0,
+                 100 * std::max(0.0, health.energy_growth), health.volume_end, health.volume_ratio,
+                 static_cast<long long>(health.unconverged_substeps), static_cast<long long>(health.substeps),
+                 static_cast<long long>(health.refined_steps), static_cast<long long>(health.inverted_end));
+    const std::vector<std::string> problems = health.problems();
+    for (const std::string& p : problems)
+        std::fprintf(stderr, "tethash: warning: %s\n", p.c_str());
+    write_run_json(o.out, sim, problems.empty() ? "ok" : "untrusted", wall);
     if (every > 0)
-        std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView)\n", series.size(), o.out.c_str());
+        std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView; run.json says how far to trust them)\n",
+                     series.size(), o.out.c_str());
+    if (o.strict && !problems.empty())
+        throw RunFailure("--strict: the run cannot be trusted (" + std::to_string(problems.size()) + " problem" +
+                         (problems.size() == 1 ? "" : "s") + " above)");
 }
 
 Registrar reg{
@@ -249,6 +315,9 @@ Registrar reg{
          sub.add_option("--threads", o->threads,
                         "Detector threads: 0 = every hardware thread, or 1..256 (default: the scene's [detector] "
                         "threads, 1 if absent)");
+         sub.add_flag("--strict", o->strict,
+                      "Exit 1 when the run cannot be trusted: energy gained, volume lost, iterations unconverged, "
+                      "steps refined or tets inverted at the end (each is a warning otherwise)");
          sub.add_option("-o,--out", o->out,
                         "Output folder for frame_NNNNN.vtu and scene.pvd (those of a previous run there are removed)")
              ->capture_default_str();

@@ -284,6 +284,9 @@ Registrar reg{
                         "stability sweep: Young's moduli in Pa, list or FROM:TO:POINTS (default: 1e3,1e5,1e7,1e9)");
          sub.add_option("--mass-ratio", a->o.mass_ratio,
                         "stability sweep: density of the first body over the second (default: 1,1e3,1e6)");
+         sub.add_option("--size", a->o.size,
+                        "stability sweep: body sizes in m (longest extent), list or FROM:TO:POINTS (default: 1; "
+                        "try 0.05,0.15,1,5)");
          sub.add_option("--duration", a->o.duration, "simulated seconds (default: the scene's, at most 0.5)");
          sub.add_option("--samples", a->o.samples, "fixed times where the position error is taken")
              ->capture_default_str();

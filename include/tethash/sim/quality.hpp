@@ -5,6 +5,7 @@
 /// simulation benchmark, so that all three count the same thing.
 #include "tethash/detect.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/sim/model.hpp"
 
 #include <cstdint>
 
@@ -12,6 +13,10 @@ namespace tethash::sim {
 
 /// Tets of `mesh` whose signed volume at `mesh.positions` has the other sign than at `start` (same topology).
 std::int64_t count_inverted(const TetMesh& mesh, const PositionsRef& start);
+
+/// Sum of the signed volumes of the model's dynamic tets (each oriented positive at rest) at `x`: what a body
+/// keeps of its volume, for the energy and volume checks of a run.
+double total_volume(const Model& model, const PositionsRef& x);
 
 /// Distinct vertices lying inside a tet of their own object (exact detector) whose nearest corner of that tet was
 /// more than `reach` mean edges away at `start`: a fold through a distant part of the body, not a local overlap.

@@ -16,12 +16,20 @@
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
 
+#include <csignal>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace tethash::sim {
+
+/// Thrown by Simulation::step() when the interrupt flag was set during the step; the state is the step's start.
+class Interrupted : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
 
 /// Timing and contact figures of one step (all its substeps). Times in milliseconds.
 struct StepStats {
@@ -38,6 +46,35 @@ struct StepStats {
     double mean_depth = 0;          ///< mean over contacts at the last substep
     int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
     int substeps = 1;               ///< substeps the step took (scene substeps, or more where it was refined)
+    int unconverged = 0;            ///< substeps whose iterations reached their cap unconverged (vbd: max_iterations)
+};
+
+/// How far a run can be trusted, kept over its steps so far (Simulation::health()). A passive scene (everything
+/// tethash simulates: gravity, ground, contacts, pins; no motors) must not gain energy, and a body must keep its
+/// volume unless its material lets its own weight squeeze it.
+struct RunHealth {
+    double energy_start = 0; ///< total energy at the start (kinetic, elastic, gravity, ground, contact)
+    /// What the scene has to spend at the start: its internal energy plus every mass falling over the scene's height
+    /// (and to the ground); the growth below is measured against it.
+    double energy_scale = 0;
+    double energy_growth = 0;  ///< the most (E − energy_start) / energy_scale at the end of any step so far
+    double energy_end = 0;     ///< total energy after the last step
+    double volume_ratio = 1;   ///< the least volume of the dynamic tets over their start volume, over the steps
+    double volume_end = 1;     ///< that ratio after the last step
+    double weight_strain = 0;  ///< the largest density · g · height / young of an object: what its weight squeezes
+    std::int64_t steps = 0;    ///< steps taken
+    std::int64_t substeps = 0; ///< substeps taken (refined steps count theirs)
+    std::int64_t refined_steps = 0;        ///< steps taken again in more substeps (tets inverted or a blow-up)
+    std::int64_t unconverged_substeps = 0; ///< substeps whose iterations reached their cap (vbd: max_iterations)
+    std::int64_t inverted_end = 0;         ///< dynamic tets inverted after the last step
+    std::int64_t tets = 0;                 ///< dynamic tets
+
+    /// Energy growth above which a run is said to create energy (1 % of energy_scale).
+    static constexpr double energy_slack = 0.01;
+    /// Volume lost (fraction) above which a run is said to lose volume, unless weight_strain says it should.
+    static constexpr double volume_slack = 0.05;
+    /// One sentence per problem, for the summary and the warnings; empty when the run can be trusted.
+    std::vector<std::string> problems() const;
 };
 
 class SimulationImpl;
@@ -101,8 +138,18 @@ class Simulation {
     /// Explicit stability limit 2/ω_max of the model (s); a warning is issued when dt/substeps exceeds it
     /// with the symplectic integrator.
     double explicit_dt_limit() const;
-    /// Warnings gathered at construction (for example "dt above the explicit stability limit").
+    /// Warnings gathered at construction: "dt above the explicit stability limit" (symplectic_euler), an object
+    /// whose size looks like millimetres or a wrong scale (larger than 20 m, smaller than 5 mm), an object that
+    /// starts below the ground or with vertices inside another object.
     const std::vector<std::string>& warnings() const;
+    /// Each object's size (the longest extent of its bounding box, in scene units: metres), scene order, objects
+    /// with collider = "bsp" left out (as object_vertices).
+    std::vector<double> object_sizes() const;
+    /// What the steps so far say about the run (energy, volume, refined steps, unconverged iterations).
+    const RunHealth& health() const;
+    /// A flag that, once non-zero, ends the current step early: the step is rolled back to its start and
+    /// step() throws Interrupted. For Ctrl-C (a signal handler sets it); nullptr: none.
+    void set_interrupt_flag(const volatile std::sig_atomic_t* flag);
 
     /// Point data (velocity, contact flag, penetration depth) and cell data (object) for a frame,
     /// filtered by scene().output.fields.

@@ -57,6 +57,7 @@ struct StudyOptions {
     std::vector<std::string> substeps;
     std::vector<std::string> young;      ///< stability sweep: Young's moduli (Pa)
     std::vector<std::string> mass_ratio; ///< stability sweep: density of the first body over the second
+    std::vector<std::string> size;       ///< stability sweep: body sizes (longest extent, m)
     double duration = 0;                 ///< simulated seconds; 0: the scene's own duration
     int samples = 4;                     ///< fixed times (evenly spaced, the last at the end) where errors are taken
     double reference_factor = 16;        ///< the reference run uses dt / reference_factor (of the smallest dt)

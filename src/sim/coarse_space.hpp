@@ -1,0 +1,98 @@
+#pragma once
+// A coarse space for the vbd sweeps (private to tethash::sim): a lattice over each dynamic object, its nodes
+// carrying displacements that reach the vertices by trilinear interpolation at their start positions.
+//
+// Why: a Gauss–Seidel sweep moves information by about one ring of neighbours, while a backward-Euler step of an
+// elastic body is a global problem whose stiffness relative to its inertia grows as (ω h)², ω = c / L̄ the
+// material's frequency at the mean edge. At a fixed mesh ω grows as the body shrinks (6.7× from 1 m to 15 cm):
+// on a 5 cm body the sweeps needed to carry an impact through the body grew past a hundred, and a fixed count
+// left the step unconverged (bodies sagging flat, energy growing tenfold). The lattice carries the long waves the
+// sweeps cannot: between sweeps the step's residual is projected on the lattice, the lattice's Newton step solved
+// directly (the Galerkin matrix Pᵀ A P) and interpolated back (a two-level cycle: the sweeps smooth, the lattice
+// corrects).
+//
+// The factorisation is kept from one substep to the next while the vertices touching the ground or a contact are
+// nine tenths the same, no object turned by more than 0.05 rad since, and for at most 8 substeps: the line search along
+// each correction (block_descent.cpp) makes a slightly stale matrix cost a little convergence, not correctness.
+//
+// The matrix: the springs' and volume terms' stiffness and damping and the masses at the start positions, Pᵀ (K +
+// C / h + M / h²) P, kept per substep length h; per substep each object's block is turned by the object's rotation
+// since the start (polar decomposition of its positions against the start), and the ground's and contacts' own
+// terms at the current iterate are added, vertex by vertex (their diagonal blocks). Pinned vertices hold their
+// lattice nodes by a stiff term. The lattice's cells are a sixth of the object's longest extent while ω h ≤ 4, finer
+// as ω h grows (the waves a substep couples reach further), and at least two
+// mean edges; an object gets at most a quarter as many nodes as it has vertices (125 for any) and at most 400, so that
+// the factorisation costs a few sweeps (and is kept across substeps, below).
+
+#include "tethash/sim/model.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace tethash::sim::detail {
+
+class CoarseSpace {
+  public:
+    /// Lattices over the free vertices of each dynamic object at positions x (the start of the run); `damping` per
+    /// object, the material's relative damping time (the sweeps damp volume terms by it, as springs); h the substep
+    /// the scene asks for, which sets each lattice's cell: a sixth of the object's longest extent while ω h ≤ 4 (ω
+    /// its material's frequency at the mean edge), finer as ω h grows (the waves a substep couples reach further in
+    /// edges than the sweeps carry them), never below two mean edges.
+    void build(const Model& model, const Positions& x, const std::vector<double>& damping, double h);
+    bool empty() const { return m_nodes == 0; }
+    std::int32_t nodes() const { return m_nodes; }
+
+    /// The coarse matrix of substep length h at positions x4 (stride 4): the cached start-state part turned by each
+    /// object's rotation, plus per vertex the 3 × 3 block of `extra` (xx, yy, zz, xy, xz, yz per vertex, 6n) for the
+    /// vertices listed in `with_extra`; factorised. False when the factorisation fails (the correction is then
+    /// skipped).
+    bool prepare(double h, const double* x4, const std::vector<double>& extra,
+                 const std::vector<std::int32_t>& with_extra);
+
+    /// The lattice's Newton step for the residual r (flat 3n, per vertex −∇G), interpolated to the vertices: dx
+    /// (flat 3n; fixed vertices 0).
+    void correct(const std::vector<double>& r, std::vector<double>& dx);
+
+  private:
+    struct Cached {
+        double h;
+        std::vector<double> values; ///< block values (9 per block, row-major 3 × 3) of Pᵀ (K + C/h + M/h²) P
+    };
+    const Model* m_model = nullptr;
+    Positions m_start;
+    std::vector<double> m_damping;
+    std::int32_t m_nodes = 0;
+    // Per vertex: its 8 lattice nodes and trilinear weights (node −1: the vertex is not in a lattice).
+    std::vector<std::int32_t> m_node;   ///< 8 n
+    std::vector<double> m_weight;       ///< 8 n
+    std::vector<std::int32_t> m_object; ///< per node: its object's index in m_objects
+    struct Object {
+        std::vector<std::int32_t> vertices;                ///< its vertices in a lattice
+        Eigen::Vector3d centre0 = Eigen::Vector3d::Zero(); ///< mass centre at the start
+        double mass = 0;
+    };
+    std::vector<Object> m_objects;
+    // Block pattern: blocks (I, J) of the coarse matrix, the scalar positions of each in the CSR matrix.
+    std::vector<std::pair<std::int32_t, std::int32_t>> m_blocks;
+    std::vector<std::int32_t> m_block_value;   ///< 9 per block: index into the matrix's value array
+    std::vector<std::int32_t> m_vertex_blocks; ///< 64 per vertex: the block of (node a, node b) of its 8 × 8
+    Eigen::SparseMatrix<double> m_matrix;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_solver;
+    bool m_analysed = false;
+    std::vector<Cached> m_cache;
+    std::vector<Eigen::Matrix3d> m_rotation;          ///< per object, this substep
+    std::vector<Eigen::Matrix3d> m_factored_rotation; ///< per object, at the last factorisation
+    std::vector<std::int32_t> m_factored_extra;       ///< the vertices with ground or contact terms then
+    double m_factored_h = 0;
+    int m_factored_age = 0; ///< substeps since the last factorisation
+    Eigen::VectorXd m_rc, m_dc;
+
+    const Cached& cached(double h);
+};
+
+} // namespace tethash::sim::detail
