@@ -332,3 +332,55 @@ TEST(CliSimulate, ATimeStepFarBeyondTheSceneIsRefused)
     r = run_tethash("simulate --dt 0.05 --steps 2 --out " + quote(dir / "out"));
     EXPECT_EQ(r.status, 0) << r.err;
 }
+
+TEST(CliSimulate, AMeshDropsOnTheGroundInOneLine)
+{
+    // `simulate --mesh FILE --scale S --up y`: the mesh (y up, in millimetres) dropped on the ground; the scene it
+    // ran is written next to the frames and runs again as it is; a mesh given where a scene goes is recognised; the
+    // template scene is a scene the loader reads.
+    const auto dir = temp_dir();
+    auto r = run_tethash("generate sphere --resolution 4 -o " + quote(dir / "ball.vtu"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    // The generated ball is 1 unit across: as "millimetres" scaled by 0.1 it is 10 cm.
+    r = run_tethash("simulate --mesh " + quote(dir / "ball.vtu") + " --scale 0.1 --up y --steps 24 --out " +
+                    quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("object sizes (longest extent): ball 0.1"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("scene.toml"), std::string::npos) << r.err;
+    const std::string scene = read_text(dir / "out" / "scene.toml");
+    EXPECT_NE(scene.find("up = \"y\""), std::string::npos) << scene;
+    EXPECT_NE(scene.find("scale = 0.1"), std::string::npos) << scene;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00024.vtu"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out" / "frame_00001.vtu")); // 60 frames a second
+    // Gravity along -y: the ball fell in y (it lands within the 0.1 s), not in z.
+    TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
+    write_text(dir / "fall.py",
+               "import meshio, sys\n"
+               "a = meshio.read(sys.argv[1]).points.mean(axis=0)\n"
+               "b = meshio.read(sys.argv[2]).points.mean(axis=0)\n"
+               "print('y' if a[1] - b[1] > 1e-2 and abs(a[2] - b[2]) < 0.1 * (a[1] - b[1]) else 'other', a - b)\n");
+    const auto fall = run_shell(py + " " + quote(dir / "fall.py") + " " + quote(dir / "out" / "frame_00000.vtu") + " " +
+                                quote(dir / "out" / "frame_00024.vtu"));
+    EXPECT_EQ(fall.out.substr(0, 2), "y ") << fall.out << fall.err;
+    // The written scene runs again as it is.
+    r = run_tethash("simulate " + quote(dir / "out" / "scene.toml") + " --steps 4 --out " + quote(dir / "again"));
+    EXPECT_EQ(r.status, 0) << r.err;
+    // A mesh where the scene goes: recognised, dropped as --mesh does, with a note.
+    r = run_tethash("simulate " + quote(dir / "ball.vtu") + " --steps 4 --out " + quote(dir / "positional"));
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("is a mesh, not a scene"), std::string::npos) << r.err;
+    // The template is a scene (its mesh file aside): printed, then read with a generated shape in its place.
+    r = run_tethash("simulate --template");
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::string text = r.out;
+    text.replace(text.find("mesh = \"body.msh\""), 17, "generate = { shape = \"sphere\", resolution = 3 }");
+    write_text(dir / "template.toml", text);
+    r = run_tethash("simulate " + quote(dir / "template.toml") + " --steps 2 --out " + quote(dir / "tpl"));
+    EXPECT_EQ(r.status, 0) << r.err;
+    // Options of the one-line path without it, and bad values: exit 2 naming them.
+    expect_refused(run_tethash("simulate --scale 0.001 --out " + quote(dir / "x")), {"--scale"});
+    expect_refused(run_tethash("simulate --mesh " + quote(dir / "ball.vtu") + " --up w --out " + quote(dir / "x")),
+                   {"--up", "'w'"});
+    expect_refused(run_tethash("simulate --mesh " + quote(dir / "none.vtu") + " --out " + quote(dir / "x")),
+                   {"none.vtu"});
+}

@@ -229,3 +229,26 @@ TEST(SimScene, DirectoryIsNamedAsSuch)
     expect_error([&] { load_scene(dir.string()); }, {"is a directory"});
     std::filesystem::remove_all(dir);
 }
+
+TEST(SimScene, UpAxisAndTimeStepFractions)
+{
+    // up = "y": gravity against y, the ground's normal along it; a gravity or normal given too wins; dt takes the
+    // command line's fractions; bad values name the key and line.
+    Scene s = parse_scene("up = \"y\"\ndt = \"1/240\"\n[ground]\n" + kObject, "s.toml", ".");
+    EXPECT_EQ(s.gravity, Eigen::Vector3d(0, -9.81, 0));
+    EXPECT_EQ(s.ground.normal, Eigen::Vector3d(0, 1, 0));
+    EXPECT_DOUBLE_EQ(s.dt, 1.0 / 240);
+    s = parse_scene("up = \"-x\"\ngravity = [0, 0, -1]\n[ground]\nnormal = [0, 0, 1]\n" + kObject, "s.toml", ".");
+    EXPECT_EQ(s.gravity, Eigen::Vector3d(0, 0, -1));
+    EXPECT_EQ(s.ground.normal, Eigen::Vector3d(0, 0, 1));
+    s = parse_scene("up = \"-x\"\n" + kObject, "s.toml", ".");
+    EXPECT_EQ(s.gravity, Eigen::Vector3d(9.81, 0, 0));
+    const std::string bad_up = error_of("up = \"w\"\n" + kObject);
+    EXPECT_NE(bad_up.find("s.toml:1"), std::string::npos) << bad_up;
+    EXPECT_NE(bad_up.find("'up'"), std::string::npos) << bad_up;
+    for (const char* dt : {"\"1/0\"", "\"fast\"", "\"-1/240\"", "\"0\""}) {
+        const std::string e = error_of(std::string("dt = ") + dt + "\n" + kObject);
+        EXPECT_NE(e.find("'dt'"), std::string::npos) << dt << ": " << e;
+        EXPECT_NE(e.find("s.toml:1"), std::string::npos) << dt << ": " << e;
+    }
+}

@@ -140,8 +140,9 @@ class BlockDescent final : public StepIntegrator {
     void refresh_contacts(const double* x4);
     /// The lattice's correction (coarse_space.hpp) at x4: the residual −∇G and the ground's and contacts' own
     /// Hessian blocks per vertex, the coarse Newton step (the matrix factorised on the first call of a substep),
-    /// added to x4 (shortened so that no vertex moves more than its clamp length). False if it could not be made.
-    bool coarse_correction(double* x4, double h, bool first);
+    /// added to x4 (shortened so that no vertex moves more than its clamp length). Returns the energy it took out (to
+    /// second order along its direction), or a negative number if it could not be made.
+    double coarse_correction(double* x4, double h, bool first);
     /// r (3n) = −∇G at x4 over the free vertices; with `extra`, m_extra the ground's and contacts' Hessian blocks.
     void residual(const double* x4, double h, std::vector<double>& r, bool extra);
     /// The fraction of the step ds of vertex u that leaves none of its pressing contacts (ground or contact) for
@@ -669,7 +670,7 @@ void BlockDescent::residual(const double* xp, double h, std::vector<double>& r, 
     }
 }
 
-bool BlockDescent::coarse_correction(double* xp, double h, bool first)
+double BlockDescent::coarse_correction(double* xp, double h, bool first)
 {
     const size_t un = m_ctx.model.mass.size();
     refresh_contacts(xp);
@@ -679,7 +680,7 @@ bool BlockDescent::coarse_correction(double* xp, double h, bool first)
         for (size_t i = 0; i < un; ++i)
             if (m_extra[6 * i] != 0 || m_extra[6 * i + 1] != 0 || m_extra[6 * i + 2] != 0)
                 m_with_extra.push_back(static_cast<std::int32_t>(i));
-        if (!m_coarse.prepare(h, xp, m_extra, m_with_extra)) return false;
+        if (!m_coarse.prepare(h, xp, m_extra, m_with_extra)) return -1;
     }
     m_coarse.correct(m_residual, m_dx);
     double over = 1.0;
@@ -689,7 +690,7 @@ bool BlockDescent::coarse_correction(double* xp, double h, bool first)
             m_dx[3 * u] * m_dx[3 * u] + m_dx[3 * u + 1] * m_dx[3 * u + 1] + m_dx[3 * u + 2] * m_dx[3 * u + 2];
         over = std::max(over, std::sqrt(len2) / (coarse_reach * m_max_step[u]));
     }
-    if (!std::isfinite(over)) return false;
+    if (!std::isfinite(over)) return -1;
     // The lattice's matrix is the start state's, turned: not the exact Hessian of the state (compressed springs,
     // friction, contacts that came or went). The step's length along its direction is the secant minimum of G
     // between x and x + dx (exact for a quadratic), so the correction never undoes what the sweeps did.
@@ -701,7 +702,7 @@ bool BlockDescent::coarse_correction(double* xp, double h, bool first)
             slope0 += m_residual[3 * u + q] * m_dx[3 * u + q];
         }
     }
-    if (!(slope0 > 0)) return true; // not a descent direction here: no correction this time
+    if (!(slope0 > 0)) return 0; // not a descent direction here: no correction this time
     for (const std::int32_t i : m_order)
         for (size_t q = 0; q < 3; ++q)
             xp[4 * static_cast<size_t>(i) + q] += m_dx[3 * static_cast<size_t>(i) + q];
@@ -716,7 +717,7 @@ bool BlockDescent::coarse_correction(double* xp, double h, bool first)
         for (const std::int32_t i : m_order)
             for (size_t q = 0; q < 3; ++q)
                 xp[4 * static_cast<size_t>(i) + q] -= (1.0 - alpha) * m_dx[3 * static_cast<size_t>(i) + q];
-    return true;
+    return 0.5 * alpha * slope0;
 }
 
 BlockDescent::Sweep BlockDescent::sweep(double* xp, double h)
@@ -840,7 +841,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
             break;
         }
         if (use_coarse && sweeps % sweeps_per_correction == 0 && sweeps < max_sweeps) {
-            use_coarse = coarse_correction(xp, h, first_coarse);
+            use_coarse = coarse_correction(xp, h, first_coarse) >= 0;
             first_coarse = false;
         }
     }

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -439,6 +440,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         joined(penalty_keys<ContactParams>(), {key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
                                                key("margin", &ContactParams::margin, &Reader::non_negative),
                                                key("speculative", &ContactParams::speculative, &Reader::boolean)});
+    std::optional<Eigen::Vector3d> up;
     const std::vector<Key<Scene>> keys = {
         key("dt", &Scene::dt, &Reader::seconds),
         int_key("steps", &Scene::steps, 0),
@@ -455,6 +457,18 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
         key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
         key("inversion_guard", &Scene::inversion_guard, &Reader::boolean),
         key("gravity", &Scene::gravity, &Reader::vec3),
+        // The scene's up axis (applied below): gravity 9.81 m/s² against it and the ground's normal along it
+        // (meshes made with y up are common; the default is z up). A `gravity` or `[ground] normal` given too wins.
+        {"up",
+         [&up](const Reader& r, const toml::node& v, const std::string& k, Scene&) {
+             const std::string name = r.string(v, k);
+             const bool minus = !name.empty() && name[0] == '-';
+             const std::string axis = minus ? name.substr(1) : name;
+             if (axis != "x" && axis != "y" && axis != "z")
+                 r.fail(&v, k, "expected \"x\", \"y\", \"z\" or one of them with a minus sign, found \"" + name + "\"");
+             up = Eigen::Vector3d::Zero();
+             (*up)[axis[0] - 'x'] = minus ? -1.0 : 1.0;
+         }},
     };
     read_table(
         r, root, "", keys, s, {"ground", "contact", "detector", "output", "object", "pin"},
@@ -614,6 +628,11 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         std::to_string(s.pins[i].object) + " does not exist (" + std::to_string(s.objects.size()) +
                         " objects)");
     if (s.objects.empty()) throw Error(source_name + ": the scene has no [[object]]");
+    if (up) {
+        if (!root.contains("gravity")) s.gravity = -9.81 * *up;
+        const toml::table* ground = root["ground"].as_table();
+        if (!ground || !ground->contains("normal")) s.ground.normal = *up;
+    }
     return s;
 }
 

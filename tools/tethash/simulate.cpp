@@ -3,6 +3,7 @@
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
+#include "tethash/io/mesh_io.hpp"
 #include "tethash/io/pvd.hpp"
 #include "tethash/io/vtu.hpp"
 #include "tethash/sim/simulation.hpp"
@@ -10,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -61,7 +63,122 @@ struct SimulateOptions {
     std::string threads; ///< "" = the scene's
     std::string out = "out";
     bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
+    // The one-line path: a mesh dropped on the ground (a scene written for it).
+    std::string mesh;
+    double scale = 1;
+    std::string up = "z";
+    double young = 1e5, density = 1000;
+    bool template_scene = false;
 };
+
+/// A file name whose extension is a mesh's (tet mesh or surface), not a scene's.
+bool looks_like_a_mesh(const std::string& path)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (const char* e :
+         {".msh", ".vtu", ".vtk", ".mesh", ".node", ".ele", ".veg", ".obj", ".stl", ".ply", ".off", ".gltf", ".glb"})
+        if (ext == e) return true;
+    return false;
+}
+
+/// The scene `--mesh FILE` runs: the mesh scaled by `scale`, its up axis `up`, centred over the origin with its
+/// lowest point a tenth of its height above the ground, 2 s at dt 1/240, 60 frames a second. Written out as TOML
+/// with comments, so that the user can edit it and run it again.
+std::string mesh_scene_text(const SimulateOptions& o)
+{
+    if (!(o.scale > 0) || !std::isfinite(o.scale))
+        throw Error(fmt::format("--scale must be a positive number, found {}", o.scale));
+    if (!(o.young > 0) || !std::isfinite(o.young))
+        throw Error(fmt::format("--young must be a positive number (Pa), found {}", o.young));
+    if (!(o.density > 0) || !std::isfinite(o.density))
+        throw Error(fmt::format("--density must be a positive number (kg/m³), found {}", o.density));
+    const bool minus = !o.up.empty() && o.up[0] == '-';
+    const std::string axis = minus ? o.up.substr(1) : o.up;
+    if (axis != "x" && axis != "y" && axis != "z")
+        throw Error("--up must be x, y or z (or -x, -y, -z), found '" + o.up + "'");
+    const int a = axis[0] - 'x';
+    const TetMesh mesh = io::read_mesh(o.mesh);
+    if (mesh.num_vertices() == 0) throw Error(o.mesh + ": the mesh has no vertices");
+    const auto [lo, hi] = bounding_box(mesh.positions);
+    const Eigen::Vector3d centre = 0.5 * o.scale * (lo + hi);
+    const double height = o.scale * (hi[a] - lo[a]);
+    Eigen::Vector3d translate = -centre;
+    // Along the up axis: the lowest point (the highest with -axis) a tenth of the height above the ground at 0.
+    translate[a] = minus ? -o.scale * hi[a] - 0.1 * height : -o.scale * lo[a] + 0.1 * height;
+    const std::string name = std::filesystem::path(o.mesh).stem().string();
+    std::string path = std::filesystem::absolute(o.mesh).string();
+    for (size_t i = 0; i < path.size(); ++i)
+        if (path[i] == '"' || path[i] == '\\') path.insert(i++, 1, '\\');
+    return fmt::format(R"(# Written by `tethash simulate --mesh`: the scene this run ran. Edit it and run it again with
+# `tethash simulate scene.toml`; `tethash simulate --template` prints every key with its meaning. Units are SI:
+# metres, kilograms, seconds, pascals.
+dt = "1/240"          # time step (s): a number or a fraction
+steps = 480           # 2 s
+up = "{}"              # gravity points against it, the ground's normal along it
+
+[ground]
+height = 0.0          # along the up axis
+
+[output]
+every = 4             # a frame every 4 steps: 60 frames a second
+
+[[object]]
+name = "{}"
+mesh = "{}"
+scale = {:.9g}         # the file's units to metres (a mesh in millimetres: 0.001)
+translate = [{:.9g}, {:.9g}, {:.9g}]  # centred, its lowest point a tenth of its height above the ground
+material = {{ young = {:.9g}, density = {:.9g} }}  # Pa, kg/m³
+)",
+                       o.up, name, path, o.scale, translate.x(), translate.y(), translate.z(), o.young, o.density);
+}
+
+/// Every key of a scene with its default and meaning, for `--template`.
+const char* template_text()
+{
+    return R"(# A tethash scene (TOML). Units are SI: metres, kilograms, seconds, pascals. Keys left out take the default
+# shown. Run it with `tethash simulate scene.toml`; docs/simulator.md has the whole grammar.
+dt = "1/240"            # time step (s): a number or a fraction
+steps = 480             # steps to run
+substeps = 1            # substeps per step (each with its own detection)
+integrator = "vbd"      # vbd (default), implicit_euler, symplectic_euler
+# iterations = 0        # vbd sweeps per substep; 0: until converged
+# convergence = 0.1     # vbd: relative tolerance of the sweeps
+# max_iterations = 100  # vbd: the most sweeps a substep takes (reaching it is reported)
+up = "z"                # gravity (9.81 m/s²) points against it; "y" for meshes made y-up
+# gravity = [0, 0, -9.81]
+
+[ground]                # absent: no ground
+height = 0.0
+# friction = 0.5
+
+[contact]
+# margin = 0.25         # contact before penetration, in mean edges
+# friction = 0.0
+
+[output]
+every = 4               # a frame every N steps (0: none)
+# fields = ["velocity", "contact", "depth", "object"]
+
+[[object]]
+name = "body"
+mesh = "body.msh"       # .msh .vtu .vtk .mesh .node/.ele .veg, or a closed surface (.obj .stl .ply ...)
+# generate = { shape = "sphere", resolution = 8, size = 0.2 }   # instead of mesh: `tethash generate --list`
+scale = 1.0             # the file's units to metres (millimetres: 0.001)
+# rotate = [0, 0, 0]    # degrees about x, y, z
+translate = [0, 0, 0.5]
+# velocity = [0, 0, 0]
+material = { young = 1e5, density = 1000, damping = 0.01 }   # Pa, kg/m³, s
+# self_collision = true
+# static = false
+
+# [[pin]]               # vertices held fixed
+# object = 0
+# box_min = [-1, -1, -1]
+# box_max = [1, 1, 0.05]
+)";
+}
 
 /// DIR/run.json: what the run was and how far it can be trusted (written at the end, or when interrupted).
 void write_run_json(const std::string& dir, const sim::Simulation& sim, const std::string& status, double wall)
@@ -97,9 +214,29 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
     std::filesystem::rename(tmp, path);
 }
 
-void run_simulate(const SimulateOptions& o)
+void run_simulate(SimulateOptions o)
 {
-    sim::Scene scene = o.scene.empty() ? sim::default_scene() : sim::load_scene(o.scene);
+    if (o.template_scene) {
+        std::fputs(template_text(), stdout);
+        return;
+    }
+    if (!o.scene.empty() && !o.mesh.empty())
+        throw Error("give a scene file or --mesh FILE, not both (found '" + o.scene + "' and --mesh '" + o.mesh + "')");
+    if (!o.scene.empty() && looks_like_a_mesh(o.scene)) {
+        std::fprintf(stderr,
+                     "tethash: note: %s is a mesh, not a scene: dropping it on the ground as `--mesh %s` does (the "
+                     "scene it runs is written to %s/scene.toml)\n",
+                     o.scene.c_str(), o.scene.c_str(), o.out.c_str());
+        o.mesh = o.scene;
+        o.scene.clear();
+    }
+    if (o.mesh.empty() && (o.scale != 1 || o.up != "z" || o.young != 1e5 || o.density != 1000))
+        throw Error("--scale, --up, --young and --density go with --mesh FILE (a scene file says them itself)");
+    std::string mesh_scene;
+    if (!o.mesh.empty()) mesh_scene = mesh_scene_text(o);
+    sim::Scene scene = !mesh_scene.empty() ? sim::parse_scene(mesh_scene, "--mesh " + o.mesh)
+                       : o.scene.empty()   ? sim::default_scene()
+                                           : sim::load_scene(o.scene);
     if (o.steps != SimulateOptions::unset) {
         if (o.steps < 0) throw Error(fmt::format("--steps must be ≥ 0, found {}", o.steps));
         scene.steps = o.steps;
@@ -144,6 +281,16 @@ void run_simulate(const SimulateOptions& o)
     if (removed > 0)
         std::fprintf(stderr, "tethash: note: removed %d file%s of a previous run from %s\n", removed,
                      removed == 1 ? "" : "s", o.out.c_str());
+    if (!mesh_scene.empty()) {
+        const std::filesystem::path path = std::filesystem::path(o.out) / "scene.toml";
+        const std::string tmp = path.string() + ".partial";
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        const bool ok = f && std::fwrite(mesh_scene.data(), 1, mesh_scene.size(), f) == mesh_scene.size();
+        if (!f || std::fclose(f) != 0 || !ok) throw Error("--out: cannot write '" + tmp + "'");
+        std::filesystem::rename(tmp, path);
+        std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n",
+                     path.string().c_str());
+    }
     std::vector<std::pair<double, std::string>> series;
     const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
     auto write_frame = [&]() {
@@ -307,7 +454,20 @@ void run_simulate(const SimulateOptions& o)
 Registrar reg{
     {"simulate", "Simulate a scene of deformable tet meshes (mass-spring) and write VTU frames", [](CLI::App& sub) {
          auto o = std::make_shared<SimulateOptions>();
-         sub.add_option("scene", o->scene, "Scene file (TOML); without it the built-in default scene runs");
+         sub.add_option("scene", o->scene,
+                        "Scene file (TOML; units SI: metres, kilograms, seconds); without it the built-in default "
+                        "scene runs; a mesh file here is dropped on the ground as with --mesh");
+         sub.add_option("--mesh", o->mesh,
+                        "Drop this mesh on the ground: 2 s at 1/240, 60 frames a second; the scene it runs is "
+                        "written to OUT/scene.toml");
+         sub.add_option("--scale", o->scale, "With --mesh: the file's units to metres (a mesh in millimetres: 0.001)")
+             ->capture_default_str();
+         sub.add_option("--up", o->up, "With --mesh: the mesh's up axis, x, y or z (or -x, -y, -z)")
+             ->capture_default_str();
+         sub.add_option("--young", o->young, "With --mesh: Young's modulus (Pa)")->capture_default_str();
+         sub.add_option("--density", o->density, "With --mesh: density (kg/m³)")->capture_default_str();
+         sub.add_flag("--template", o->template_scene,
+                      "Print a commented scene with every key and its default, and exit");
          sub.add_option("--steps", o->steps, "Number of steps (overrides the scene)");
          sub.add_option("--dt", o->dt, "Time step in s, or a fraction such as 1/240 (overrides the scene)");
          sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
