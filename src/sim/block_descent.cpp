@@ -329,8 +329,11 @@ void BlockDescent::setup()
     std::vector<double> damping;
     for (const ObjectSpec& o : m_ctx.scene.objects)
         damping.push_back(o.material.damping);
-    if (m_ctx.scene.coarse_space)
-        m_coarse.build(model, m_ctx.mesh.positions, damping, m_ctx.scene.dt / std::max(1, m_ctx.scene.substeps));
+    if (m_ctx.scene.coarse_space) {
+        const double h = m_ctx.scene.dt / std::max(1, m_ctx.scene.substeps);
+        m_coarse.build(model, m_ctx.mesh.positions, damping, h);
+        m_coarse.set_up_for(h);
+    }
     m_gather = detail::choose_gather(m_ctx.scene.inversion_guard);
     m_start = detail::choose_start(m_gather);
     m_solve = detail::choose_solve(m_gather);

@@ -45,6 +45,11 @@ class CoarseSpace {
     /// edges than the sweeps carry them), never below two mean edges.
     void build(const Model& model, const Positions& x, const std::vector<double>& damping, double h);
     bool empty() const { return m_nodes == 0; }
+    /// Builds the start-state matrix of substep length h now (set-up), instead of at the first substep with that h.
+    void set_up_for(double h)
+    {
+        if (m_nodes > 0) cached(h);
+    }
     std::int32_t nodes() const { return m_nodes; }
 
     /// The coarse matrix of substep length h at positions x4 (stride 4): the cached start-state part turned by each
