@@ -384,3 +384,20 @@ TEST(CliSimulate, AMeshDropsOnTheGroundInOneLine)
     expect_refused(run_tethash("simulate --mesh " + quote(dir / "none.vtu") + " --out " + quote(dir / "x")),
                    {"none.vtu"});
 }
+
+TEST(CliSimulate, FramesDefaultToSixtyASecondAndProgressSaysTheTimeLeft)
+{
+    // No [output]: a frame every round(1 / (60 dt)) steps (4 at 1/240), not every step; the progress lines say the
+    // time elapsed and left.
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml",
+               "dt = \"1/240\"\nsteps = 8\n[[object]]\ngenerate = { shape = \"box\", resolution = 2 }\n");
+    const auto r = run_tethash("simulate " + quote(dir / "s.toml") + " --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const char* f : {"frame_00000.vtu", "frame_00004.vtu", "frame_00008.vtu"})
+        EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
+    for (const char* f : {"frame_00001.vtu", "frame_00002.vtu", "frame_00007.vtu"})
+        EXPECT_FALSE(std::filesystem::exists(dir / "out" / f)) << f;
+    EXPECT_NE(r.err.find(" s elapsed, "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" s left"), std::string::npos) << r.err;
+}

@@ -87,7 +87,7 @@ struct ContactParams {
 };
 
 struct Output {
-    int every = 1; ///< write a frame every N steps (0: never)
+    int every = -1; ///< write a frame every N steps (0: never; -1, the default: 60 frames per simulated second)
     std::vector<std::string> fields{"velocity", "contact", "depth", "object"}; ///< of these
 };
 
