@@ -182,13 +182,15 @@ TEST(SimBlockDescent, AutomaticSweepsFollowConvergenceAndReportTheCap)
 {
     // Automatic sweeps stop when the substep has converged: a body in free fall (its inertial guess is the answer)
     // takes the minimum of 3; a cantilever pinned at one end, bending, takes more than that and fewer than the cap;
-    // a cap of 4 is reached and the substep counted unconverged; a scene's fixed `iterations` sweeps that many.
-    auto first_step = [](bool pinned, int iterations, int cap) {
+    // a cap of 4 is reached and the substep counted unconverged (refined steps off), or the step taken again in more
+    // substeps (on); a scene's fixed `iterations` sweeps that many.
+    auto first_step = [](bool pinned, int iterations, int cap, int max_substeps = 1) {
         Scene s = cantilever(6, 0.2, 1e6);
         if (!pinned) s.pins.clear();
         s.dt = 1.0 / 240;
         s.iterations = iterations;
         s.max_iterations = cap;
+        s.max_substeps = max_substeps;
         s.output.every = 0;
         Simulation sim(s);
         for (int i = 0; i < 12; ++i)
@@ -205,6 +207,9 @@ TEST(SimBlockDescent, AutomaticSweepsFollowConvergenceAndReportTheCap)
     const StepStats capped = first_step(true, 0, 4);
     EXPECT_EQ(capped.solver_iterations, 4);
     EXPECT_EQ(capped.unconverged, 1);
+    // With refined steps allowed (the default), a step whose substep reached the cap is taken again in more substeps.
+    const StepStats refined = first_step(true, 0, 4, 0);
+    EXPECT_GT(refined.substeps, 1);
     const StepStats fixed = first_step(true, 7, 100);
     EXPECT_EQ(fixed.solver_iterations, 7);
     EXPECT_EQ(fixed.unconverged, 0);
