@@ -20,7 +20,7 @@ Eigen::Matrix3d closest_rotation(const Eigen::Matrix3d& s)
 {
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd(s, Eigen::ComputeFullU | Eigen::ComputeFullV);
     Eigen::Matrix3d u = svd.matrixU();
-    const Eigen::Matrix3d v = svd.matrixV();
+    const Eigen::Matrix3d& v = svd.matrixV();
     if ((u * v.transpose()).determinant() < 0) u.col(2) = -u.col(2);
     return u * v.transpose();
 }
