@@ -106,8 +106,9 @@ constexpr double energy_tolerance = 1e-3;
 /// The coarse correction moves no vertex further than this many times its sweep clamp (a fifth of its object's mean
 /// edge), the whole correction shortened alike; its length along that direction is then the line search's.
 constexpr double coarse_reach = 1.0;
-/// Sweeps an automatic substep takes at least.
-constexpr int min_sweeps_automatic = 3;
+/// Sweeps an automatic substep takes at least: one, so that a body in free fall (its start is the answer) pays one
+/// sweep, not three (the hand's drop: 1.08× Bullet's mean step with three, 1.01× with one, the same end state).
+constexpr int min_sweeps_automatic = 1;
 
 class BlockDescent final : public StepIntegrator {
   public:

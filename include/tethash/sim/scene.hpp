@@ -106,7 +106,7 @@ struct Scene {
     int max_substeps = 0;
     Integrator integrator = Integrator::vbd;
     LinearSolver solver = LinearSolver::cg;
-    /// vbd: sweeps over all vertices per substep; 0 = automatic: until they converge (`convergence`), at least 3, at
+    /// vbd: sweeps over all vertices per substep; 0 = automatic: until they converge (`convergence`), at least 1, at
     /// most `max_iterations`. A fixed count leaves small or stiff bodies unconverged: the sweeps needed grow with
     /// ω h (ω = c / L̄ the material's frequency at the mean edge), 6.7× from 1 m to 15 cm at a fixed mesh.
     int iterations = 0;
@@ -114,7 +114,7 @@ struct Scene {
     /// they take out) are below this fraction of the largest sweep's, and below a thousandth of the energy the scene
     /// has to spend (or stalled below it); in [0, 1) (0: the energy test and stalls only). The energy test is what
     /// keeps runs from gaining energy; this one buys accuracy (the hand at 1 m: 0.3 rests 5 % below the converged
-    /// height at 1.1× Bullet's mean step, 0.1 at 1.3 % below at 1.6×; docs/simulator.md).
+    /// height at 1.0× Bullet's mean step, 0.1 at 1.3 % below at 1.6×; docs/simulator.md).
     double convergence = 0.3;
     /// vbd, automatic sweeps: the most a substep may take; a substep that reaches it is counted unconverged
     /// (StepStats::unconverged, the run's summary and warnings).
