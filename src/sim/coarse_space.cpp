@@ -40,6 +40,8 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
     m_objects.clear();
     m_nodes = 0;
     m_cache.clear();
+    m_blocks.clear();
+    m_block_index.clear();
     m_analysed = false;
     const size_t objects = model.object_mean_edge.size();
     std::vector<std::vector<std::int32_t>> members(objects);
@@ -194,10 +196,9 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
 
     if (m_blocks.empty()) {
         // The block pattern, once: every 3 × 3 block the product touches, and the 8 × 8 blocks of each vertex.
-        std::unordered_map<std::int64_t, std::int32_t> index;
         auto block_of = [&](std::int32_t bi, std::int32_t bj) {
             const std::int64_t key = static_cast<std::int64_t>(bi) * m_nodes + bj;
-            auto [it, inserted] = index.emplace(key, static_cast<std::int32_t>(m_blocks.size()));
+            auto [it, inserted] = m_block_index.emplace(key, static_cast<std::int32_t>(m_blocks.size()));
             if (inserted) m_blocks.emplace_back(bi, bj);
             return it->second;
         };
@@ -235,10 +236,7 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
     }
     Cached out{h, std::vector<double>(9 * m_blocks.size(), 0.0)};
     {
-        std::unordered_map<std::int64_t, std::int32_t> index;
-        for (size_t b = 0; b < m_blocks.size(); ++b)
-            index.emplace(static_cast<std::int64_t>(m_blocks[b].first) * m_nodes + m_blocks[b].second,
-                          static_cast<std::int32_t>(b));
+        const auto& index = m_block_index;
         for (int c = 0; c < ac.outerSize(); ++c)
             for (Eigen::SparseMatrix<double>::InnerIterator it(ac, c); it; ++it) {
                 const std::int32_t b = index.at(static_cast<std::int64_t>(it.row() / 3) * m_nodes + it.col() / 3);
@@ -347,27 +345,24 @@ void CoarseSpace::correct(const std::vector<double>& r, std::vector<double>& dx)
 {
     const Model& model = *m_model;
     const size_t un = model.mass.size();
+    // Each free vertex in a lattice with each of its 8 nodes and weights: restriction Pᵀ r, then prolongation P dc.
+    auto each_weight = [&](auto f) {
+        for (size_t i = 0; i < un; ++i)
+            if (m_node[8 * i] >= 0 && !model.fixed[i])
+                for (size_t k = 0; k < 8; ++k)
+                    f(3 * i, 3 * static_cast<Index>(m_node[8 * i + k]), m_weight[8 * i + k]);
+    };
     m_rc.setZero(3 * m_nodes);
-    for (size_t i = 0; i < un; ++i) {
-        if (m_node[8 * i] < 0 || model.fixed[i]) continue;
-        for (size_t k = 0; k < 8; ++k) {
-            const double w = m_weight[8 * i + k];
-            const Index node = m_node[8 * i + k];
-            for (Index q = 0; q < 3; ++q)
-                m_rc[3 * node + q] += w * r[3 * i + static_cast<size_t>(q)];
-        }
-    }
+    each_weight([&](size_t v, Index node, double w) {
+        for (Index q = 0; q < 3; ++q)
+            m_rc[node + q] += w * r[v + static_cast<size_t>(q)];
+    });
     m_dc = m_solver.solve(m_rc);
     dx.assign(3 * un, 0.0);
-    for (size_t i = 0; i < un; ++i) {
-        if (m_node[8 * i] < 0 || model.fixed[i]) continue;
-        for (size_t k = 0; k < 8; ++k) {
-            const double w = m_weight[8 * i + k];
-            const Index node = m_node[8 * i + k];
-            for (size_t q = 0; q < 3; ++q)
-                dx[3 * i + q] += w * m_dc[3 * node + static_cast<Index>(q)];
-        }
-    }
+    each_weight([&](size_t v, Index node, double w) {
+        for (Index q = 0; q < 3; ++q)
+            dx[v + static_cast<size_t>(q)] += w * m_dc[node + q];
+    });
 }
 
 } // namespace tethash::sim::detail

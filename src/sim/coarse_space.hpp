@@ -31,6 +31,7 @@
 #include <Eigen/SparseCholesky>
 
 #include <cstdint>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -84,7 +85,8 @@ class CoarseSpace {
     std::vector<Object> m_objects;
     // Block pattern: blocks (I, J) of the coarse matrix, the scalar positions of each in the CSR matrix.
     std::vector<std::pair<std::int32_t, std::int32_t>> m_blocks;
-    std::vector<std::int32_t> m_block_value;   ///< 9 per block: index into the matrix's value array
+    std::vector<std::int32_t> m_block_value;                      ///< 9 per block: index into the matrix's value array
+    std::unordered_map<std::int64_t, std::int32_t> m_block_index; ///< node I · nodes + node J → its block
     std::vector<std::int32_t> m_vertex_blocks; ///< 64 per vertex: the block of (node a, node b) of its 8 × 8
     Eigen::SparseMatrix<double> m_matrix;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_solver;

@@ -35,10 +35,36 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
     if (model.ground.enabled) extent += std::abs(model.ground.normal.dot(lo) - model.ground.height);
     m_energy_ref = e0.internal() + m_msum * model.gravity.norm() * extent + contact_energy;
     m_energy_ref = std::max(m_energy_ref, 1e-12 * std::max(1.0, m_msum));
+    // What the scene has to spend, as precisely as the start says: its internal energy plus every free mass falling
+    // over the free vertices' span along gravity and from their lowest point to the ground (the blow-up reference
+    // above takes the box's diagonal instead: a flat mat 1 m across would count 1.4 m of fall for 8 mm).
+    const double gn = model.gravity.norm();
+    double fall = 0;
+    if (gn > 0) {
+        const Eigen::Vector3d down = model.gravity / gn;
+        double low = INFINITY, high = -INFINITY;
+        Eigen::Index lowest = -1;
+        for (size_t i = 0; i < model.mass.size(); ++i) {
+            if (model.fixed[i]) continue;
+            const double along = down.dot(x.row(static_cast<Eigen::Index>(i)).transpose());
+            if (along > high) {
+                high = along;
+                lowest = static_cast<Eigen::Index>(i); // the lowest point: furthest along gravity
+            }
+            low = std::min(low, along);
+        }
+        if (lowest >= 0) {
+            fall = high - low;
+            const double facing = -model.ground.normal.dot(down); // 1: the ground faces straight up
+            if (model.ground.enabled && facing > 0.1)
+                fall +=
+                    std::max(0.0, model.ground.normal.dot(x.row(lowest).transpose()) - model.ground.height) / facing;
+        }
+    }
+    m_energy_available = std::max(e0.internal() + m_msum * gn * fall + contact_energy, 1e-12 * std::max(1.0, m_msum));
     // Fastest any vertex can move if all the energy the blow-up test allows went into it.
     m_speed_bound = std::sqrt(2 * 1e3 * m_energy_ref / min_mass);
     // Each object's height along gravity (for ρ g h / E, the strain its own weight causes).
-    const double gn = model.gravity.norm();
     m_object_height.clear();
     std::vector<double> lo_h, hi_h;
     for (size_t i = 0; i < model.mass.size(); ++i) {
@@ -56,17 +82,20 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
         m_object_height.push_back(hi_h[o] > lo_h[o] ? hi_h[o] - lo_h[o] : 0.0);
 }
 
-std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out)
+std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out, double* volume)
 {
     out.clear();
+    double six_volume = 0;
     const Index nt = static_cast<Index>(model.volumes.tets.rows());
     for (Index t = 0; t < nt; ++t) {
         const auto tet = model.volumes.tets.row(t);
         const Eigen::Vector3d a = x.row(tet(0)).transpose();
         const double w =
             (x.row(tet(1)).transpose() - a).dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
+        six_volume += w;
         if (!(w > 0)) out.push_back(static_cast<std::int32_t>(t));
     }
+    if (volume) *volume = six_volume / 6;
     return static_cast<std::int64_t>(out.size());
 }
 

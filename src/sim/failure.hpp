@@ -34,9 +34,14 @@ class FailureCheck {
     std::string likely_cause(const Scene& scene, double h, double dt_limit, const ContactResponse& contacts) const;
 
     double energy_ref() const { return m_energy_ref; }
+    /// The energy the scene has to spend at the start: internal energy plus every free mass falling over the free
+    /// vertices' span along gravity and down to the ground. The run's health and vbd's energy test measure
+    /// against it.
+    double energy_available() const { return m_energy_available; }
 
   private:
     double m_energy_ref = 0;
+    double m_energy_available = 0;
     double m_msum = 0;
     Eigen::Vector3d m_centre0{0, 0, 0};
     double m_radius0 = 0;
@@ -46,8 +51,10 @@ class FailureCheck {
 };
 
 /// Tets of the model's volume terms (the dynamic ones) whose signed volume at x is ≤ 0, by row, into `out`
-/// (cleared first); returns their count.
-std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out);
+/// (cleared first); returns their count. `volume`, when given, receives the sum of their signed volumes (the same
+/// pass: what the run's health reads every step).
+std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out,
+                                double* volume = nullptr);
 
 /// Short number for messages (3 significant digits).
 std::string short_number(double v);

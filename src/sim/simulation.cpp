@@ -83,7 +83,8 @@ class SimulationImpl {
     int refined = 1;                         // substeps of the last refined step, kept until refined_until
     double refined_until = 0;
     RunHealth health;
-    double volume0 = 0; // volume of the dynamic tets at the start
+    double volume0 = 0;        // volume of the dynamic tets at the start
+    std::vector<double> sizes; // per object: the longest extent of its box at the start
     const volatile std::sig_atomic_t* interrupt = nullptr;
 
     explicit SimulationImpl(const Scene& s);
@@ -139,8 +140,12 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     StepStats first;
     contacts.update(mesh().positions, v, scene.dt / scene.substeps, first);
     failure.setup(model, mesh().positions, v, contacts.energy());
-    inverted = find_inverted_tets(model, mesh().positions, inverted_tets);
-    integrator = make_integrator(StepContext{scene, mesh(), model, contacts, &interrupt});
+    inverted = find_inverted_tets(model, mesh().positions, inverted_tets, &volume0);
+    integrator = make_integrator(StepContext{scene, mesh(), model, contacts, &interrupt, failure.energy_available()});
+    for (const auto& [first, count] : objects.vertices) {
+        const auto box = bounding_box(mesh().positions.middleRows(first, count));
+        sizes.push_back(count > 0 ? (box.second - box.first).maxCoeff() : 0.0);
+    }
     check_placement();
     start_health();
     check_time_step();
@@ -156,8 +161,7 @@ void SimulationImpl::check_time_step()
     for (size_t k = 0; k < objects.vertices.size(); ++k) {
         const auto [first, count] = objects.vertices[k];
         if (objects.is_static[k] || count == 0) continue;
-        const auto box = bounding_box(mesh().positions.middleRows(first, count));
-        const double size = (box.second - box.first).maxCoeff();
+        const double size = sizes[k];
         double speed = 0;
         for (Index i = first; i < first + count; ++i)
             speed = std::max(speed, v.row(i).norm());
@@ -180,8 +184,8 @@ void SimulationImpl::check_placement()
 {
     const Positions& x = mesh().positions;
     const Ground& g = model.ground;
-    std::vector<std::int64_t> inside(scene.objects.size() * scene.objects.size(), 0);
     const size_t nobj = objects.vertices.size();
+    std::vector<std::int64_t> inside(nobj * nobj, 0);
     for (const Contact& c : contacts.contacts())
         if (c.vertex_object != c.tet_object && static_cast<size_t>(c.vertex_object) < nobj &&
             static_cast<size_t>(c.tet_object) < nobj)
@@ -189,8 +193,7 @@ void SimulationImpl::check_placement()
     for (size_t k = 0; k < nobj; ++k) {
         const auto [first, count] = objects.vertices[k];
         if (count == 0) continue;
-        const auto box = bounding_box(x.middleRows(first, count));
-        const double size = (box.second - box.first).maxCoeff();
+        const double size = sizes[k];
         if (size > 20.0)
             warnings.push_back(object_name(k) + " is " + short_number(size) +
                                " m across: if its mesh is in millimetres, give it scale = 0.001 (scene sizes are in "
@@ -220,10 +223,9 @@ void SimulationImpl::start_health()
     const Energy e = model.energy(mesh().positions, v);
     health.energy_start = e.total() + contacts.energy();
     health.energy_end = health.energy_start;
-    health.energy_scale = failure.energy_ref();
+    health.energy_scale = failure.energy_available();
     health.tets = static_cast<std::int64_t>(model.volumes.tets.rows());
     health.inverted_end = inverted;
-    volume0 = total_volume(model, mesh().positions);
     // What each object's weight squeezes: density · g · height / young (a strain).
     const double gn = model.gravity.norm();
     for (size_t k = 0; k < objects.vertices.size(); ++k) {
@@ -316,7 +318,7 @@ void Simulation::step()
         st.unconverged = 0; // the attempt's own; its iterations and times stay counted
         return true;
     };
-    double energy_now = 0;
+    double energy_now = 0, volume_now = 0;
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
@@ -351,7 +353,7 @@ void Simulation::step()
             if (refine()) continue;
             fail(bad);
         }
-        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets);
+        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now);
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
         // stiff body: the armadillo with young 1e9 at 1/60 gained 13 % of the scene's energy in one such substep):
@@ -389,7 +391,7 @@ void Simulation::step()
     if (hl.energy_scale > 0)
         hl.energy_growth = std::max(hl.energy_growth, (energy_now - hl.energy_start) / hl.energy_scale);
     if (s.volume0 > 0) {
-        hl.volume_end = total_volume(s.model, x) / s.volume0;
+        hl.volume_end = volume_now / s.volume0;
         hl.volume_ratio = std::min(hl.volume_ratio, hl.volume_end);
     }
     hl.inverted_end = s.inverted;
@@ -512,16 +514,7 @@ const std::vector<std::string>& Simulation::warnings() const
 
 std::vector<double> Simulation::object_sizes() const
 {
-    std::vector<double> out;
-    for (const auto& [first, count] : m_impl->objects.vertices) {
-        if (count == 0) {
-            out.push_back(0);
-            continue;
-        }
-        const auto box = bounding_box(m_impl->mesh().positions.middleRows(first, count));
-        out.push_back((box.second - box.first).maxCoeff());
-    }
-    return out;
+    return m_impl->sizes;
 }
 
 const RunHealth& Simulation::health() const

@@ -3,15 +3,17 @@
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
+#include "tethash/io/file.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/pvd.hpp"
+#include "tethash/io/surface.hpp"
 #include "tethash/io/vtu.hpp"
 #include "tethash/sim/simulation.hpp"
+#include "tethash/study/json.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -74,13 +76,7 @@ struct SimulateOptions {
 /// A file name whose extension is a mesh's (tet mesh or surface), not a scene's.
 bool looks_like_a_mesh(const std::string& path)
 {
-    std::string ext = std::filesystem::path(path).extension().string();
-    for (char& c : ext)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    for (const char* e :
-         {".msh", ".vtu", ".vtk", ".mesh", ".node", ".ele", ".veg", ".obj", ".stl", ".ply", ".off", ".gltf", ".glb"})
-        if (ext == e) return true;
-    return false;
+    return io::is_tet_mesh_path(path) || io::is_surface_path(path);
 }
 
 /// The scene `--mesh FILE` runs: the mesh scaled by `scale`, its up axis `up`, centred over the origin with its
@@ -184,34 +180,31 @@ material = { young = 1e5, density = 1000, damping = 0.01 }   # Pa, kg/m³, s
 void write_run_json(const std::string& dir, const sim::Simulation& sim, const std::string& status, double wall)
 {
     const sim::RunHealth& h = sim.health();
-    std::string problems;
-    for (const std::string& p : h.problems()) {
-        std::string q;
-        for (char c : p)
-            q += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
-        problems += (problems.empty() ? "" : ", ") + ("\"" + q + "\"");
-    }
-    std::string scene = sim.scene().source;
-    for (size_t i = 0; i < scene.size(); ++i)
-        if (scene[i] == '"' || scene[i] == '\\') scene.insert(i++, 1, '\\');
-    const std::string text = fmt::format(
-        "{{\n  \"scene\": \"{}\",\n  \"status\": \"{}\",\n  \"integrator\": \"{}\",\n  \"dt\": {:.9g},\n"
-        "  \"steps\": {},\n  \"substeps\": {},\n  \"refined_steps\": {},\n  \"unconverged_substeps\": {},\n"
-        "  \"energy_start\": {:.9g},\n  \"energy_end\": {:.9g},\n  \"energy_scale\": {:.9g},\n"
-        "  \"energy_growth\": {:.6g},\n  \"volume_ratio_min\": {:.6g},\n  \"volume_ratio_end\": {:.6g},\n"
-        "  \"inverted_tets_end\": {},\n  \"tets\": {},\n  \"wall_seconds\": {:.4g},\n  \"problems\": [{}]\n}}\n",
-        scene, status, sim::to_string(sim.scene().integrator), sim.scene().dt, h.steps, h.substeps, h.refined_steps,
-        h.unconverged_substeps, h.energy_start, h.energy_end, h.energy_scale, h.energy_growth, h.volume_ratio,
-        h.volume_end, h.inverted_end, h.tets, wall, problems);
-    const std::filesystem::path path = std::filesystem::path(dir) / "run.json";
-    const std::filesystem::path tmp = path.string() + ".partial";
-    {
-        std::FILE* f = std::fopen(tmp.string().c_str(), "wb");
-        if (!f) throw Error("--out: cannot write '" + tmp.string() + "'");
-        const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-        if (std::fclose(f) != 0 || !ok) throw Error("--out: cannot write '" + tmp.string() + "'");
-    }
-    std::filesystem::rename(tmp, path);
+    study::JsonWriter j;
+    j.begin_object()
+        .member("scene", sim.scene().source)
+        .member("status", status)
+        .member("integrator", sim::to_string(sim.scene().integrator))
+        .member("dt", sim.scene().dt)
+        .member("steps", h.steps)
+        .member("substeps", h.substeps)
+        .member("refined_steps", h.refined_steps)
+        .member("unconverged_substeps", h.unconverged_substeps)
+        .member("energy_start", h.energy_start)
+        .member("energy_end", h.energy_end)
+        .member("energy_scale", h.energy_scale)
+        .member("energy_growth", h.energy_growth)
+        .member("volume_ratio_min", h.volume_ratio)
+        .member("volume_ratio_end", h.volume_end)
+        .member("inverted_tets_end", h.inverted_end)
+        .member("tets", h.tets)
+        .member("wall_seconds", wall)
+        .key("problems")
+        .begin_array(study::JsonWriter::block_layout);
+    for (const std::string& p : h.problems())
+        j.value(p);
+    j.end_array().end_object();
+    io::write_text_file((std::filesystem::path(dir) / "run.json").string(), j.str() + "\n");
 }
 
 void run_simulate(SimulateOptions o)
@@ -282,14 +275,9 @@ void run_simulate(SimulateOptions o)
         std::fprintf(stderr, "tethash: note: removed %d file%s of a previous run from %s\n", removed,
                      removed == 1 ? "" : "s", o.out.c_str());
     if (!mesh_scene.empty()) {
-        const std::filesystem::path path = std::filesystem::path(o.out) / "scene.toml";
-        const std::string tmp = path.string() + ".partial";
-        std::FILE* f = std::fopen(tmp.c_str(), "wb");
-        const bool ok = f && std::fwrite(mesh_scene.data(), 1, mesh_scene.size(), f) == mesh_scene.size();
-        if (!f || std::fclose(f) != 0 || !ok) throw Error("--out: cannot write '" + tmp + "'");
-        std::filesystem::rename(tmp, path);
-        std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n",
-                     path.string().c_str());
+        const std::string path = (std::filesystem::path(o.out) / "scene.toml").string();
+        io::write_text_file(path, mesh_scene);
+        std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n", path.c_str());
     }
     std::vector<std::pair<double, std::string>> series;
     const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();

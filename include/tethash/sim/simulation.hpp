@@ -142,8 +142,8 @@ class Simulation {
     /// whose size looks like millimetres or a wrong scale (larger than 20 m, smaller than 5 mm), an object that
     /// starts below the ground or with vertices inside another object.
     const std::vector<std::string>& warnings() const;
-    /// Each object's size (the longest extent of its bounding box, in scene units: metres), scene order, objects
-    /// with collider = "bsp" left out (as object_vertices).
+    /// Each object's size at the start (the longest extent of its bounding box, in scene units: metres), scene
+    /// order, objects with collider = "bsp" left out (as object_vertices).
     std::vector<double> object_sizes() const;
     /// What the steps so far say about the run (energy, volume, refined steps, unconverged iterations).
     const RunHealth& health() const;
