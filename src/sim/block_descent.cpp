@@ -99,10 +99,9 @@ struct Sym3 {
 /// sweep cost more than it saved (two residual passes per correction), every fourth converged in more sweeps.
 constexpr int sweeps_per_correction = 3;
 /// An automatic substep has converged when, besides `convergence`, its last sweep took out less than this fraction of
-/// the energy the scene has to spend (StepContext::energy_scale). At 5 cm the relative test alone stopped the hand,
-/// octocat and the raptor with 1.9×, 4.5× and 7× their start energy at the end of a drop (the sweeps' remaining error
-/// is stiff: it stores (ω h)² times the energy its length suggests); 1e-3 ends them below their start, 1e-4 costs twice
-/// as much.
+/// the energy the scene has to spend (energy_scale). At 5 cm the relative test alone stopped the hand, octocat and the
+/// raptor with 1.9×, 4.5× and 7× their start energy at the end of a drop (the sweeps' remaining error is stiff: it
+/// stores (ω h)² times the energy its length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much.
 constexpr double energy_tolerance = 1e-3;
 /// The coarse correction moves no vertex further than this many times its sweep clamp (a fifth of its object's mean
 /// edge), the whole correction shortened alike; its length along that direction is then the line search's.
@@ -127,13 +126,17 @@ class BlockDescent final : public StepIntegrator {
     /// inertia, ground and contacts lane by lane). Returns the largest step over its lane's clamp length (0 … 1);
     /// adds Σ dᵀ H d of its lanes' moves to `moved` (d the move, H the vertex's local Hessian).
     double solve_group(std::int32_t g, double* x4, double h, double& moved) const;
-    /// One Gauss–Seidel sweep over the colours (each colour's groups in parallel). The size of its moves (Σ dᵀ H d)
-    /// is summed per group, then in group order, so it is the same at any thread count.
+    /// One Gauss–Seidel sweep over the colours (each colour's groups in parallel). The mass-weighted size of its
+    /// moves is summed per group, then in group order, so it is the same at any thread count.
     struct Sweep {
         double largest = 0; ///< largest step over its vertex's clamp length
         double moved = 0;   ///< Σ dᵀ H d over the sweep's moves: twice the energy they took out (to second order)
     };
     Sweep sweep(double* x4, double h);
+    /// The energy the scene has at (x, v) to spend: kinetic, plus every free mass falling over the free vertices'
+    /// extent along gravity (and to the ground where there is one); a sweep whose moves, as velocities, carry a
+    /// small part of it has not much left to change.
+    double energy_scale(const Positions& x, const Positions& v) const;
     /// Contacts' relative displacements since the start of the substep, at x4 (once per sweep: Jacobi across them).
     void refresh_contacts(const double* x4);
     /// The lattice's correction (coarse_space.hpp) at x4: the residual −∇G and the ground's and contacts' own
@@ -146,10 +149,8 @@ class BlockDescent final : public StepIntegrator {
     /// The fraction of the step ds of vertex u that leaves none of its pressing contacts (ground or contact) for
     /// more than half the way to the surface: 1 when no step leaves one.
     double leaving_fraction(size_t u, const double* x4, const double* ds) const;
-    /// Adds lane l's inertia, ground and contact terms to its elastic ones; the ground's and contacts' Hessian block
-    /// (xx, yy, zz, xy, xz, yz) also to `contact_hessian` when given. Returns whether the ground or a contact pushes.
-    bool add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h,
-                        double* contact_hessian = nullptr) const;
+    /// Adds lane l's inertia, ground and contact terms to its elastic ones.
+    void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
     /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
     void accelerate(int n, double rho, double& omega, double* x);
 
@@ -180,6 +181,7 @@ class BlockDescent final : public StepIntegrator {
     std::vector<double> m_moved_history;  ///< Σ dᵀ H d of each sweep of the substep
     bool m_converged = true;              ///< the last substep's sweeps met the tolerance
     mutable std::vector<char> m_entered; ///< vertex id → it stepped into a contact in this substep (leaving_fraction)
+    double m_energy_ref = 0;             ///< the energy the scene has to spend (energy_scale at the first substep)
     // Contacts of the substep: per contact depth, direction, weighted stiffness and damping, relative
     // displacement since the start (refreshed each iteration); per vertex its incidences.
     struct ActiveContact {
@@ -193,9 +195,8 @@ class BlockDescent final : public StepIntegrator {
     detail::CoarseSpace m_coarse;
     std::vector<double> m_residual, m_residual_end, m_extra, m_dx; ///< per vertex: −∇G (3) at x and x + dx, ground
                                                                    ///< and contact Hessian (6), the lattice's step (3)
-    std::vector<char> m_touching;           ///< vertex id → the ground or a contact pushes it (residual with extra)
-    std::vector<std::int32_t> m_with_extra; ///< those vertices, in order
-    InversionGuard m_inversions;            ///< whole-state checks of the inversion guard (inversion_guard.hpp)
+    std::vector<std::int32_t> m_with_extra;
+    InversionGuard m_inversions; ///< whole-state checks of the inversion guard (inversion_guard.hpp)
 };
 
 void BlockDescent::setup()
@@ -481,8 +482,7 @@ double BlockDescent::leaving_fraction(size_t u, const double* x, const double* d
     return t;
 }
 
-bool BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms, const double* x, double h,
-                                  double* contact_hessian) const
+void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms, const double* x, double h) const
 {
     const Model& model = m_ctx.model;
     const size_t u = static_cast<size_t>(grp.vertex[l]);
@@ -491,8 +491,13 @@ bool BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
     const double xi = x[4 * u], yi = x[4 * u + 1], zi = x[4 * u + 2];
     double f[3] = {m_h2 * (m_y[3 * u] - xi) + terms.f[0][l], m_h2 * (m_y[3 * u + 1] - yi) + terms.f[1][l],
                    m_h2 * (m_y[3 * u + 2] - zi) + terms.f[2][l]};
-    Sym3 H; // the ground's and the contacts' terms (the elastic ones and the inertia are added at the end)
-    bool touching = false;
+    Sym3 H;
+    H.xx = terms.H[0][l] + m_h2;
+    H.yy = terms.H[1][l] + m_h2;
+    H.zz = terms.H[2][l] + m_h2;
+    H.xy = terms.H[3][l];
+    H.xz = terms.H[4][l];
+    H.yz = terms.H[5][l];
 
     const double* xt = m_xt.data() + 3 * u;
     if (!m_ground_k.empty()) {
@@ -509,7 +514,6 @@ bool BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
                 f[1] += fn * gny;
                 f[2] += fn * gnz;
                 H.add_outer(k + c * inv_h, gnx, gny, gnz);
-                touching = true;
                 if (g.friction > 0) {
                     // Coulomb friction on the tangential displacement, smoothed below 1 mm/s of sliding
                     // (lagged normal force: Hessian μ fn / max(|t|, ε) on the tangent plane).
@@ -541,7 +545,6 @@ bool BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
         f[1] += fc * c.n[1];
         f[2] += fc * c.n[2];
         H.add_outer(vc.coef * vc.coef * (c.k + c.c * inv_h), c.n[0], c.n[1], c.n[2]);
-        touching = true;
         if (mu > 0) {
             const double tx = c.rel[0] - rn * c.n[0], ty = c.rel[1] - rn * c.n[1], tz = c.rel[2] - rn * c.n[2];
             const double tl = std::sqrt(tx * tx + ty * ty + tz * tz);
@@ -556,12 +559,12 @@ bool BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
 
     for (int r = 0; r < 3; ++r)
         terms.f[r][l] = f[r];
-    const double contact[6] = {H.xx, H.yy, H.zz, H.xy, H.xz, H.yz};
-    for (int q = 0; q < 6; ++q) {
-        terms.H[q][l] += (q < 3 ? m_h2 : 0.0) + contact[q];
-        if (contact_hessian) contact_hessian[q] = contact[q];
-    }
-    return touching;
+    terms.H[0][l] = H.xx;
+    terms.H[1][l] = H.yy;
+    terms.H[2][l] = H.zz;
+    terms.H[3][l] = H.xy;
+    terms.H[4][l] = H.xz;
+    terms.H[5][l] = H.yz;
 }
 
 void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
@@ -588,6 +591,33 @@ void BlockDescent::accelerate(int n, double rho, double& omega, double* x)
     }
 }
 
+double BlockDescent::energy_scale(const Positions& x, const Positions& v) const
+{
+    const Model& model = m_ctx.model;
+    const double g = model.gravity.norm();
+    const Eigen::Vector3d down = g > 0 ? Eigen::Vector3d(model.gravity / g) : Eigen::Vector3d::Zero();
+    double kinetic = 0, mass = 0, lo = INFINITY, hi = -INFINITY;
+    for (const std::int32_t i : m_order) {
+        const size_t u = static_cast<size_t>(i);
+        kinetic += 0.5 * model.mass[u] * v.row(i).squaredNorm();
+        mass += model.mass[u];
+        const double along = down.dot(x.row(i).transpose());
+        lo = std::min(lo, along);
+        hi = std::max(hi, along);
+    }
+    double drop = hi > lo ? hi - lo : 0.0;
+    if (model.ground.enabled && g > 0) {
+        // The ground's plane, along gravity: how far the lowest free vertex is above it.
+        const double above =
+            model.ground.normal.dot(-down) > 0.1
+                ? (model.ground.height - model.ground.normal.dot(x.row(m_order.empty() ? 0 : m_order[0]).transpose()))
+                : 0.0;
+        drop += std::max(0.0, -above);
+    }
+    const double e = kinetic + mass * g * drop;
+    return e > 0 ? e : std::max(1e-300, mass * 1e-12);
+}
+
 void BlockDescent::refresh_contacts(const double* xp)
 {
     const double* xtp = m_xt.data();
@@ -603,15 +633,14 @@ void BlockDescent::refresh_contacts(const double* xp)
 
 void BlockDescent::residual(const double* xp, double h, std::vector<double>& r, bool extra)
 {
-    const size_t un = m_ctx.model.mass.size();
+    const Model& model = m_ctx.model;
+    const size_t un = model.mass.size();
     r.assign(3 * un, 0.0);
-    if (extra) {
-        m_extra.assign(6 * un, 0.0);
-        m_touching.assign(un, 0);
-    }
+    if (extra) m_extra.assign(6 * un, 0.0);
+    const double inv_h2 = 1.0 / (h * h);
     const std::int32_t groups = static_cast<std::int32_t>(m_groups.size());
     // Every group's terms at x4, none moved: the residual and, if asked, the blocks the ground and the contacts add
-    // to each vertex's Hessian.
+    // to the vertex's Hessian (its total less the elastic part and the inertia).
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel for num_threads(m_threads) schedule(static) if (m_threads > 1)
 #endif
@@ -619,12 +648,28 @@ void BlockDescent::residual(const double* xp, double h, std::vector<double>& r, 
         const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
         LaneTerms terms;
         m_gather(grp, m_springs.data(), m_tets.data(), xp, 1.0 / h, terms);
+        double elastic[6][4];
+        for (int q = 0; q < 6; ++q)
+            for (int l = 0; l < 4; ++l)
+                elastic[q][l] = terms.H[q][l];
         for (int l = 0; l < grp.lanes; ++l) {
+            add_lane_terms(grp, l, terms, xp, h);
             const size_t u = static_cast<size_t>(grp.vertex[l]);
-            const bool touching = add_lane_terms(grp, l, terms, xp, h, extra ? &m_extra[6 * u] : nullptr);
-            if (extra) m_touching[u] = touching ? 1 : 0;
             for (size_t q = 0; q < 3; ++q)
                 r[3 * u + q] = terms.f[q][l];
+            if (!extra) continue;
+            const double m_h2 = model.mass[u] * inv_h2;
+            // What the ground and the contacts added (0 where they add nothing: the sum less its parts leaves
+            // round-off, which would list every vertex).
+            bool any = false;
+            double e[6];
+            for (size_t q = 0; q < 6; ++q) {
+                const double base = elastic[q][l] + (q < 3 ? m_h2 : 0.0);
+                e[q] = terms.H[q][l] - base;
+                any = any || std::abs(e[q]) > 1e-9 * (std::abs(base) + m_h2);
+            }
+            for (size_t q = 0; q < 6; ++q)
+                m_extra[6 * u + q] = any ? e[q] : 0.0;
         }
     }
 }
@@ -637,7 +682,8 @@ double BlockDescent::coarse_correction(double* xp, double h, bool first)
     if (first) {
         m_with_extra.clear();
         for (size_t i = 0; i < un; ++i)
-            if (m_touching[i]) m_with_extra.push_back(static_cast<std::int32_t>(i));
+            if (m_extra[6 * i] != 0 || m_extra[6 * i + 1] != 0 || m_extra[6 * i + 2] != 0)
+                m_with_extra.push_back(static_cast<std::int32_t>(i));
         if (!m_coarse.prepare(h, xp, m_extra, m_with_extra)) return -1;
     }
     m_coarse.correct(m_residual, m_dx);
@@ -720,7 +766,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     m_y.resize(3 * un);
     const bool automatic = m_ctx.scene.iterations <= 0;
     const double inv_h = 1.0 / h;
-    const double energy_ref = m_ctx.energy_scale > 0 ? m_ctx.energy_scale : 1.0;
+    if (!(m_energy_ref > 0)) m_energy_ref = energy_scale(x, v);
     // Chebyshev acceleration: the scene's ρ, or automatic: none with the coarse space (its corrections carry the
     // long waves the acceleration was for), 0.9 without.
     const double rho = m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
@@ -758,9 +804,9 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     gather_contacts();
     m_entered.assign(un, 0);
 
-    // Automatic: sweep until a sweep's moves (Σ dᵀ H d) are below `convergence` of the largest sweep's of the substep
-    // and below energy_tolerance of the scene's energy, or they hardly move at all; at least min_sweeps, at most
-    // max_iterations (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
+    // Automatic: sweep until a sweep moves the vertices by less than `convergence` of what the largest sweep of the
+    // substep moved them (mass-weighted), or they hardly move at all; at least min_sweeps, at most max_iterations
+    // (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
     const int min_sweeps =
         automatic ? std::min(min_sweeps_automatic, m_ctx.scene.max_iterations) : m_ctx.scene.iterations;
     const int max_sweeps = automatic ? m_ctx.scene.max_iterations : m_ctx.scene.iterations;
@@ -785,7 +831,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (sw.largest <= stop) break;
         moved_max = std::max(moved_max, sw.moved);
-        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * energy_ref;
+        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * m_energy_ref;
         // A contact or friction that switches between sweeps and corrections can hold the moves in a cycle (seen
         // at 1 m: the same six moves over and over, each far below the energy tolerance): once the moves stop
         // shrinking over a cycle of corrections, more sweeps change nothing.
@@ -794,7 +840,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         const bool stalled =
             m_moved_history.size() > cycle && sw.moved >= 0.9 * m_moved_history[m_moved_history.size() - 1 - cycle];
         if (automatic && sweeps >= min_sweeps &&
-            (((sw.moved <= tol2 * moved_max || stalled) && small_energy) || 0.5 * sw.moved <= 1e-14 * energy_ref)) {
+            (((sw.moved <= tol2 * moved_max || stalled) && small_energy) || 0.5 * sw.moved <= 1e-14 * m_energy_ref)) {
             m_converged = true;
             break;
         }

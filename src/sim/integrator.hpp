@@ -23,9 +23,6 @@ struct StepContext {
     /// The simulation's interrupt flag (Simulation::set_interrupt_flag; may point to nullptr): iterative
     /// integrators stop iterating once it is set, and the step is rolled back.
     const volatile std::sig_atomic_t* const* interrupt = nullptr;
-    /// The energy the scene has to spend at its start (FailureCheck::energy_available), against which the run's
-    /// health and the iterations' energy test measure.
-    double energy_scale = 0;
     bool interrupted() const { return interrupt && *interrupt && **interrupt; }
 };
 

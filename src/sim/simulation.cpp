@@ -141,7 +141,7 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     contacts.update(mesh().positions, v, scene.dt / scene.substeps, first);
     failure.setup(model, mesh().positions, v, contacts.energy());
     inverted = find_inverted_tets(model, mesh().positions, inverted_tets, &volume0);
-    integrator = make_integrator(StepContext{scene, mesh(), model, contacts, &interrupt, failure.energy_available()});
+    integrator = make_integrator(StepContext{scene, mesh(), model, contacts, &interrupt});
     for (const auto& [first, count] : objects.vertices) {
         const auto box = bounding_box(mesh().positions.middleRows(first, count));
         sizes.push_back(count > 0 ? (box.second - box.first).maxCoeff() : 0.0);
