@@ -126,8 +126,8 @@ class BlockDescent final : public StepIntegrator {
     /// inertia, ground and contacts lane by lane). Returns the largest step over its lane's clamp length (0 … 1);
     /// adds Σ dᵀ H d of its lanes' moves to `moved` (d the move, H the vertex's local Hessian).
     double solve_group(std::int32_t g, double* x4, double h, double& moved) const;
-    /// One Gauss–Seidel sweep over the colours (each colour's groups in parallel). The mass-weighted size of its
-    /// moves is summed per group, then in group order, so it is the same at any thread count.
+    /// One Gauss–Seidel sweep over the colours (each colour's groups in parallel). The size of its moves (Σ dᵀ H d)
+    /// is summed per group, then in group order, so it is the same at any thread count.
     struct Sweep {
         double largest = 0; ///< largest step over its vertex's clamp length
         double moved = 0;   ///< Σ dᵀ H d over the sweep's moves: twice the energy they took out (to second order)
@@ -607,7 +607,9 @@ double BlockDescent::energy_scale(const Positions& x, const Positions& v) const
     }
     double drop = hi > lo ? hi - lo : 0.0;
     if (model.ground.enabled && g > 0) {
-        // The ground's plane, along gravity: how far the lowest free vertex is above it.
+        // The ground's plane, along gravity: how far a free vertex (the first of the order; not necessarily the lowest,
+        // which the run's health measures: FailureCheck::energy_available) is above it. Measuring from the lowest
+        // made the energy test stricter and left the screw dropped at 1/60 with a tet inverted.
         const double above =
             model.ground.normal.dot(-down) > 0.1
                 ? (model.ground.height - model.ground.normal.dot(x.row(m_order.empty() ? 0 : m_order[0]).transpose()))
@@ -804,9 +806,9 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     gather_contacts();
     m_entered.assign(un, 0);
 
-    // Automatic: sweep until a sweep moves the vertices by less than `convergence` of what the largest sweep of the
-    // substep moved them (mass-weighted), or they hardly move at all; at least min_sweeps, at most max_iterations
-    // (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
+    // Automatic: sweep until a sweep's moves (Σ dᵀ H d) are below `convergence` of the largest sweep's of the substep
+    // and below energy_tolerance of the scene's energy, or they hardly move at all; at least min_sweeps, at most
+    // max_iterations (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
     const int min_sweeps =
         automatic ? std::min(min_sweeps_automatic, m_ctx.scene.max_iterations) : m_ctx.scene.iterations;
     const int max_sweeps = automatic ? m_ctx.scene.max_iterations : m_ctx.scene.iterations;
