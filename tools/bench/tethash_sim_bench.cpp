@@ -180,7 +180,7 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
 void print(const Row& r)
 {
     std::printf(
-        "%-30s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %8.4g "
+        "%-36s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %8.4g "
         "%7.3g %6.3f %6lld %10.3g  %s\n",
         r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
         r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
@@ -207,7 +207,7 @@ int main(int argc, char** argv)
     CLI::App app{"tethash_sim_bench: the simulator on the shared real meshes (drops and a collision)"};
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
-    std::vector<double> sizes{1.0};
+    std::vector<double> sizes{1.0}, youngs;
     double seconds = 0.5;
     int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
     double convergence = -1;
@@ -225,6 +225,10 @@ int main(int argc, char** argv)
     runs->add_option("--size", sizes,
                      "body sizes (longest extent, m), comma-separated; drops start 0.2 sizes above the ground, the "
                      "two armadillos 1.4 sizes apart")
+        ->delimiter(',')
+        ->check(CLI::PositiveNumber);
+    runs->add_option("--young", youngs,
+                     "Young's moduli (Pa), comma-separated; each scene runs at each (default: the scenes' 1e5)")
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
     runs->add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
@@ -296,32 +300,41 @@ int main(int argc, char** argv)
             if (sizes.size() == 1 && size == 1.0) return std::string();
             return size < 1 ? fmt::format(" {:g}cm", 100 * size) : fmt::format(" {:g}m", size);
         };
+        // With --young, each scene runs at each modulus and is named with it ("drop hand 5cm E1e+09").
+        const std::vector<double> moduli = youngs.empty() ? std::vector<double>{0.0} : youngs;
+        auto with_young = [&](const sim::ObjectSpec& base, double young) {
+            sim::ObjectSpec o = base;
+            if (young > 0) o.material.young = young;
+            return o;
+        };
+        auto young_name = [](double young) { return young > 0 ? fmt::format(" E{:.0e}", young) : std::string(); };
         for (const std::string& file : files) {
             const std::filesystem::path p = std::filesystem::path(meshes_dir) / file;
             if (!std::filesystem::exists(p)) continue;
             const TetMesh mesh = io::read_mesh(p.string());
-            for (double size : sizes) {
-                sim::Scene s;
-                s.objects.push_back(placed(mesh, 0.2, size));
-                s.ground.enabled = true;
-                s.output.every = 0;
-                scenes.emplace_back("drop " + p.stem().string() + size_name(size), s);
-                if (file == "armadillo_4k.node") {
-                    sim::Scene two;
-                    for (int k = 0; k < 2; ++k) {
-                        sim::ObjectSpec o = placed(mesh, 0.3, size);
-                        o.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
-                        o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
-                        two.objects.push_back(o);
+            for (double size : sizes)
+                for (double young : moduli) {
+                    sim::Scene s;
+                    s.objects.push_back(with_young(placed(mesh, 0.2, size), young));
+                    s.ground.enabled = true;
+                    s.output.every = 0;
+                    scenes.emplace_back("drop " + p.stem().string() + size_name(size) + young_name(young), s);
+                    if (file == "armadillo_4k.node") {
+                        sim::Scene two;
+                        for (int k = 0; k < 2; ++k) {
+                            sim::ObjectSpec o = with_young(placed(mesh, 0.3, size), young);
+                            o.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
+                            o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
+                            two.objects.push_back(o);
+                        }
+                        two.ground.enabled = true;
+                        two.output.every = 0;
+                        scenes.emplace_back("two armadillos at 2 m/s" + size_name(size) + young_name(young), two);
                     }
-                    two.ground.enabled = true;
-                    two.output.every = 0;
-                    scenes.emplace_back("two armadillos at 2 m/s" + size_name(size), two);
                 }
-            }
         }
         std::printf(
-            "%-30s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  %s\n",
+            "%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  %s\n",
             "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
             "integr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "E1/E0", "V1/V0", "unconv",
             "dt/ms", "failure");
@@ -372,7 +385,7 @@ int main(int argc, char** argv)
             }
         std::printf("\nlargest stable dt / ms per step (Teschner et al. 2004), over the dt run:\n");
         for (const auto& [key, v] : best)
-            std::printf("  %-26s %-16s dt %.5f s at %.2f ms/step: %.3g s/ms\n", key.first.c_str(), key.second.c_str(),
+            std::printf("  %-34s %-16s dt %.5f s at %.2f ms/step: %.3g s/ms\n", key.first.c_str(), key.second.c_str(),
                         v.first, v.second, v.first / v.second);
         if (!csv.empty()) {
             const std::string tmp = csv + ".partial";
