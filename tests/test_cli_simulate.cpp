@@ -2,6 +2,7 @@
 // stops a blow-up with status 1 and never writes a NaN frame.
 #include "support.hpp"
 
+#include <cstring>
 #include <filesystem>
 
 using namespace tethash::test;
@@ -82,6 +83,25 @@ TEST(CliSimulate, DefaultSceneRuns)
     for (const char* s : {"ms/step: detection ", ", response ", ", integration ", "contacts per step: ",
                           "penetration depth: max ", ", mean ", "energy: start ", ", end ", "scene.pvd"})
         EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+    // The summary's stages account for the whole step: they add up to its ms/step (to the printed rounding).
+    {
+        const size_t at = r.out.find("ms/step: detection ");
+        ASSERT_NE(at, std::string::npos) << r.out;
+        const size_t open = r.out.rfind('(', at);
+        ASSERT_NE(open, std::string::npos);
+        const double ms_step = std::stod(r.out.substr(open + 1));
+        double sum = 0;
+        int stages = 0;
+        for (const char* stage : {"detection ", "depth ", "proximity ", "response ", "integration ",
+                                  "checks and output "}) {
+            const size_t k = r.out.find(stage, at);
+            ASSERT_NE(k, std::string::npos) << stage << "\n" << r.out;
+            sum += std::stod(r.out.substr(k + std::strlen(stage)));
+            ++stages;
+        }
+        EXPECT_EQ(stages, 6);
+        EXPECT_NEAR(sum, ms_step, 0.005 + 0.0005 * stages) << r.out;
+    }
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00000.vtu"));
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00010.vtu"));
     TETHASH_SKIP_WITHOUT_PYTHON(py, "meshio numpy");
