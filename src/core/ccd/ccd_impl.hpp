@@ -132,18 +132,15 @@ inline void set_motion(const Points& x, Motion& m)
     }
 }
 
-/// A second exclusion of a box: n · F, for n the centre of F's range over the box (any direction serves), is
-/// multilinear too, so its range is inside its corner values'; computed with the corner values' errors (e_k per
-/// axis: Σ |n_k| e_k) plus the dot product's rounding (3 roundings: 3.01 ε Σ |n_k| |F_k|). Near a contact the
-/// axis-aligned ranges straddle 0 long after the values lie on one side of a slanted plane (edges or a face
-/// approaching at an angle, or sliding along a line of near contacts); this test drops those boxes.
-inline bool excluded_along_centre(const double (&f)[8][3], const double* lo, const double* hi, const double* err)
+/// True when n · F has one strict sign over the box. n · F is multilinear too, so its range is inside its corner
+/// values'; each is computed with the corner values' errors (e_k per axis: Σ |n_k| e_k) plus the dot product's
+/// rounding (3 roundings: 3.01 ε Σ |n_k| |F_k|). Any direction serves; `big[k]` bounds |F_k| at the corners.
+inline bool one_sign_along(const double (&f)[8][3], const double* n, const double* err, const double* big)
 {
-    double n[3], e = kUnderflowSlack, scale = 0;
+    double e = kUnderflowSlack, scale = 0;
     for (int k = 0; k < 3; ++k) {
-        n[k] = 0.5 * (lo[k] + hi[k]);
         e += std::abs(n[k]) * err[k];
-        scale += std::abs(n[k]) * std::max(std::abs(lo[k]), std::abs(hi[k]));
+        scale += std::abs(n[k]) * big[k];
     }
     e += 3.01 * kEps * scale;
     bool positive = true, negative = true;
@@ -153,6 +150,38 @@ inline bool excluded_along_centre(const double (&f)[8][3], const double* lo, con
         negative = negative && g < -e;
     }
     return positive || negative;
+}
+
+/// Exclusions of a box beyond the axes, along slanted directions. The axis-aligned ranges of F straddle 0 long after
+/// its values lie on one side of a slanted plane (primitives approaching at an angle); so F is also tested along the
+/// centre of its range (what the box's values have in common), and along the rows of the adjugate of F's Jacobian
+/// over the box (estimated from the corner differences): those turn F into, nearly, the offset of the box from the
+/// root in (t, u, v), so a box is dropped as soon as the root is outside it (the test of a preconditioned inclusion).
+inline bool excluded_along_slants(const double (&f)[8][3], const double* lo, const double* hi, const double* err)
+{
+    double centre[3], big[3];
+    for (int k = 0; k < 3; ++k) {
+        centre[k] = 0.5 * (lo[k] + hi[k]);
+        big[k] = std::max(std::abs(lo[k]), std::abs(hi[k]));
+    }
+    if (one_sign_along(f, centre, err, big)) return true;
+    // Columns of the Jacobian (times the box's widths): mean differences across the box in t, u and v.
+    double j[3][3] = {}; // j[axis][parameter]
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const int cu = (c & 1) | ((c & 2) << 1);
+            j[k][0] += f[c + 4][k] - f[c][k];
+            j[k][1] += f[cu + 2][k] - f[cu][k];
+            j[k][2] += f[2 * c + 1][k] - f[2 * c][k];
+        }
+    // Rows of the adjugate: row p is the cross product of the Jacobian's other two columns (in cyclic order).
+    for (int p = 0; p < 3; ++p) {
+        const int q = (p + 1) % 3, r = (p + 2) % 3;
+        const double n[3] = {j[1][q] * j[2][r] - j[2][q] * j[1][r], j[2][q] * j[0][r] - j[0][q] * j[2][r],
+                             j[0][q] * j[1][r] - j[1][q] * j[0][r]};
+        if (one_sign_along(f, n, err, big)) return true;
+    }
+    return false;
 }
 
 /// The inclusion search. `range(box, f)` gives F's computed values at the 8 corners of the box; `triangle` drops
@@ -226,7 +255,7 @@ CcdResult inclusion_search(const Motion& m, const Range& range, bool triangle, c
             out = out || lo[k] > m.err[k] || hi[k] < -m.err[k];
             small = small && hi[k] - lo[k] <= params.tolerance;
         }
-        if (!out) out = excluded_along_centre(f, lo, hi, m.err);
+        if (!out) out = excluded_along_slants(f, lo, hi, m.err);
         if (out) continue;
         // Split the parameter along which F's corner values change most (corner index 4 it + 2 iu + iv).
         double wt = 0, wu = 0, wv = 0;
