@@ -17,8 +17,9 @@
 ///     the range of any fixed linear combination n · F, is inside the hull of its values at the 8 corners; each
 ///     corner value is computed in floating point with a proven error bound (64 ε max|coordinate| per axis, plus
 ///     1e-200 for underflow), and a box is discarded only when that enlarged range excludes 0 along an axis, along
-///     the centre of the range, or along a row of the adjugate of F's Jacobian over the box (a preconditioned
-///     test: nearly the box's offset from the root). A box that may hold a root is split (along the parameter
+///     the centre of the range, along a row of the adjugate of F's Jacobian over the box (a preconditioned
+///     test: nearly the box's offset from the root), or, when that Jacobian is nearly singular (coplanar motion),
+///     along in-plane directions normal to its columns. A box that may hold a root is split (along the parameter
 ///     that changes F most) until its range is at most `tolerance` wide on every axis, and is then accepted as a
 ///     contact at its earliest t. Boxes are searched depth first from the open box of least t, and cut to times
 ///     before the earliest accepted box; when no box is left, that earliest t is the time of impact.

@@ -175,10 +175,34 @@ inline bool excluded_along_slants(const double (&f)[8][3], const double* lo, con
             j[k][2] += f[2 * c + 1][k] - f[2 * c][k];
         }
     // Rows of the adjugate: row p is the cross product of the Jacobian's other two columns (in cyclic order).
+    double rows[3][3], widest = -1;
+    int normal = 0;
     for (int p = 0; p < 3; ++p) {
         const int q = (p + 1) % 3, r = (p + 2) % 3;
-        const double n[3] = {j[1][q] * j[2][r] - j[2][q] * j[1][r], j[2][q] * j[0][r] - j[0][q] * j[2][r],
-                             j[0][q] * j[1][r] - j[1][q] * j[0][r]};
+        double* n = rows[p];
+        n[0] = j[1][q] * j[2][r] - j[2][q] * j[1][r];
+        n[1] = j[2][q] * j[0][r] - j[0][q] * j[2][r];
+        n[2] = j[0][q] * j[1][r] - j[1][q] * j[0][r];
+        if (one_sign_along(f, n, err, big)) return true;
+        const double size = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        if (size > widest) {
+            widest = size;
+            normal = p;
+        }
+    }
+    // When F's values span only a plane, or nearly (coplanar motion: the Jacobian's determinant vanishes, and the
+    // adjugate's rows are all normal to the plane and see nothing), the in-plane directions normal to each column:
+    // N × column p, N the largest adjugate row.
+    const double* nn = rows[normal];
+    double det = 0, column = 0;
+    for (int k = 0; k < 3; ++k) {
+        det += j[k][0] * rows[0][k];
+        column = std::max({column, std::abs(j[k][0]), std::abs(j[k][1]), std::abs(j[k][2])});
+    }
+    if (!(std::abs(det) <= 1e-3 * std::sqrt(widest) * column)) return false;
+    for (int p = 0; p < 3; ++p) {
+        const double n[3] = {nn[1] * j[2][p] - nn[2] * j[1][p], nn[2] * j[0][p] - nn[0] * j[2][p],
+                             nn[0] * j[1][p] - nn[1] * j[0][p]};
         if (one_sign_along(f, n, err, big)) return true;
     }
     return false;
