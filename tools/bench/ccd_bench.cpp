@@ -4,6 +4,10 @@
 // --repeat runs over the same queries.
 #include "tethash/ccd.hpp"
 #include "tethash/io/ccd_queries.hpp"
+#include "tethash/io/mesh_io.hpp"
+#include "tethash/mesh.hpp"
+
+#include "tethash/error.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -93,6 +97,70 @@ std::vector<Query> random_candidates(std::mt19937_64& rng, bool edge_edge, int c
     return out;
 }
 
+/// Axis-aligned box of some rows of x0 and x1.
+struct Box {
+    V lo, hi;
+};
+Box swept(const tethash::Positions& x0, const tethash::Positions& x1, std::initializer_list<tethash::Index> ids)
+{
+    Box b{x0.row(*ids.begin()).transpose(), x0.row(*ids.begin()).transpose()};
+    for (const tethash::Index v : ids) {
+        b.lo = b.lo.cwiseMin(x0.row(v).transpose()).cwiseMin(x1.row(v).transpose());
+        b.hi = b.hi.cwiseMax(x0.row(v).transpose()).cwiseMax(x1.row(v).transpose());
+    }
+    return b;
+}
+bool overlap(const Box& a, const Box& b)
+{
+    return !((a.lo.array() > b.hi.array()).any() || (b.lo.array() > a.hi.array()).any());
+}
+
+/// The queries of a step between two frames of the same meshes: boundary vertex-face and edge-edge pairs whose
+/// swept boxes overlap and that share no vertex (what a broad phase hands the narrow phase).
+void step_queries(const std::string& frame0, const std::string& frame1, std::vector<Query>& vertex_face,
+                  std::vector<Query>& edge_edge)
+{
+    const tethash::TetMesh m0 = tethash::io::read_tet_mesh(frame0), m1 = tethash::io::read_tet_mesh(frame1);
+    if (m0.tets != m1.tets) throw tethash::Error(frame1 + ": not the meshes of " + frame0);
+    const tethash::Positions &x0 = m0.positions, &x1 = m1.positions;
+    const tethash::Triangles faces = tethash::boundary_faces(m0.tets);
+    std::vector<std::array<tethash::Index, 2>> edges;
+    std::vector<tethash::Index> vertices;
+    for (Eigen::Index f = 0; f < faces.rows(); ++f)
+        for (int c = 0; c < 3; ++c) {
+            const tethash::Index i = faces(f, c), j = faces(f, (c + 1) % 3);
+            edges.push_back({std::min(i, j), std::max(i, j)});
+            vertices.push_back(i);
+        }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    std::vector<Box> face_box, edge_box;
+    for (Eigen::Index f = 0; f < faces.rows(); ++f)
+        face_box.push_back(swept(x0, x1, {faces(f, 0), faces(f, 1), faces(f, 2)}));
+    for (const auto& e : edges)
+        edge_box.push_back(swept(x0, x1, {e[0], e[1]}));
+    const auto row = [](const tethash::Positions& x, tethash::Index v) { return V(x.row(v).transpose()); };
+    for (const tethash::Index v : vertices) {
+        const Box vb = swept(x0, x1, {v});
+        for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+            const tethash::Index a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
+            if (v == a || v == b || v == c || !overlap(vb, face_box[static_cast<std::size_t>(f)])) continue;
+            vertex_face.push_back(
+                {row(x0, v), row(x0, a), row(x0, b), row(x0, c), row(x1, v), row(x1, a), row(x1, b), row(x1, c)});
+        }
+    }
+    for (std::size_t e = 0; e < edges.size(); ++e)
+        for (std::size_t g = e + 1; g < edges.size(); ++g) {
+            const auto &a = edges[e], &b = edges[g];
+            if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1] || !overlap(edge_box[e], edge_box[g]))
+                continue;
+            edge_edge.push_back({row(x0, a[0]), row(x0, a[1]), row(x0, b[0]), row(x0, b[1]), row(x1, a[0]),
+                                 row(x1, a[1]), row(x1, b[0]), row(x1, b[1])});
+        }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -104,7 +172,15 @@ int main(int argc, char** argv)
     app.add_option("--repeat", repeat, "Runs per set (the median is printed)")->capture_default_str();
     app.add_option("--shared", shared, "Folder of the CCD benchmark files (unit-tests/<type>/*.csv)")
         ->capture_default_str();
+    std::vector<std::string> frames;
+    app.add_option("--frames", frames,
+                   "Pairs of frames of the same meshes (FRAME0 FRAME1 ...; e.g. simulation output): the step's "
+                   "boundary pairs whose swept boxes overlap are timed as one more set");
     CLI11_PARSE(app, argc, argv);
+    if (frames.size() % 2 != 0) {
+        std::fprintf(stderr, "tethash_ccd_bench: --frames takes pairs of files\n");
+        return 2;
+    }
     repeat = std::max(repeat, 1);
 
     double load[3] = {0, 0, 0};
@@ -170,5 +246,27 @@ int main(int argc, char** argv)
                         static_cast<double>(t.iterations) / static_cast<double>(queries.size()),
                         static_cast<long long>(hits));
         }
+    if (!frames.empty()) {
+        std::vector<Query> vertex_face, edge_edge;
+        try {
+            for (std::size_t k = 0; k < frames.size(); k += 2)
+                step_queries(frames[k], frames[k + 1], vertex_face, edge_edge);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "tethash_ccd_bench: %s\n", e.what());
+            return 2;
+        }
+        for (const bool ee : {false, true}) {
+            const auto& queries = ee ? edge_edge : vertex_face;
+            const Timing t = run(queries, ee, repeat);
+            const auto hits = std::count(t.hits.begin(), t.hits.end(), 1);
+            const std::string name = std::string("frames (") + std::to_string(frames.size() / 2) + " steps), " +
+                                     (ee ? "edge-edge" : "vertex-face");
+            std::printf("%-44s %8zu %9s %6s %6s %12.0f %10.2f   (%lld reported colliding)\n", name.c_str(),
+                        queries.size(), "-", "-", "-", t.ns_per_query,
+                        static_cast<double>(t.iterations) /
+                            static_cast<double>(std::max<std::size_t>(queries.size(), 1)),
+                        static_cast<long long>(hits));
+        }
+    }
     return 0;
 }
