@@ -6,6 +6,8 @@
 // read); a strided or Fortran-ordered one is copied once into a C-contiguous buffer (Detector.positions_copied).
 // Another dtype, dimension or column count is a TypeError/ValueError naming the argument: converting silently
 // would hide a copy per call (float32 positions) or a precision loss (int64 ids).
+#include "tethash/ccd.hpp"
+#include "tethash/continuous.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -518,6 +520,67 @@ py::dict run_study(const std::string& sweep, const py::dict& kw)
     return d;
 }
 
+/// A continuous query on two (4, 3) float64 arrays (ccd.hpp): (hit, toi).
+py::tuple ccd_query(bool edge_edge, const py::object& start, const py::object& end, double tolerance,
+                    std::int64_t max_iterations)
+{
+    const auto s = positions_of(start, "start"), e = positions_of(end, "end");
+    if (s.rows != 4 || e.rows != 4)
+        throw py::value_error("start, end: expected shape (4, 3) each, found " + std::to_string(s.rows) + " and " +
+                              std::to_string(e.rows) + " rows");
+    const auto a = s.map(), b = e.map();
+    const auto row = [](const auto& m, int i) { return Eigen::Vector3d(m(i, 0), m(i, 1), m(i, 2)); };
+    tethash::ccd::CcdParams params;
+    params.tolerance = tolerance;
+    params.max_iterations = max_iterations;
+    const tethash::ccd::CcdResult r =
+        edge_edge ? tethash::ccd::edge_edge_ccd(row(a, 0), row(a, 1), row(a, 2), row(a, 3), row(b, 0), row(b, 1),
+                                                row(b, 2), row(b, 3), params)
+                  : tethash::ccd::vertex_face_ccd(row(a, 0), row(a, 1), row(a, 2), row(a, 3), row(b, 0), row(b, 1),
+                                                  row(b, 2), row(b, 3), params);
+    return py::make_tuple(r.hit, r.toi);
+}
+
+/// Continuous detection over a step (continuous.hpp) as a dict of arrays.
+py::dict detect_continuous(const py::object& tets, const py::object& x0, const py::object& x1, int threads,
+                           double tolerance, std::int64_t max_iterations)
+{
+    const auto t = tets_of(tets);
+    const auto p0 = positions_of(x0, "x0"), p1 = positions_of(x1, "x1");
+    tethash::ccd::ContinuousParams params;
+    params.threads = threads;
+    params.query.tolerance = tolerance;
+    params.query.max_iterations = max_iterations;
+    tethash::ccd::ContinuousResult r;
+    {
+        py::gil_scoped_release release;
+        r = tethash::ccd::detect_continuous(t.map(), p0.map(), p1.map(), params);
+    }
+    const auto n = static_cast<py::ssize_t>(r.contacts.size());
+    py::array_t<std::int8_t> kind(n);
+    py::array_t<Index> a(n), b(n);
+    py::array_t<double> toi(n);
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const auto& c = r.contacts[static_cast<std::size_t>(i)];
+        kind.mutable_at(i) = static_cast<std::int8_t>(c.kind);
+        a.mutable_at(i) = c.a;
+        b.mutable_at(i) = c.b;
+        toi.mutable_at(i) = c.toi;
+    }
+    py::array_t<Index> faces({static_cast<py::ssize_t>(r.faces.rows()), py::ssize_t{3}});
+    py::array_t<Index> edges({static_cast<py::ssize_t>(r.edges.rows()), py::ssize_t{2}});
+    std::copy(r.faces.data(), r.faces.data() + r.faces.size(), faces.mutable_data());
+    std::copy(r.edges.data(), r.edges.data() + r.edges.size(), edges.mutable_data());
+    py::dict d;
+    d["kind"] = kind;
+    d["a"] = a;
+    d["b"] = b;
+    d["toi"] = toi;
+    d["faces"] = faces;
+    d["edges"] = edges;
+    return d;
+}
+
 } // namespace
 
 PYBIND11_MODULE(_tethash, m)
@@ -573,4 +636,18 @@ PYBIND11_MODULE(_tethash, m)
         py::arg("integrator"), py::arg("record_every"));
     m.def("_default_scene_text", [] { return tethash::sim::default_scene_text(); });
     m.def("_study", &run_study, py::arg("sweep"), py::arg("options"));
+    m.def(
+        "ccd_vertex_face",
+        [](const py::object& start, const py::object& end, double tolerance, std::int64_t max_iterations) {
+            return ccd_query(false, start, end, tolerance, max_iterations);
+        },
+        py::arg("start"), py::arg("end"), py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
+    m.def(
+        "ccd_edge_edge",
+        [](const py::object& start, const py::object& end, double tolerance, std::int64_t max_iterations) {
+            return ccd_query(true, start, end, tolerance, max_iterations);
+        },
+        py::arg("start"), py::arg("end"), py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
+    m.def("detect_continuous", &detect_continuous, py::arg("tets"), py::arg("x0"), py::arg("x1"),
+          py::arg("threads") = 1, py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
 }

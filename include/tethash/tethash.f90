@@ -142,6 +142,27 @@ module tethash
       type(tethash_stats), intent(out) :: stats
       integer(c_int) :: status
     end function
+    ! Continuous queries: start and end are real(c_double) :: x(3, 4) (vertex, triangle corners; or the two edges).
+    function tethash_ccd_vertex_face(start, end, tolerance, max_iterations, hit, toi) &
+        bind(C, name="tethash_ccd_vertex_face") result(status)
+      import :: c_double, c_int64_t, c_int32_t, c_int
+      real(c_double), intent(in) :: start(3, 4), end(3, 4)
+      real(c_double), value :: tolerance
+      integer(c_int64_t), value :: max_iterations
+      integer(c_int32_t), intent(out) :: hit
+      real(c_double), intent(out) :: toi
+      integer(c_int) :: status
+    end function
+    function tethash_ccd_edge_edge(start, end, tolerance, max_iterations, hit, toi) &
+        bind(C, name="tethash_ccd_edge_edge") result(status)
+      import :: c_double, c_int64_t, c_int32_t, c_int
+      real(c_double), intent(in) :: start(3, 4), end(3, 4)
+      real(c_double), value :: tolerance
+      integer(c_int64_t), value :: max_iterations
+      integer(c_int32_t), intent(out) :: hit
+      real(c_double), intent(out) :: toi
+      integer(c_int) :: status
+    end function
     function tethash_last_error() bind(C, name="tethash_last_error") result(message)
       import :: c_ptr
       type(c_ptr) :: message

@@ -126,6 +126,16 @@ tethash_status tethash_detector_compute_penetration(tethash_detector* detector, 
 /** Statistics of the last detection. */
 tethash_status tethash_detector_stats(const tethash_detector* detector, tethash_stats* out_stats);
 
+/** Continuous queries (ccd.hpp): whether two primitives moving linearly from their start positions (t = 0) to their
+ *  end positions (t = 1) meet. `start` and `end`: 4 x 3 doubles each, vertex-face (p, a, b, c: the vertex and the
+ *  triangle's corners) or edge-edge (ea0, ea1, eb0, eb1). `tolerance` > 0 (in the coordinates' units; 1e-6 for
+ *  unit-sized scenes) and `max_iterations` >= 1 (1000000) as in CcdParams. *out_hit: 1 when they may meet, never 0
+ *  when they do; *out_toi: when hit, a time in [0, 1] no later than the first contact, else 1. */
+tethash_status tethash_ccd_vertex_face(const double* start, const double* end, double tolerance, int64_t max_iterations,
+                                       int32_t* out_hit, double* out_toi);
+tethash_status tethash_ccd_edge_edge(const double* start, const double* end, double tolerance, int64_t max_iterations,
+                                     int32_t* out_hit, double* out_toi);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -17,11 +17,11 @@ direction (3; NaN and 0 unless the detector was made with penetration=True).
 import math
 import os
 
-from ._tethash import CONTACT_DTYPE, Detector, Error, RunFailure
+from ._tethash import CONTACT_DTYPE, Detector, Error, RunFailure, ccd_edge_edge, ccd_vertex_face, detect_continuous
 from . import _tethash
 
 __all__ = ["CONTACT_DTYPE", "Detector", "Error", "RunFailure", "detect", "read_mesh", "write_mesh", "simulate",
-           "study", "scene_toml", "default_scene_text"]
+           "study", "scene_toml", "default_scene_text", "ccd_vertex_face", "ccd_edge_edge", "detect_continuous"]
 
 
 def detect(positions, tets, vertex_object=None, tet_object=None, objects=None, **params):

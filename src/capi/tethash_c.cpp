@@ -1,8 +1,9 @@
-// The C interface (include/tethash/tethash.h) over Detector and Penetration: every entry point checks its
-// pointers and sizes, runs the C++ call inside guard(), which maps exceptions to a status and a thread-local
+// The C interface (include/tethash/tethash.h) over Detector, Penetration and the continuous queries: every entry point
+// checks its pointers and sizes, runs the C++ call inside guard(), which maps exceptions to a status and a thread-local
 // message, so nothing is thrown across the boundary.
 #include "tethash/tethash.h"
 
+#include "tethash/ccd.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/penetration.hpp"
@@ -125,6 +126,30 @@ tethash_status check_positions(const char* where, const tethash_detector* d, boo
                                   std::to_string(d->num_vertices));
     if (!positions && num_vertices > 0) return null_argument(where, "positions");
     return TETHASH_OK;
+}
+
+/// The continuous queries' shared checks and call; `edge_edge` picks the query.
+tethash_status ccd_query(const char* where, bool edge_edge, const double* start, const double* end, double tolerance,
+                         std::int64_t max_iterations, std::int32_t* out_hit, double* out_toi)
+{
+    if (!start) return null_argument(where, "start");
+    if (!end) return null_argument(where, "end");
+    if (!out_hit) return null_argument(where, "out_hit");
+    if (!out_toi) return null_argument(where, "out_toi");
+    return guard(where, [&] {
+        using V = Eigen::Vector3d;
+        const auto s = [&](int i) { return V(start[3 * i], start[3 * i + 1], start[3 * i + 2]); };
+        const auto e = [&](int i) { return V(end[3 * i], end[3 * i + 1], end[3 * i + 2]); };
+        tethash::ccd::CcdParams params;
+        params.tolerance = tolerance;
+        params.max_iterations = max_iterations;
+        const tethash::ccd::CcdResult r =
+            edge_edge ? tethash::ccd::edge_edge_ccd(s(0), s(1), s(2), s(3), e(0), e(1), e(2), e(3), params)
+                      : tethash::ccd::vertex_face_ccd(s(0), s(1), s(2), s(3), e(0), e(1), e(2), e(3), params);
+        *out_hit = r.hit ? 1 : 0;
+        *out_toi = r.toi;
+        return TETHASH_OK;
+    });
 }
 
 } // namespace
@@ -386,6 +411,18 @@ tethash_status tethash_detector_stats(const tethash_detector* detector, tethash_
     out_stats->reused = s.reused;
     out_stats->threads = s.threads;
     return TETHASH_OK;
+}
+
+tethash_status tethash_ccd_vertex_face(const double* start, const double* end, double tolerance, int64_t max_iterations,
+                                       int32_t* out_hit, double* out_toi)
+{
+    return ccd_query("tethash_ccd_vertex_face", false, start, end, tolerance, max_iterations, out_hit, out_toi);
+}
+
+tethash_status tethash_ccd_edge_edge(const double* start, const double* end, double tolerance, int64_t max_iterations,
+                                     int32_t* out_hit, double* out_toi)
+{
+    return ccd_query("tethash_ccd_edge_edge", true, start, end, tolerance, max_iterations, out_hit, out_toi);
 }
 
 } // extern "C"

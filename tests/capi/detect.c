@@ -81,6 +81,30 @@ int main(void)
     check(count == 0, "no contact after the move");
 
     tethash_detector_destroy(d);
+
+    /* Continuous queries: the vertex from (0.2, 0.2, 1) to (0.2, 0.2, -1) through the still triangle (0,0,0),
+     * (1,0,0), (0,1,0) meets it at t = 0.5; two edges, (0,0,0)-(1,0,0) still and (0.5,-1,1)-(0.5,1,1) moving down by 2,
+     * cross at t = 0.5; raised by 3, they never meet. */
+    {
+        double start[12] = {0.2, 0.2, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+        double end[12] = {0.2, 0.2, -1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+        double ea[12] = {0, 0, 0, 1, 0, 0, 0.5, -1, 1, 0.5, 1, 1};
+        double eb[12] = {0, 0, 0, 1, 0, 0, 0.5, -1, -1, 0.5, 1, -1};
+        int32_t hit = -1;
+        double toi = -1;
+        check(tethash_ccd_vertex_face(start, end, 1e-6, 1000000, &hit, &toi) == TETHASH_OK, "ccd_vertex_face");
+        check(hit == 1 && toi <= 0.5 && toi > 0.4999, "vertex meets the triangle at t = 0.5");
+        check(tethash_ccd_edge_edge(ea, eb, 1e-6, 1000000, &hit, &toi) == TETHASH_OK, "ccd_edge_edge");
+        check(hit == 1 && toi <= 0.5 && toi > 0.4999, "edges cross at t = 0.5");
+        ea[8] = ea[11] = 4;
+        eb[8] = eb[11] = 2;
+        check(tethash_ccd_edge_edge(ea, eb, 1e-6, 1000000, &hit, &toi) == TETHASH_OK && hit == 0 && toi == 1,
+              "raised edges never meet");
+        check(tethash_ccd_vertex_face(start, end, 0, 1000000, &hit, &toi) == TETHASH_ERROR_INVALID_ARGUMENT,
+              "tolerance 0 refused");
+        check(strstr(tethash_last_error(), "tolerance") != NULL, "message names the tolerance");
+        check(tethash_ccd_edge_edge(ea, NULL, 1e-6, 1, &hit, &toi) == TETHASH_ERROR_NULL_ARGUMENT, "NULL refused");
+    }
     printf("%s (tethash %s)\n", failures ? "FAILED" : "ok", tethash_version());
     return failures ? 1 : 0;
 }

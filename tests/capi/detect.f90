@@ -16,6 +16,8 @@ program detect_fortran
   type(tethash_contact) :: c
   type(tethash_stats) :: stats
   integer :: failures
+  real(c_double) :: ccd_start(3, 4), ccd_end(3, 4), toi
+  integer(c_int32_t) :: hit
 
   failures = 0
   x = reshape([0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, &
@@ -62,6 +64,13 @@ program detect_fortran
   call expect(count == 0, "no contact after the move")
 
   call tethash_detector_destroy(d)
+
+  ! A continuous query: the vertex from (0.2, 0.2, 1) to (0.2, 0.2, -1) through the still triangle meets it at 0.5.
+  ccd_start = reshape([0.2d0, 0.2d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0], [3, 4])
+  ccd_end = ccd_start
+  ccd_end(3, 1) = -1d0
+  call ok(tethash_ccd_vertex_face(ccd_start, ccd_end, 1d-6, 1000000_c_int64_t, hit, toi), "ccd_vertex_face")
+  call expect(hit == 1 .and. toi <= 0.5d0 .and. toi > 0.4999d0, "vertex meets the triangle at t = 0.5")
   if (failures > 0) then
     print *, 'FAILED'
     stop 1

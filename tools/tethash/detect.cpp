@@ -1,6 +1,7 @@
 // tethash detect MESH... : one scene (each file an object), collision detection by the spatial hash or another
 // broad phase (--method; --method all compares them), summary, optional contacts CSV and statistics JSON.
 #include "command.hpp"
+#include "detect_continuous.hpp"
 
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
@@ -43,6 +44,7 @@ struct DetectOptions {
     std::string objects_from_labels; ///< "", "separate" or "join"
     bool linearize = false;
     std::vector<std::string> obstacles; ///< closed surfaces, each a static BSP obstacle
+    bool continuous = false;            ///< the two meshes are frames: contacts over the step between them
 };
 
 /// One input file of the scene: where its vertices and tets start in the scene, and its own numbering.
@@ -174,8 +176,39 @@ void compare_all_methods(const TetMesh& scene, Index nv, Index nt, Index num_obj
     fmt::print("agreement: {}\n", a.message);
 }
 
+/// `--continuous FRAME0 FRAME1`: the options that apply to it, the others refused.
+void run_continuous_detection(const DetectOptions& o)
+{
+    if (o.meshes.size() != 2)
+        throw Error(fmt::format("--continuous: expected two frames of the same meshes (FRAME0 FRAME1), got {} files",
+                                o.meshes.size()));
+    if (o.method == "all" || !o.stats_path.empty() || !o.obstacles.empty() || o.repeat_given || o.skin != "0")
+        throw Error(std::string("--continuous: not with ") +
+                    (o.method == "all"       ? "--method all"
+                     : !o.stats_path.empty() ? "--stats"
+                     : !o.obstacles.empty()  ? "--obstacle"
+                     : o.repeat_given        ? "--repeat"
+                                             : "--skin") +
+                    " (continuous detection has its own broad phase over swept boxes)");
+    check_objects_from_labels_value(o.objects_from_labels);
+    ContinuousOptions c;
+    c.frame0 = o.meshes[0];
+    c.frame1 = o.meshes[1];
+    c.contacts_path = o.contacts_path;
+    c.threads = set_threads(parse_threads(o.threads));
+    c.no_self = o.no_self;
+    c.static_objects = o.static_objects;
+    c.objects_from_labels = o.objects_from_labels;
+    c.linearize = o.linearize;
+    run_continuous(c);
+}
+
 void run(const DetectOptions& o)
 {
+    if (o.continuous) {
+        run_continuous_detection(o);
+        return;
+    }
     DetectParams params;
     parse_cell_size(o.cell_size, params);
     parse_table_size(o.table_size, 0); // the syntax now; the value once the vertices are counted
@@ -424,6 +457,11 @@ Registrar reg{
                         "vertices inside it (closed: on its faces counts) are reported with depth and direction. "
                         "Repeatable")
              ->allow_extra_args(false);
+         sub.add_flag("--continuous", o->continuous,
+                      "The two meshes are frames of the same meshes (FRAME0 FRAME1, e.g. simulation frames): report "
+                      "the boundary vertex-face and edge-edge pairs that meet during the step between them (linear "
+                      "motion), with a time of impact no later than each pair's first contact; --contacts FILE.csv "
+                      "writes them");
          add_objects_from_labels_option(sub, o->objects_from_labels);
          add_linearize_option(sub, o->linearize);
          sub.callback([o, repeat] {

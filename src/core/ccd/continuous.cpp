@@ -1,0 +1,238 @@
+// Continuous detection on tet meshes (include/tethash/continuous.hpp): boundary primitives, swept boxes in two
+// bounding-volume trees (the core's triangle tree, each box given as the "triangle" lo, hi, centre, whose corner box
+// is the box itself), the narrow phase of ccd.hpp, per-thread lists merged and sorted.
+#include "tethash/continuous.hpp"
+
+#include "../team.hpp"
+#include "../triangle_bvh.hpp"
+#include "tethash/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace tethash::ccd {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+struct Box {
+    Vec3 lo, hi;
+};
+
+bool overlap(const Box& a, const Box& b)
+{
+    return !((a.lo.array() > b.hi.array()).any() || (b.lo.array() > a.hi.array()).any());
+}
+
+void check_input(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1)
+{
+    if (x0.rows() != x1.rows())
+        throw Error("detect_continuous: the start positions have " + std::to_string(x0.rows()) +
+                    " rows, the end positions " + std::to_string(x1.rows()));
+    const Index n = static_cast<Index>(x0.rows());
+    for (Eigen::Index t = 0; t < tets.rows(); ++t)
+        for (int c = 0; c < 4; ++c)
+            if (tets(t, c) < 0 || tets(t, c) >= n)
+                throw Error("detect_continuous: tet " + std::to_string(t) + " names vertex " +
+                            std::to_string(tets(t, c)) + ", outside [0, " + std::to_string(n) + ")");
+    for (const PositionsRef* x : {&x0, &x1})
+        for (Eigen::Index i = 0; i < x->rows(); ++i)
+            for (int k = 0; k < 3; ++k)
+                if (!(std::abs((*x)(i, k)) <= 1e50))
+                    throw Error(std::string("detect_continuous: coordinate ") + std::to_string(k) + " of vertex " +
+                                std::to_string(i) + " at " + (x == &x0 ? "the start" : "the end") +
+                                " is not finite or above 1e50 in magnitude");
+}
+
+/// Boundary faces, their edges and their vertices.
+struct Boundary {
+    Triangles faces;
+    Edges edges;
+    std::vector<Index> vertices; ///< increasing
+};
+
+Boundary boundary_of(const TetsRef& tets)
+{
+    Boundary b;
+    b.faces = boundary_faces(tets);
+    std::vector<std::array<Index, 2>> edges;
+    edges.reserve(static_cast<std::size_t>(3 * b.faces.rows()));
+    for (Eigen::Index f = 0; f < b.faces.rows(); ++f)
+        for (int c = 0; c < 3; ++c) {
+            const Index i = b.faces(f, c), j = b.faces(f, (c + 1) % 3);
+            edges.push_back({std::min(i, j), std::max(i, j)});
+            b.vertices.push_back(i);
+        }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    b.edges.resize(static_cast<Eigen::Index>(edges.size()), 2);
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+        b.edges(static_cast<Eigen::Index>(e), 0) = edges[e][0];
+        b.edges(static_cast<Eigen::Index>(e), 1) = edges[e][1];
+    }
+    std::sort(b.vertices.begin(), b.vertices.end());
+    b.vertices.erase(std::unique(b.vertices.begin(), b.vertices.end()), b.vertices.end());
+    return b;
+}
+
+template <int N> Box swept_box(const PositionsRef& x0, const PositionsRef& x1, const std::array<Index, N>& ids)
+{
+    Box b{x0.row(ids[0]).transpose(), x0.row(ids[0]).transpose()};
+    for (const Index v : ids)
+        for (const PositionsRef* x : {&x0, &x1}) {
+            const Vec3 p = x->row(v).transpose();
+            b.lo = b.lo.cwiseMin(p);
+            b.hi = b.hi.cwiseMax(p);
+        }
+    return b;
+}
+
+std::array<Index, 3> face_of(const Triangles& faces, Index f)
+{
+    return {faces(f, 0), faces(f, 1), faces(f, 2)};
+}
+std::array<Index, 2> edge_of(const Edges& edges, Index e)
+{
+    return {edges(e, 0), edges(e, 1)};
+}
+
+/// The narrow phase of one pair; appends a contact when they may meet.
+void vertex_face_pair(const PositionsRef& x0, const PositionsRef& x1, const Triangles& faces, Index v, Index f,
+                      const CcdParams& query, std::vector<ContinuousContact>& out)
+{
+    const auto c = face_of(faces, f);
+    if (c[0] == v || c[1] == v || c[2] == v) return;
+    const CcdResult r = vertex_face_ccd(x0.row(v).transpose(), x0.row(c[0]).transpose(), x0.row(c[1]).transpose(),
+                                        x0.row(c[2]).transpose(), x1.row(v).transpose(), x1.row(c[0]).transpose(),
+                                        x1.row(c[1]).transpose(), x1.row(c[2]).transpose(), query);
+    if (r.hit) out.push_back({ContinuousKind::vertex_face, v, f, r.toi, r.outcome});
+}
+
+void edge_edge_pair(const PositionsRef& x0, const PositionsRef& x1, const Edges& edges, Index e, Index g,
+                    const CcdParams& query, std::vector<ContinuousContact>& out)
+{
+    const auto a = edge_of(edges, e), b = edge_of(edges, g);
+    if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
+    const CcdResult r = edge_edge_ccd(x0.row(a[0]).transpose(), x0.row(a[1]).transpose(), x0.row(b[0]).transpose(),
+                                      x0.row(b[1]).transpose(), x1.row(a[0]).transpose(), x1.row(a[1]).transpose(),
+                                      x1.row(b[0]).transpose(), x1.row(b[1]).transpose(), query);
+    if (r.hit) out.push_back({ContinuousKind::edge_edge, e, g, r.toi, r.outcome});
+}
+
+void sort_contacts(std::vector<ContinuousContact>& contacts)
+{
+    std::sort(contacts.begin(), contacts.end(), [](const ContinuousContact& p, const ContinuousContact& q) {
+        if (p.kind != q.kind) return p.kind < q.kind;
+        if (p.a != q.a) return p.a < q.a;
+        return p.b < q.b;
+    });
+}
+
+/// A tree over boxes: box i as the triangle (lo, hi, centre).
+void build_tree(detail::TriangleBvh& tree, const std::vector<Box>& boxes)
+{
+    tree.build(
+        static_cast<Index>(boxes.size()),
+        [&](Index i, Vec3& a, Vec3& b, Vec3& c) {
+            const Box& box = boxes[static_cast<std::size_t>(i)];
+            a = box.lo;
+            b = box.hi;
+            c = 0.5 * (box.lo + box.hi);
+        },
+        4);
+}
+
+} // namespace
+
+ContinuousResult detect_continuous(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
+                                   const ContinuousParams& params)
+{
+    check_input(tets, x0, x1);
+    // The narrow phase checks its parameters; checked here once so that an empty scene refuses them too.
+    if (!(params.query.tolerance > 0 && params.query.tolerance < 1e300) || params.query.max_iterations < 1)
+        throw Error("detect_continuous: the tolerance must be positive and finite and max_iterations at least 1");
+    Boundary bd = boundary_of(tets);
+    ContinuousResult result;
+    std::vector<Box> face_boxes(static_cast<std::size_t>(bd.faces.rows())),
+        edge_boxes(static_cast<std::size_t>(bd.edges.rows()));
+    for (std::size_t f = 0; f < face_boxes.size(); ++f)
+        face_boxes[f] = swept_box<3>(x0, x1, face_of(bd.faces, static_cast<Index>(f)));
+    for (std::size_t e = 0; e < edge_boxes.size(); ++e)
+        edge_boxes[e] = swept_box<2>(x0, x1, edge_of(bd.edges, static_cast<Index>(e)));
+    detail::TriangleBvh face_tree, edge_tree;
+    build_tree(face_tree, face_boxes);
+    build_tree(edge_tree, edge_boxes);
+
+    int threads = params.threads;
+#ifdef TETHASH_HAVE_OPENMP
+    if (threads <= 0) threads = omp_get_max_threads();
+#endif
+    threads = std::max(threads, 1);
+    const std::int64_t nv = static_cast<std::int64_t>(bd.vertices.size()), ne = bd.edges.rows();
+    std::vector<std::vector<ContinuousContact>> found(static_cast<std::size_t>(threads));
+    std::vector<std::int64_t> vf_candidates(static_cast<std::size_t>(threads)),
+        ee_candidates(static_cast<std::size_t>(threads));
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel num_threads(threads) if (threads > 1)
+#endif
+    {
+        const int rank = detail::team_rank(), size = detail::team_size();
+        auto& out = found[static_cast<std::size_t>(rank)];
+        std::int64_t begin = 0, end = 0;
+        detail::team_split(nv, rank, size, begin, end);
+        for (std::int64_t i = begin; i < end; ++i) {
+            const Index v = bd.vertices[static_cast<std::size_t>(i)];
+            const Box vb = swept_box<1>(x0, x1, {v});
+            face_tree.for_box(vb.lo, vb.hi, [&](Index f) {
+                if (!overlap(vb, face_boxes[static_cast<std::size_t>(f)])) return;
+                ++vf_candidates[static_cast<std::size_t>(rank)];
+                vertex_face_pair(x0, x1, bd.faces, v, f, params.query, out);
+            });
+        }
+        detail::team_split(ne, rank, size, begin, end);
+        for (std::int64_t e = begin; e < end; ++e) {
+            const Box& eb = edge_boxes[static_cast<std::size_t>(e)];
+            edge_tree.for_box(eb.lo, eb.hi, [&](Index g) {
+                if (g <= e || !overlap(eb, edge_boxes[static_cast<std::size_t>(g)])) return;
+                ++ee_candidates[static_cast<std::size_t>(rank)];
+                edge_edge_pair(x0, x1, bd.edges, static_cast<Index>(e), g, params.query, out);
+            });
+        }
+    }
+    for (int r = 0; r < threads; ++r) {
+        const auto& part = found[static_cast<std::size_t>(r)];
+        result.contacts.insert(result.contacts.end(), part.begin(), part.end());
+        result.vertex_face_candidates += vf_candidates[static_cast<std::size_t>(r)];
+        result.edge_edge_candidates += ee_candidates[static_cast<std::size_t>(r)];
+    }
+    sort_contacts(result.contacts);
+    result.faces = std::move(bd.faces);
+    result.edges = std::move(bd.edges);
+    return result;
+}
+
+ContinuousResult detect_continuous_brute_force(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
+                                               const CcdParams& query)
+{
+    check_input(tets, x0, x1);
+    Boundary bd = boundary_of(tets);
+    ContinuousResult result;
+    for (const Index v : bd.vertices)
+        for (Index f = 0; f < bd.faces.rows(); ++f) {
+            ++result.vertex_face_candidates;
+            vertex_face_pair(x0, x1, bd.faces, v, f, query, result.contacts);
+        }
+    for (Index e = 0; e < bd.edges.rows(); ++e)
+        for (Index g = e + 1; g < bd.edges.rows(); ++g) {
+            ++result.edge_edge_candidates;
+            edge_edge_pair(x0, x1, bd.edges, e, g, query, result.contacts);
+        }
+    sort_contacts(result.contacts);
+    result.faces = std::move(bd.faces);
+    result.edges = std::move(bd.edges);
+    return result;
+}
+
+} // namespace tethash::ccd
