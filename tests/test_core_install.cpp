@@ -105,7 +105,8 @@ TEST(CoreInstall, CConsumerBuildsAndRuns)
 }
 
 // docs/embedding.md's CMakeLists.txt and solver.cpp, copied verbatim: they configure with no C++ standard set (the
-// installed tethash::core asks for C++20), build against the installed package only, and run.
+// installed tethash::core asks for C++20), build against the installed package only (catching tethash::Error after
+// the documented includes), and run.
 TEST(CoreInstall, DocumentedConsumerBuildsVerbatim)
 {
     const auto doc = read_text(std::filesystem::path(TETHASH_SOURCE_DIR) / "docs/embedding.md");
@@ -113,6 +114,9 @@ TEST(CoreInstall, DocumentedConsumerBuildsVerbatim)
     const std::string cpp = fenced_block_after(doc, "solver.cpp of the documented consumer");
     ASSERT_NE(cmake.find("find_package(tethash REQUIRED)"), std::string::npos) << cmake;
     ASSERT_NE(cpp.find("int main"), std::string::npos) << cpp;
+    // The documented includes (detect.hpp, penetration.hpp) bring what the catch needs.
+    ASSERT_NE(cpp.find("catch (const tethash::Error& e)"), std::string::npos) << cpp;
+    ASSERT_EQ(cpp.find("tethash/error.hpp"), std::string::npos) << cpp;
     EXPECT_EQ(cmake.find("CMAKE_CXX_STANDARD"), std::string::npos) << "the documented consumer sets no standard";
     const auto dir = temp_dir();
     std::filesystem::create_directories(dir / "src");

@@ -3,6 +3,8 @@
 /// The file handling every format shares: the extension of a path, reading a whole file, and
 /// writing files atomically (to a temporary name in the target folder, renamed when complete, so a
 /// failed write never leaves half a file where a good one was).
+#include "tethash/error.hpp"
+
 #include <functional>
 #include <string>
 #include <vector>
