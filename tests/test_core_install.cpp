@@ -80,8 +80,23 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.h"));   // the C interface
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.f90")); // its Fortran module
-    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/io"));         // core only
+    // The io and meshing components with their headers; not the simulator's or the studies'.
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/io/mesh_io.hpp"));
+    EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/meshing/generate.hpp"));
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/sim"));
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/study"));
     build_and_run_consumer("install_consumer", "consumer", prefix, dir / "consumer");
+
+    // A component the package does not have is named.
+    const auto other = dir / "other_component";
+    std::filesystem::create_directories(other);
+    write_text(other / "CMakeLists.txt", "cmake_minimum_required(VERSION 3.25)\nproject(other LANGUAGES CXX)\n"
+                                         "find_package(tethash REQUIRED COMPONENTS io sim)\n");
+    const auto bad = run_shell("cmake -S " + quote(other) + " -B " + quote(other / "build") +
+                               " -DCMAKE_PREFIX_PATH=" + quote(prefix));
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE((bad.out + bad.err).find("tethash has no component 'sim' (components: io, meshing)"), std::string::npos)
+        << bad.out << bad.err;
 }
 
 TEST(CoreInstall, CConsumerBuildsAndRuns)
