@@ -1,6 +1,8 @@
 // Bad input to every command that reads or writes files (info, convert, generate, tetrahedralize,
 // detect, study): one line on standard error naming the thing, exit status 2, no work done first,
-// no half-written or temporary file left, an existing good file never destroyed.
+// no half-written or temporary file left, an existing good file never destroyed. A write the file
+// system refuses (a folder that takes no files, a full disk) is not bad input: one line, exit status 1,
+// the same guarantees.
 #include "support.hpp"
 
 #include "tethash/io/surface.hpp"
@@ -39,6 +41,17 @@ void expect_one_line_error(const RunResult& r, const std::string& args, const st
     EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
     EXPECT_EQ(line_count(r.err), 1u) << args << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("tethash: error: ", 0), 0u) << args << "\n" << r.err;
+    for (const auto& f : fragments)
+        EXPECT_NE(r.err.find(f), std::string::npos) << args << ": no '" << f << "' in\n" << r.err;
+}
+
+/// A write the file system refused: status 1, exactly one line "tethash: failed: ..." holding every fragment.
+void expect_one_line_write_failure(const RunResult& r, const std::string& args,
+                                   const std::vector<std::string>& fragments)
+{
+    EXPECT_EQ(r.status, 1) << args << "\n" << r.err;
+    EXPECT_EQ(line_count(r.err), 1u) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("tethash: failed: ", 0), 0u) << args << "\n" << r.err;
     for (const auto& f : fragments)
         EXPECT_NE(r.err.find(f), std::string::npos) << args << ": no '" << f << "' in\n" << r.err;
 }
@@ -148,9 +161,11 @@ TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
 {
     const auto dir = temp_dir();
     fs::create_directories(dir / "folder");
+    write_text(dir / "file", "a file, not a folder\n");
     struct Case {
         std::string args;
         std::vector<std::string> fragments;
+        int status = 2; ///< 1: the file system refuses (a folder that takes no files)
     };
     std::vector<Case> cases;
     const std::vector<std::pair<std::string, std::string>> commands = {
@@ -162,10 +177,11 @@ TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
     for (const auto& [prefix, option] : commands) {
         cases.push_back({prefix + quote(dir / "missing" / "out.vtu"), {"out.vtu", "folder", "does not exist"}});
         cases.push_back({prefix + quote(dir / "folder"), {"folder", "is a directory"}});
-        cases.push_back({prefix + quote("/proc/out.vtu"), {"/proc", "cannot create"}});
+        cases.push_back({prefix + quote(dir / "file" / "out.vtu"), {"out.vtu", "is not a folder"}});
+        cases.push_back({prefix + quote("/proc/out.vtu"), {"/proc", "cannot create"}, 1});
         if (!option.empty())
-            for (auto& c : std::vector<Case*>{&cases[cases.size() - 3], &cases[cases.size() - 2], &cases.back()})
-                c->fragments.push_back(option);
+            for (std::size_t i = cases.size() - 4; i < cases.size(); ++i)
+                cases[i].fragments.push_back(option);
     }
     cases.push_back({"convert " + quote(kBox) + " " + quote(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
     cases.push_back({"generate box -o " + quote(dir / "out.xyz"), {"out.xyz", "unknown output format"}});
@@ -176,15 +192,18 @@ TEST(CliBadInput, BadOutputPathsFailBeforeAnyWork)
                          {"t.vtu", "does not exist"}});
     for (const Case& c : cases) {
         const RunResult r = run_tethash(c.args);
-        expect_one_line_error(r, c.args, c.fragments);
+        if (c.status == 1)
+            expect_one_line_write_failure(r, c.args, c.fragments);
+        else
+            expect_one_line_error(r, c.args, c.fragments);
         EXPECT_TRUE(r.out.empty()) << "work was done before the output was checked: " << c.args << "\n" << r.out;
     }
     EXPECT_TRUE(temporaries(dir).empty());
     EXPECT_TRUE(fs::is_empty(dir / "folder"));
 }
 
-// A write that fails part way (file size limit: the same errors as a full disk) exits 2 naming the
-// file, leaves no temporary and keeps the file that was there.
+// A write that fails part way (file size limit: the same errors as a full disk) exits 1 naming the
+// file (not 2: the input was good), leaves no temporary and keeps the file that was there.
 TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
 {
     const auto dir = temp_dir();
@@ -199,7 +218,7 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
         // dash counts ulimit -f in 512-byte blocks: 4 KiB, far less than any of these files.
         const RunResult r = run_shell("trap '' XFSZ; ulimit -f 8; " + quote(TETHASH_EXE) + " convert " + quote(kBox) +
                                       " " + quote(out));
-        expect_one_line_error(r, name, {name});
+        expect_one_line_write_failure(r, name, {name, "write failed"});
         EXPECT_EQ(r.err.find(".tmp"), std::string::npos) << "the message names the temporary: " << r.err;
         EXPECT_EQ(read_text(out), good) << name;
         if (name == "out.node") {
@@ -213,7 +232,7 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
     const RunResult r =
         run_shell("trap '' XFSZ; ulimit -f 8; " + quote(TETHASH_EXE) + " detect " + quote(dir / "b.vtu") + " " +
                   quote(dir / "b.vtu") + " --contacts " + quote(dir / "c.csv"));
-    expect_one_line_error(r, "detect --contacts", {"c.csv"});
+    expect_one_line_write_failure(r, "detect --contacts", {"c.csv", "write failed"});
     EXPECT_EQ(read_text(dir / "c.csv"), good);
     EXPECT_TRUE(temporaries(dir).empty());
     fs::remove(dir / "c.csv");
@@ -223,6 +242,11 @@ TEST(CliBadInput, FailedWriteKeepsTheOldFileAndLeavesNoTemporary)
                   .status,
               0);
     EXPECT_GT(fs::file_size(dir / "c.csv"), 4096u);
+    // simulate: its first frame does not fit; no frame, no temporary, no run.json claiming a run.
+    const RunResult sim =
+        run_shell("trap '' XFSZ; ulimit -f 8; " + quote(TETHASH_EXE) + " simulate --steps 2 -o " + quote(dir / "run"));
+    expect_one_line_write_failure(sim, "simulate -o run", {"frame_00000.vtu", "write failed"});
+    EXPECT_TRUE(fs::is_empty(dir / "run"));
 }
 
 TEST(CliBadInput, StudyRejectsBadCountsAndOutputFolders)
@@ -235,13 +259,17 @@ TEST(CliBadInput, StudyRejectsBadCountsAndOutputFolders)
         {base + " --warmup -1 --out " + quote(dir / "s"), "--warmup"},
         {base + " --out " + quote(dir / "file"), "not a folder"},
         {base + " --out " + quote(dir / "file" / "sub"), "--out"},
-        {base + " --out /proc/tethash_study", "--out"},
     };
     for (const auto& [args, fragment] : cases) {
         const RunResult r = run_tethash(args);
         expect_one_line_error(r, args, {fragment});
         EXPECT_TRUE(r.out.empty()) << args << "\n" << r.out;
     }
+    // A folder that takes no files: the file system refuses, exit 1.
+    const std::string proc = base + " --out /proc/tethash_study";
+    const RunResult r = run_tethash(proc);
+    expect_one_line_write_failure(r, proc, {"--out", "/proc"});
+    EXPECT_TRUE(r.out.empty()) << proc << "\n" << r.out;
     EXPECT_FALSE(fs::exists(dir / "s" / "study.csv"));
     EXPECT_EQ(read_text(dir / "file"), "not a folder\n");
 }

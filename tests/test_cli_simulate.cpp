@@ -58,6 +58,21 @@ TEST(CliSimulate, RunsASceneAndWritesReadableFrames)
     EXPECT_EQ(check_frames(py, dir / "out"), "OK 4\n");
 }
 
+// The shipped extreme scene (a projectile crossing the target in about a step, stiffness and mass ratios of 1e6,
+// dt 0.02) runs to its end with nothing to report (--strict): a shipped scene that stops would greet a user with a
+// failure. It used to stop at step 7, the target crumpled.
+TEST(CliSimulate, ShippedExtremeSceneRunsToItsEnd)
+{
+    const auto dir = temp_dir();
+    const auto scene = std::filesystem::path(TETHASH_SOURCE_DIR) / "meshes" / "scenes" / "extreme.toml";
+    const auto r = run_tethash("simulate " + quote(scene) + " --strict --out " + quote(dir / "out"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("step 50/50 "), std::string::npos) << r.err;
+    EXPECT_NE(read_text(dir / "out" / "run.json").find("\"status\": \"ok\""), std::string::npos)
+        << read_text(dir / "out" / "run.json");
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00050.vtu"));
+}
+
 TEST(CliSimulate, OverridesFromTheCommandLine)
 {
     const auto dir = temp_dir();

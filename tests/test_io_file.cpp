@@ -74,3 +74,42 @@ TEST(IoFile, AFailedWriteLeavesTheOldFileAndNoTemporary)
         ++files;
     EXPECT_EQ(files, 1);
 }
+
+// The file system refusing a file is a WriteError (a RunFailure: exit 1 in the command line), naming the target,
+// never its temporary; a path that cannot name a file is bad input (Error).
+TEST(IoFile, TheFileSystemRefusingAFileIsAWriteError)
+{
+    const auto dir = temp_dir();
+    const std::string proc = "/proc/tethash_out.txt"; // procfs takes no new files, not even from root
+    try {
+        io::write_text_file(proc, "x\n");
+        FAIL() << "no error";
+    } catch (const WriteError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind(proc + ": cannot create file: ", 0), 0U) << e.what();
+    }
+    EXPECT_THROW(io::check_output_file(proc, "--out"), WriteError);
+    // A WriteError thrown on the temporary comes back as one naming the target.
+    const std::string path = (dir / "keep.txt").string();
+    io::write_text_file(path, "old\n");
+    try {
+        io::write_atomically(path, [](const std::string& tmp) { throw WriteError(tmp + ": write failed: full"); });
+        FAIL() << "no error";
+    } catch (const WriteError& e) {
+        EXPECT_EQ(std::string(e.what()), path + ": write failed: full");
+    }
+    EXPECT_EQ(io::read_file(path), "old\n");
+    // A regular file where the folder should be: bad input, not a WriteError.
+    const std::string under_file = (dir / "keep.txt" / "out.txt").string();
+    try {
+        io::write_text_file(under_file, "x\n");
+        FAIL() << "no error";
+    } catch (const WriteError& e) {
+        FAIL() << "a WriteError: " << e.what();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is not a folder"), std::string::npos) << e.what();
+    }
+    int files = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir))
+        ++files;
+    EXPECT_EQ(files, 1);
+}

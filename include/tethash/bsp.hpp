@@ -9,6 +9,7 @@
 /// both children, so the test is closed (on a face, edge or corner counts as inside) and decided the same way
 /// every time. The tree is built once: candidate planes from the faces, each scored by
 /// 4 × (faces it splits) + |faces in front − faces behind|.
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <Eigen/Core>

@@ -15,6 +15,7 @@
 ///   }
 /// \endcode
 
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <cstdint>

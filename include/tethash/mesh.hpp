@@ -7,6 +7,8 @@
 /// so that an FEM code's own `std::vector<double>` of xyz triples maps onto them without a copy
 /// (see `PositionsRef` / `TetsRef` and `Eigen::Map`).
 
+#include "tethash/error.hpp"
+
 #include <Eigen/Core>
 
 #include <array>

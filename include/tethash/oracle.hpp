@@ -6,6 +6,7 @@
 /// so that each tet only looks at the vertices within its x-extent (still all pairs that can touch).
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 
 #include <span>
 #include <vector>

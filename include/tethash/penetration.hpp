@@ -17,6 +17,7 @@
 /// Nothing here is computed unless called: the detector leaves depth NaN.
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 
 #include <cstdint>
 #include <memory>

@@ -12,6 +12,8 @@
 /// Build is serial and deterministic; `query` is const and may run from several threads at once (each
 /// thread passes its own `SplitTreeScratch`). Buffers are kept across builds.
 
+#include "tethash/error.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>

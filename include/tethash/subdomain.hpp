@@ -27,6 +27,7 @@
 /// \endcode
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <Eigen/Core>

@@ -16,9 +16,33 @@ direction (3; NaN and 0 unless the detector was made with penetration=True).
 
 import math
 import os
+import sys
 
-from ._tethash import CONTACT_DTYPE, Detector, Error, RunFailure, ccd_edge_edge, ccd_vertex_face, detect_continuous
-from . import _tethash
+
+def _load_failure(error):
+    """The ImportError to raise when the compiled module does not load: which interpreter it was built for, which
+    one this is, and what to do."""
+    from ._build_info import PYTHON, PYTHON_VERSION
+
+    built = f"Python {PYTHON_VERSION[0]}.{PYTHON_VERSION[1]} ({PYTHON})"
+    here = f"Python {sys.version_info[0]}.{sys.version_info[1]} ({sys.executable})"
+    if tuple(sys.version_info[:2]) != tuple(PYTHON_VERSION):
+        return ImportError(f"tethash: this build of the module is for {built}, this interpreter is {here}: run "
+                           f"{PYTHON}, or build tethash for this interpreter (cmake -DPython3_EXECUTABLE="
+                           f"{sys.executable}; it needs numpy and pybind11)")
+    try:
+        import numpy  # noqa: F401  (the compiled module needs it)
+    except ImportError:
+        return ImportError(f"tethash: numpy is not installed for {here} (the module was built for {built} with its "
+                           f"numpy): install numpy for this interpreter, or run {PYTHON}")
+    return ImportError(f"tethash: the compiled module does not load in {here} (built for {built}): {error}")
+
+
+try:
+    from ._tethash import CONTACT_DTYPE, Detector, Error, RunFailure, ccd_edge_edge, ccd_vertex_face, detect_continuous
+    from . import _tethash
+except ImportError as _error:
+    raise _load_failure(_error) from _error
 
 __all__ = ["CONTACT_DTYPE", "Detector", "Error", "RunFailure", "detect", "read_mesh", "write_mesh", "simulate",
            "study", "scene_toml", "default_scene_text", "ccd_vertex_face", "ccd_edge_edge", "detect_continuous"]

@@ -116,13 +116,13 @@ void check_target(const std::string& path)
 void write_bytes(const std::string& file, const std::string& text, const std::string& path)
 {
     std::FILE* f = std::fopen(file.c_str(), "wb");
-    if (!f) throw Error(path + ": cannot create file: " + std::strerror(errno));
+    if (!f) throw WriteError(path + ": cannot create file: " + std::strerror(errno));
     errno = 0;
     const bool wrote = std::fwrite(text.data(), 1, text.size(), f) == text.size();
     const bool flushed = std::fflush(f) == 0;
     const int err = errno;
     const bool closed = std::fclose(f) == 0;
-    if (!wrote || !flushed || !closed) throw Error(path + ": write failed: " + std::strerror(err ? err : EIO));
+    if (!wrote || !flushed || !closed) throw WriteError(path + ": write failed: " + std::strerror(err ? err : EIO));
 }
 
 } // namespace
@@ -138,6 +138,12 @@ void write_atomically(const std::vector<std::string>& paths,
     std::vector<std::unique_ptr<TrackedTemporary>> tracked;
     for (const std::string& t : tmps)
         tracked.push_back(std::make_unique<TrackedTemporary>(t));
+    // A message that names a temporary names its target instead.
+    auto naming_targets = [&](std::string msg) {
+        for (std::size_t i = 0; i < paths.size(); ++i)
+            msg = replace_all(msg, tmps[i], paths[i]);
+        return msg;
+    };
     auto remove_temporaries = [&] {
         for (const std::string& t : tmps) {
             std::error_code ec;
@@ -149,14 +155,14 @@ void write_atomically(const std::vector<std::string>& paths,
         for (std::size_t i = 0; i < paths.size(); ++i) {
             std::error_code ec;
             fs::rename(tmps[i], paths[i], ec);
-            if (ec) throw Error(paths[i] + ": cannot move the temporary file into place: " + ec.message());
+            if (ec) throw WriteError(paths[i] + ": cannot move the temporary file into place: " + ec.message());
         }
+    } catch (const WriteError& e) {
+        remove_temporaries();
+        throw WriteError(naming_targets(e.what()));
     } catch (const Error& e) {
         remove_temporaries();
-        std::string msg = e.what();
-        for (std::size_t i = 0; i < paths.size(); ++i)
-            msg = replace_all(msg, tmps[i], paths[i]);
-        throw Error(msg);
+        throw Error(naming_targets(e.what()));
     } catch (...) {
         remove_temporaries();
         throw;
@@ -198,8 +204,8 @@ void check_output_file(const std::string& path, const std::string& what)
     const fs::path probe = temporary_for(fs::path(path));
     const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
     if (fd < 0)
-        throw Error(what + ": " + path + ": cannot create files in folder '" + folder_of(fs::path(path)).string() +
-                    "': " + std::strerror(errno));
+        throw WriteError(what + ": " + path + ": cannot create files in folder '" + folder_of(fs::path(path)).string() +
+                         "': " + std::strerror(errno));
     ::close(fd);
     ::unlink(probe.c_str());
 }

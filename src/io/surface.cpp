@@ -304,10 +304,12 @@ void write_surface(const std::string& path, const SurfaceMesh& surface)
         {
             Assimp::Exporter exporter;
             exporter.SetIOHandler(new CheckedIOSystem(&io_error)); // the exporter owns it
-            if (exporter.Export(&scene, format, main_file.string()) != aiReturn_SUCCESS)
+            if (exporter.Export(&scene, format, main_file.string()) != aiReturn_SUCCESS) {
+                if (!io_error.empty()) throw WriteError(path + ": write failed: " + io_error);
                 throw Error(path + ": cannot write surface: " + exporter.GetErrorString());
+            }
         }
-        if (!io_error.empty()) throw Error(path + ": write failed: " + io_error);
+        if (!io_error.empty()) throw WriteError(path + ": write failed: " + io_error);
         if (!fs::exists(main_file)) throw Error(path + ": assimp wrote no file");
         for (const auto& entry : fs::directory_iterator(work)) {
             if (entry.path() == main_file) continue;

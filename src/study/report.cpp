@@ -60,7 +60,12 @@ void make_out_dir(const std::string& dir)
 {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec) throw Error("--out: cannot create folder '" + dir + "': " + ec.message());
+    if (ec) {
+        // A file on the way is a bad --out; anything else is the file system refusing.
+        const std::string msg = "--out: cannot create folder '" + dir + "': " + ec.message();
+        if (ec == std::errc::not_a_directory || ec == std::errc::file_exists) throw Error(msg);
+        throw WriteError(msg);
+    }
 }
 
 void write_machine(JsonWriter& j, const std::string& compiler_flags)

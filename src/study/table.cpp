@@ -157,14 +157,14 @@ void CsvWriter::open(const std::string& path, const std::vector<std::string>& co
     m_file = std::fopen(m_tmp_path.c_str(), "wb");
     if (!m_file) {
         m_tmp_path.clear();
-        throw Error(path + ": cannot create file: " + std::strerror(errno));
+        throw WriteError(path + ": cannot create file: " + std::strerror(errno));
     }
     m_path = path;
     m_columns = columns.size();
     const std::string line = csv_line(columns) + "\n";
     if (std::fwrite(line.data(), 1, line.size(), m_file) != line.size() || std::fflush(m_file) != 0) {
         abandon();
-        throw Error(path + ": write failed: " + std::strerror(errno));
+        throw WriteError(path + ": write failed: " + std::strerror(errno));
     }
 }
 
@@ -176,7 +176,7 @@ void CsvWriter::write(const Row& row)
                     std::to_string(m_columns));
     const std::string line = csv_line(row) + "\n";
     if (std::fwrite(line.data(), 1, line.size(), m_file) != line.size() || std::fflush(m_file) != 0)
-        throw Error(m_path + ": write failed: " + std::strerror(errno));
+        throw WriteError(m_path + ": write failed: " + std::strerror(errno));
 }
 
 void CsvWriter::close()
@@ -186,13 +186,13 @@ void CsvWriter::close()
     m_file = nullptr;
     if (!ok) {
         abandon();
-        throw Error(m_path + ": write failed: " + std::strerror(errno));
+        throw WriteError(m_path + ": write failed: " + std::strerror(errno));
     }
     std::error_code ec;
     std::filesystem::rename(m_tmp_path, m_path, ec);
     if (ec) {
         abandon();
-        throw Error(m_path + ": cannot move the temporary file into place: " + ec.message());
+        throw WriteError(m_path + ": cannot move the temporary file into place: " + ec.message());
     }
     m_tmp_path.clear();
 }

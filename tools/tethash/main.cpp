@@ -148,6 +148,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "tethash: error: %s\n", e.what());
         return 2;
     } catch (const RunFailure& e) {
+        // A run that failed, or a write the file system refused (WriteError: full disk, no permission).
         std::fprintf(stderr, "tethash: failed: %s\n", e.what());
         return 1;
     } catch (const std::bad_alloc&) {

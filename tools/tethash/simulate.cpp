@@ -267,7 +267,12 @@ void run_simulate(SimulateOptions o)
 
     std::error_code ec;
     std::filesystem::create_directories(o.out, ec);
-    if (ec) throw Error("--out: cannot create folder '" + o.out + "': " + ec.message());
+    if (ec) {
+        // A file on the way is a bad --out; anything else is the file system refusing (exit 1).
+        const std::string msg = "--out: cannot create folder '" + o.out + "': " + ec.message();
+        if (ec == std::errc::not_a_directory || ec == std::errc::file_exists) throw Error(msg);
+        throw WriteError(msg);
+    }
     // A previous run's frames would join this run's in ParaView's file group: they go first (only the files this
     // command writes: frame_NNNNN.vtu and scene.pvd), and the run says so.
     const int removed = remove_previous_frames(o.out);

@@ -9,6 +9,7 @@
 /// Sections the reader does not need ($PhysicalNames, $NodeData, $Periodic, $Surface, any other) are
 /// skipped up to their $End line. Errors: "FILE:LINE: expected X, found Y", or "FILE: byte OFFSET: ..."
 /// inside binary data.
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 namespace tethash::io {

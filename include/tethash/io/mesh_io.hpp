@@ -5,6 +5,7 @@
 /// Readers throw tethash::Error with a message "FILE:LINE: expected X, found Y" (or "FILE: byte
 /// OFFSET: ..." for binary data). Writers write atomically (io/file.hpp).
 
+#include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
 #include "tethash/mesh.hpp"
 

@@ -1,6 +1,8 @@
 #pragma once
 /// \file io/pvd.hpp
 /// ParaView collections (.pvd): time series of mesh files.
+#include "tethash/error.hpp"
+
 #include <string>
 #include <utility>
 #include <vector>

@@ -2,6 +2,7 @@
 /// \file io/surface.hpp
 /// Triangle surfaces through assimp (OBJ, STL, PLY, OFF, glTF, ...): import for obstacles and for
 /// tetrahedralization, export of a tet mesh's boundary. Without assimp these throw Error saying so.
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/meshing/surface_mesh.hpp"
 

@@ -2,6 +2,7 @@
 /// \file io/tetgen.hpp
 /// TetGen .node + .ele pairs (0- or 1-based, attributes and boundary markers). ASCII; '#' starts a
 /// comment. Errors: "FILE:LINE: expected X, found Y".
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 namespace tethash::io {

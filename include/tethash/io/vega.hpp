@@ -2,6 +2,7 @@
 /// \file io/vega.hpp
 /// Vega .veg (*VERTICES, *ELEMENTS TET; other sections skipped). ASCII; '#' starts a comment.
 /// Errors: "FILE:LINE: expected X, found Y".
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 namespace tethash::io {

@@ -11,6 +11,7 @@
 /// Writers store positions as Float64/double (exact round trip), tets as Int32, the user fields as
 /// Float64 and the mesh's object ids and labels as Int32 arrays "object", "tet_label", "vertex_label"
 /// (a user field of the same name takes precedence).
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 
 namespace tethash::io {

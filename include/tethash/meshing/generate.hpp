@@ -3,6 +3,7 @@
 /// Tet meshes of built-in shapes (box, bar, sphere, torus, ...), each a signed-distance function
 /// meshed on the BCC lattice of tetrahedralize.hpp. Deterministic: the same parameters give the same
 /// mesh bit for bit, whatever the thread count.
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <string>

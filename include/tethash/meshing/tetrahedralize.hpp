@@ -11,6 +11,7 @@
 /// vertices onto the surface, one at a time, only as far as keeps every incident tet positively
 /// oriented, at least a fraction of its lattice volume, and above a minimum dihedral angle.
 /// All output tets have (b-a)·((c-a)×(d-a)) > 0.
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 #include "tethash/meshing/surface_mesh.hpp"
 

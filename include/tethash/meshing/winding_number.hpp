@@ -1,6 +1,7 @@
 #pragma once
 /// \file meshing/winding_number.hpp
 /// Generalized winding numbers of a triangle surface: the inside test of tetrahedralize().
+#include "tethash/error.hpp"
 #include "tethash/meshing/surface_mesh.hpp"
 
 #include <vector>

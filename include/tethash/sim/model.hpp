@@ -14,6 +14,7 @@
 /// material_courant · L̄ / c (c = sqrt(young / density) the wave speed, L̄ the object's mean edge): the explicit
 /// limit is the material's, not the worst sliver's (see Model::build).
 
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <Eigen/Core>

@@ -5,6 +5,7 @@
 /// Units: SI-like (length m, mass kg, time s) but nothing depends on the choice.
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 #include "tethash/meshing/generate.hpp"
 #include "tethash/sim/model.hpp"

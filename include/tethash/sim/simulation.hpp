@@ -11,6 +11,7 @@
 /// \endcode
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"

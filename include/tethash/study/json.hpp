@@ -4,6 +4,8 @@
 /// escaped, numbers that read back to the same double, nesting checked. Non-finite numbers are written as null
 /// (JSON has no NaN or infinity); a reader sees "not measured", never an invalid file.
 
+#include "tethash/error.hpp"
+
 #include <cstdint>
 #include <string>
 #include <string_view>

@@ -5,6 +5,7 @@
 /// contacts compared (`tethash detect --method all`).
 
 #include "tethash/detect.hpp"
+#include "tethash/error.hpp"
 
 #include <span>
 #include <string>

@@ -6,6 +6,7 @@
 /// packed so that neighbours overlap heavily and the detector finds real contacts. Deterministic.
 /// Used by `tethash study --teschner-scenarios` and by the benchmark.
 
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <Eigen/Core>

@@ -18,6 +18,8 @@
 ///  - integrator: names of the simulator's integrators or "all"; dt: seconds, list or log range
 ///    "FROM:TO:POINTS"; substeps: counts ≥ 1.
 
+#include "tethash/error.hpp"
+
 #include <string>
 #include <vector>
 

@@ -7,6 +7,8 @@
 /// RunFailure), so the simulation is the same for all. Per (method, depth, frame): time of build and pair tests,
 /// sphere-sphere tests. DIR/spheres.csv (one row per method, depth and frame, flushed) and DIR/spheres.json.
 
+#include "tethash/error.hpp"
+
 #include <atomic>
 #include <cstdint>
 #include <functional>

@@ -6,6 +6,7 @@
 ///
 /// What a study is and its value lists: spec.hpp.
 
+#include "tethash/error.hpp"
 #include "tethash/study/spec.hpp"
 #include "tethash/study/table.hpp"
 

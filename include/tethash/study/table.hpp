@@ -3,6 +3,8 @@
 /// The study's CSV: a header line and one row per measurement, written row by row and flushed so that an
 /// interrupted study leaves a valid file; read back for merging shards and summarising.
 
+#include "tethash/error.hpp"
+
 #include <cstdio>
 #include <string>
 #include <vector>
