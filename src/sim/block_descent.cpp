@@ -815,6 +815,10 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     const double tol2 = m_ctx.scene.convergence * m_ctx.scene.convergence;
     // Stop when no vertex moved more than this fraction of its clamp length (a fifth of its object's mean edge).
     const double stop = 5 * m_ctx.scene.sweep_tolerance;
+    // A step refined into k times the scene's substeps gives each a k-th of the energy tolerance, so that what a
+    // step may leave unconverged does not grow with its refinement (a 5 cm octocat of young 1e9 took 100 substeps a
+    // step and ended its drop with 5.6 times its start energy, every substep converged).
+    const double refined_share = std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
     int sweeps = 0;
     double omega = 1, moved_max = 0;
     m_moved_history.clear();
@@ -833,7 +837,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (sw.largest <= stop) break;
         moved_max = std::max(moved_max, sw.moved);
-        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * m_energy_ref;
+        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * refined_share * m_energy_ref;
         // A contact or friction that switches between sweeps and corrections can hold the moves in a cycle (seen
         // at 1 m: the same six moves over and over, each far below the energy tolerance): once the moves stop
         // shrinking over a cycle of corrections, more sweeps change nothing.

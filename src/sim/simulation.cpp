@@ -81,6 +81,7 @@ class SimulationImpl {
     std::int64_t inverted = 0;               // inverted dynamic tets after the last step
     std::vector<std::int32_t> inverted_tets; // which (scratch of each step)
     int refined = 1;                         // substeps of the last refined step, kept until refined_until
+    int auto_max_substeps = 8;               // vbd's automatic max_substeps (set_auto_max_substeps)
     double refined_until = 0;
     RunHealth health;
     double volume0 = 0;        // volume of the dynamic tets at the start
@@ -98,6 +99,8 @@ class SimulationImpl {
     void start_health();
     /// Throws Error for a dt far beyond the scene's own time scale.
     void check_time_step();
+    /// vbd's automatic max_substeps from the stiffest object's ω h.
+    void set_auto_max_substeps();
     TetMesh& mesh() { return objects.mesh; }
     const TetMesh& mesh() const { return objects.mesh; }
     void automatic_ground();
@@ -149,6 +152,26 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     check_placement();
     start_health();
     check_time_step();
+    set_auto_max_substeps();
+}
+
+void SimulationImpl::set_auto_max_substeps()
+{
+    // vbd refines a step whose substeps do not converge (or invert tets, or blow up) into up to 8 × substeps, and
+    // more for a stiff material at a long step: the sweeps and the coarse space converge while ω h (ω the material's
+    // frequency at the mean edge, h the substep) stays within a few hundred, and a young 1e9 body of 5 cm at 1/60 has
+    // ω h ≈ 5,000. The cap lets the refined substep reach ω h ≈ stiff_omega_h: each doubling is paid only by the steps
+    // that need it.
+    constexpr double stiff_omega_h = 100;
+    constexpr int most = 256;
+    double omega = 0;
+    for (size_t o = 0; o < model.object_frequency_sq.size(); ++o)
+        omega = std::max(omega, std::sqrt(model.object_frequency_sq[o]));
+    const double omega_h = omega * scene.dt / scene.substeps;
+    int factor = 1;
+    while (factor < most / 8 && omega_h / factor > stiff_omega_h)
+        factor *= 2;
+    auto_max_substeps = 8 * factor * scene.substeps;
 }
 
 void SimulationImpl::check_time_step()
@@ -301,7 +324,7 @@ void Simulation::step()
     // failed attempt every step. (At 0.5 % instead of 1 %, transient inversions of impacts that recover by themselves
     // were refined too: screw at 1/240 cost 2.3× as much and ended with more inverted tets, not fewer.)
     const int max_substeps = std::max(substeps, s.scene.max_substeps > 0                ? s.scene.max_substeps
-                                                : s.scene.integrator == Integrator::vbd ? 8 * substeps
+                                                : s.scene.integrator == Integrator::vbd ? s.auto_max_substeps
                                                                                         : substeps);
     if (s.refined > substeps && s.t >= s.refined_until) {
         s.refined /= 2;
