@@ -107,8 +107,8 @@ TEST(CliSimulate, DefaultSceneRuns)
         const double ms_step = std::stod(r.out.substr(open + 1));
         double sum = 0;
         int stages = 0;
-        for (const char* stage : {"detection ", "depth ", "proximity ", "response ", "integration ",
-                                  "checks and output "}) {
+        for (const char* stage :
+             {"detection ", "depth ", "proximity ", "response ", "integration ", "checks and output "}) {
             const size_t k = r.out.find(stage, at);
             ASSERT_NE(k, std::string::npos) << stage << "\n" << r.out;
             sum += std::stod(r.out.substr(k + std::strlen(stage)));
