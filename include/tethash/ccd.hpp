@@ -39,6 +39,8 @@
 /// Cost (tools/bench/ccd_bench.cpp; docs/ccd.md has the figures): a query the filters reject costs tens of
 /// nanoseconds, a contact about 110 boxes (8 µs), degenerate contacts more, up to the cap.
 
+#include "tethash/error.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdint>

@@ -11,6 +11,7 @@
 /// mesh). The contacts are sorted and the same for every thread count.
 
 #include "tethash/ccd.hpp"
+#include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
 #include <cstdint>

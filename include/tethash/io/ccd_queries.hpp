@@ -5,6 +5,8 @@
 /// denominator, of any size) and the query's ground truth (1: the primitives meet for some t in [0, 1]; 0: never).
 /// Vertex-face rows: v, f0, f1, f2 at t = 0, then the same at t = 1; edge-edge rows: ea0, ea1, eb0, eb1 at t = 0,
 /// then at t = 1.
+#include "tethash/error.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
