@@ -15,6 +15,9 @@ namespace {
 /// The most lattice nodes one object gets (each carries three unknowns of the factorised system).
 constexpr size_t max_nodes_per_object = 400;
 
+/// The weight-to-bending number ρ g L³ / (E t²) above which a thin sheet's weight folds it (no lattice, below).
+constexpr double sheet_folds = 10.0;
+
 /// The rotation closest to the 3 × 3 matrix s (its polar factor; a reflection turned into a rotation).
 Eigen::Matrix3d closest_rotation(const Eigen::Matrix3d& s)
 {
@@ -57,11 +60,19 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
             lo = lo.cwiseMin(x.row(i).transpose());
             hi = hi.cwiseMax(x.row(i).transpose());
         }
-        // A sheet thinner than half a cell (the mat: one tet layer, 8 mm over 1 m) gets no lattice: the cells span
-        // its folds, and the start state's matrix points nowhere useful once it crumples (its corrections slowed the
-        // sweeps: mean height 0.11-0.13 m at 0.5 s where the converged step is at 0.044).
-        if ((hi - lo).minCoeff() < 0.5 * std::max(2.0 * model.object_mean_edge[o], (hi - lo).maxCoeff() / 6.0))
-            continue;
+        // A sheet thinner than half a cell (the mat: one tet layer, 8 mm over 1 m) that its weight folds gets no
+        // lattice: the cells span its folds, and the start state's matrix points nowhere useful once it crumples
+        // (its corrections slowed the sweeps: mean height 0.11-0.18 m at 0.5 s where the converged step is at
+        // 0.044). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
+        // large: 1,500 for the mat of young 1e5 at 1 m. A stiff sheet keeps its lattice: the mat of young 1e9 at 1 m
+        // (0.15) ended its drop at 124 times its start energy with the sweeps alone, at 0.99 with the lattice.
+        const Eigen::Vector3d extent3 = hi - lo;
+        if (extent3.minCoeff() < 0.5 * std::max(2.0 * model.object_mean_edge[o], extent3.maxCoeff() / 6.0)) {
+            const double stiffness = model.object_frequency_sq[o] * model.object_mean_edge[o] *
+                                     model.object_mean_edge[o] * extent3.minCoeff() * extent3.minCoeff();
+            const double weight = model.gravity.norm() * std::pow(extent3.maxCoeff(), 3);
+            if (!(weight <= sheet_folds * stiffness)) continue;
+        }
         const double omega_h = std::sqrt(model.object_frequency_sq[o]) * h;
         const double cells_per_extent = 6.0 * std::max(1.0, omega_h / 4.0);
         const double extent = (hi - lo).maxCoeff();
