@@ -429,10 +429,11 @@ Registrar reg{
          CLI::Option* repeat = sub.add_option("--repeat", o->repeat,
                                               "Time K calls after the first (which does the set-up and is reported "
                                               "apart); report the median (default 1; 3 with --method all)");
-         sub.add_option("--method", o->method,
-                        "Broad phase: hash, brute, grid, hgrid, octree, octree-point, octree-loose, kd, kd-point, bsp, "
-                        "bsp-balanced, sort-sweep, bvh, bvh-refit, auto; or all: every method side by side (a table "
-                        "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
+         sub.add_option(
+                "--method", o->method,
+                "Broad phase: hash, brute, grid, hgrid, octree, octree-point, octree-loose, kd, kd-point, bsp, "
+                "bsp-balanced, sort-sweep, bvh, bvh-refit, portals, auto; or all: every method side by side (a table "
+                "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
              ->capture_default_str();
          sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..30 (default: the method's)")
              ->capture_default_str();
