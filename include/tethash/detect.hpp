@@ -82,7 +82,7 @@ std::span<const Method> all_methods();
 /// Parameters of the methods other than the hash. 0 = the method's default.
 struct PartitionParams {
     int max_depth = 0;    ///< trees: deepest level (0: the method's default; at most 30)
-    int leaf_size = 0;    ///< trees: items a node holds before it splits (0: the method's default)
+    int leaf_size = 0;    ///< trees: items a node holds before it splits; portals: vertices per slab (0: the default)
     double looseness = 0; ///< loose octree: cell enlargement factor ≥ 1 (0: 2)
     int levels = 0;       ///< hierarchical grid: most levels (0: as many as the tet sizes span, at most 32)
     /// portals: the cells and portals (checked by set_params); null: a grid of cells of the method's own making over

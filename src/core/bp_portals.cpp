@@ -55,6 +55,17 @@ bool intersects(const Box& a, const Box& b)
     return true;
 }
 
+/// The slabs of a cell: `count` slices across `axis` (y or z), [first, first + count) in the bucket numbering.
+struct Slabs {
+    int axis = 1;
+    double origin = 0, inv = 0; ///< slab of x: cell_coord(x, origin, inv), clamped to 0 .. count - 1
+    Index first = 0, count = 1;
+    Index slab(double x) const
+    {
+        return static_cast<Index>(std::clamp<std::int64_t>(cell_coord(x, origin, inv), 0, count - 1));
+    }
+};
+
 struct PortalFace {
     Box rect;     ///< the portal's rectangle (flat on `axis`)
     int axis = 0; ///< the face's axis
@@ -72,14 +83,18 @@ class Portals final : public BroadPhaseBase {
     }
 
     static constexpr int max_hops = 64;
+    /// Vertices per slab the cells aim at by default (PartitionParams::leaf_size): a cell of n vertices has about
+    /// sqrt(n / slab_vertices) slabs, at most 256.
+    static constexpr double slab_vertices = 16;
 
   private:
     bool build_phase(const PartitionScene& scene, int threads) override;
     void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override
     {
-        std::int64_t m = bytes_of(m_cells, m_face_start, m_faces, m_bucket_start, m_bucket_cells, m_vcell, m_vold,
-                                  m_tcell, m_told, m_vstart, m_vids, m_vx, m_boxes, m_reg_start, m_reg_tets);
+        std::int64_t m =
+            bytes_of(m_cells, m_face_start, m_faces, m_bucket_start, m_bucket_cells, m_vcell, m_vold, m_tcell, m_told,
+                     m_slabs, m_vbucket, m_vstart, m_vids, m_vx, m_vyz, m_boxes, m_reg_start, m_reg_tets);
         for (const auto& r : m_thread_regs)
             m += bytes_of(r);
         return m;
@@ -112,8 +127,11 @@ class Portals final : public BroadPhaseBase {
     std::vector<Index> m_vcell, m_tcell; // per vertex, per tet: its cell
     std::vector<double> m_vold, m_told;  // positions, centres at the last call (3 per item)
     // This call.
-    std::vector<Index> m_vstart, m_vids;                             // cells + 2: vertices by cell, by x within a cell
+    std::vector<Slabs> m_slabs;                                      // per cell (the outside cell last)
+    std::vector<Index> m_vbucket;                                    // per vertex: its slab
+    std::vector<Index> m_vstart, m_vids;                             // slabs + 1: vertices by slab, by x within a slab
     std::vector<double> m_vx;                                        // their x
+    std::vector<double> m_vyz;                                       // their y and z (2 per vertex)
     std::vector<Box> m_boxes;                                        // per tet
     std::vector<std::vector<std::pair<Index, Index>>> m_thread_regs; // per thread: (cell, tet) entries
     std::vector<Index> m_reg_start, m_reg_tets;                      // cells + 2: tets entered in each cell
@@ -449,31 +467,65 @@ bool Portals::build_phase(const PartitionScene& s, int threads)
         m_overlaps += overlaps[static_cast<std::size_t>(k)];
     }
 
-    // Vertices by cell (counting sort), by x within a cell; tets by cell.
+    // Vertices by cell, each cell cut into slabs across its longer side of y and z, by x within a slab (counting
+    // sort, then a sort per slab); tets by cell.
     const std::size_t cells = m_cells.size() + 1;
-    m_vstart.assign(cells + 1, 0);
+    std::vector<Index> per_cell(cells, 0);
     for (Index c : m_vcell)
-        ++m_vstart[static_cast<std::size_t>(c) + 1];
-    for (std::size_t c = 0; c < cells; ++c)
-        m_vstart[c + 1] += m_vstart[c];
+        ++per_cell[static_cast<std::size_t>(c)];
+    m_slabs.resize(cells);
+    const double per_slab = s.params.leaf_size > 0 ? static_cast<double>(s.params.leaf_size) : slab_vertices;
+    Index buckets = 0;
+    for (std::size_t c = 0; c < cells; ++c) {
+        Slabs& sl = m_slabs[c];
+        sl.first = buckets;
+        sl.count = 1;
+        sl.axis = 1;
+        sl.origin = 0;
+        sl.inv = 0;
+        if (c + 1 < cells) { // the outside cell keeps one slab
+            const Box& b = m_cells[c];
+            sl.axis = b.hi[2] - b.lo[2] > b.hi[1] - b.lo[1] ? 2 : 1;
+            const double k = std::round(std::sqrt(static_cast<double>(per_cell[c]) / per_slab));
+            sl.count = static_cast<Index>(std::clamp(k, 1.0, 256.0));
+            sl.origin = b.lo[sl.axis];
+            sl.inv = static_cast<double>(sl.count) / (b.hi[sl.axis] - b.lo[sl.axis]);
+        }
+        buckets += sl.count;
+    }
+    m_vbucket.resize(un);
+    m_vstart.assign(static_cast<std::size_t>(buckets) + 1, 0);
+    for (Index v = 0; v < n; ++v) {
+        const Slabs& sl = m_slabs[static_cast<std::size_t>(m_vcell[static_cast<std::size_t>(v)])];
+        const Index b = sl.first + sl.slab(s.positions[3 * static_cast<std::size_t>(v) + sl.axis]);
+        m_vbucket[static_cast<std::size_t>(v)] = b;
+        ++m_vstart[static_cast<std::size_t>(b) + 1];
+    }
+    for (Index b = 0; b < buckets; ++b)
+        m_vstart[static_cast<std::size_t>(b) + 1] += m_vstart[static_cast<std::size_t>(b)];
     m_vids.resize(un);
     {
         std::vector<Index> fill(m_vstart.begin(), m_vstart.end() - 1);
         for (Index v = 0; v < n; ++v)
-            m_vids[static_cast<std::size_t>(fill[static_cast<std::size_t>(m_vcell[static_cast<std::size_t>(v)])]++)] =
+            m_vids[static_cast<std::size_t>(fill[static_cast<std::size_t>(m_vbucket[static_cast<std::size_t>(v)])]++)] =
                 v;
     }
     const double* P = s.positions;
 #pragma omp parallel for num_threads(T) if (T > 1) schedule(dynamic, 16)
-    for (std::int64_t c = 0; c < static_cast<std::int64_t>(cells); ++c)
-        std::sort(m_vids.begin() + m_vstart[static_cast<std::size_t>(c)],
-                  m_vids.begin() + m_vstart[static_cast<std::size_t>(c) + 1], [P](Index a, Index b) {
-                      const double xa = P[3 * static_cast<std::size_t>(a)], xb = P[3 * static_cast<std::size_t>(b)];
-                      return xa < xb || (xa == xb && a < b);
+    for (Index b = 0; b < buckets; ++b)
+        std::sort(m_vids.begin() + m_vstart[static_cast<std::size_t>(b)],
+                  m_vids.begin() + m_vstart[static_cast<std::size_t>(b) + 1], [P](Index u, Index w) {
+                      const double xu = P[3 * static_cast<std::size_t>(u)], xw = P[3 * static_cast<std::size_t>(w)];
+                      return xu < xw || (xu == xw && u < w);
                   });
     m_vx.resize(un);
-    for (std::size_t i = 0; i < un; ++i)
-        m_vx[i] = P[3 * static_cast<std::size_t>(m_vids[i])];
+    m_vyz.resize(2 * un);
+    for (std::size_t i = 0; i < un; ++i) {
+        const double* p = P + 3 * static_cast<std::size_t>(m_vids[i]);
+        m_vx[i] = p[0];
+        m_vyz[2 * i] = p[1];
+        m_vyz[2 * i + 1] = p[2];
+    }
 
     m_reg_start.assign(cells + 1, 0);
     for (const auto& regs : m_thread_regs)
@@ -493,7 +545,9 @@ bool Portals::build_phase(const PartitionScene& s, int threads)
 
 void Portals::query_phase(const PartitionScene& s, std::vector<CandidateSink>& sinks)
 {
-    // One entry (cell, tet) after the other: the vertices of the cell in the box's x-range, tested against the box.
+    // One entry (cell, tet) after the other: the vertices of the cell's slabs the box spans, in the box's x-range,
+    // tested against the box. A vertex in the box has its slab in the box's slab range (the same monotone expression
+    // for both, clamped to the cell's slabs), so none is missed.
     const std::size_t cells = m_cells.size() + 1;
     std::vector<Index> cell_of_entry(m_reg_tets.size());
     for (std::size_t c = 0; c < cells; ++c)
@@ -504,12 +558,18 @@ void Portals::query_phase(const PartitionScene& s, std::vector<CandidateSink>& s
         const Index t = m_reg_tets[static_cast<std::size_t>(e)];
         const std::size_t c = static_cast<std::size_t>(cell_of_entry[static_cast<std::size_t>(e)]);
         const Box& b = m_boxes[static_cast<std::size_t>(t)];
-        const auto first = m_vx.begin() + m_vstart[c], last = m_vx.begin() + m_vstart[c + 1];
         const bool tstatic = s.tet_static[t] != 0;
-        for (auto it = std::lower_bound(first, last, b.lo[0]); it != last && *it <= b.hi[0]; ++it) {
-            const Index v = m_vids[static_cast<std::size_t>(it - m_vx.begin())];
-            if (!in_box(s.positions + 3 * static_cast<std::size_t>(v), b.lo, b.hi)) continue;
-            add_candidate(s, v, t, tstatic, vstatic, out);
+        const Slabs& sl = m_slabs[c];
+        const Index s0 = sl.first + sl.slab(b.lo[sl.axis]), s1 = sl.first + sl.slab(b.hi[sl.axis]);
+        for (Index slab = s0; slab <= s1; ++slab) {
+            const auto first = m_vx.begin() + m_vstart[static_cast<std::size_t>(slab)],
+                       last = m_vx.begin() + m_vstart[static_cast<std::size_t>(slab) + 1];
+            for (auto it = std::lower_bound(first, last, b.lo[0]); it != last && *it <= b.hi[0]; ++it) {
+                const auto i = static_cast<std::size_t>(it - m_vx.begin());
+                const double y = m_vyz[2 * i], z = m_vyz[2 * i + 1];
+                if (y < b.lo[1] || y > b.hi[1] || z < b.lo[2] || z > b.hi[2]) continue;
+                add_candidate(s, m_vids[i], t, tstatic, vstatic, out);
+            }
         }
     });
 }

@@ -339,7 +339,7 @@ int main(int argc, char** argv)
                 }
                 if (std::find(known.begin(), known.end(), item) == known.end())
                     throw Error("--partition-scenes: unknown scene '" + item +
-                                "' (expected bars, sizes, corner, thin, all or none)");
+                                "' (expected bars, sizes, corner, thin, building, hall, all or none)");
                 scene_names.push_back(item);
                 item.clear();
             }
@@ -424,7 +424,10 @@ int main(int argc, char** argv)
         for (const std::string& n : scene_names) {
             const study::NamedScene ps = study::partition_scene(n);
             std::printf("%s: %s\n", n.c_str(), ps.description.c_str());
-            report(n.c_str(), ps.mesh, base, threads_all, std::max(3, repeat / 3), baseline, table_factor, methods);
+            DetectParams with_cells = base; // the scene's cells and portals, for --method portals
+            with_cells.partition.cells = ps.cells;
+            report(n.c_str(), ps.mesh, with_cells, threads_all, std::max(3, repeat / 3), baseline, table_factor,
+                   methods);
         }
     if (meshes && only < 0) {
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;

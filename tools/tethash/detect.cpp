@@ -451,7 +451,9 @@ Registrar reg{
              ->capture_default_str();
          sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..30 (default: the method's)")
              ->capture_default_str();
-         sub.add_option("--leaf-size", o->leaf_size, "Trees: items a node holds before it splits, >= 1")
+         sub.add_option(
+                "--leaf-size", o->leaf_size,
+                "Trees: items a node holds before it splits; portals: vertices per slab of a cell (default 16), >= 1")
              ->capture_default_str();
          sub.add_option("--looseness", o->looseness, "Loose octree: cell enlargement factor, 1..16 (default 2)")
              ->capture_default_str();
