@@ -8,11 +8,13 @@
 //   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
 //   tethash_bench --methods hash,bvh,kd [--partition-scenes bars,sizes]: the other broad phases on every scene, in the
 //                 same run as the hash and the baseline (medians at 1 thread)
-//   tethash_bench --walk [--steps N] [--walk-speed L] [--methods ...]: the building and the hall with every object
+//   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building and the hall with every
+//   object
 //                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/portals.hpp"
 #include "tethash/study/methods.hpp"
 #include "tethash/study/scenarios.hpp"
 #include "tethash/study/stats_table.hpp"
@@ -29,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -287,10 +290,23 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
 /// doors alike: nothing stops them). Per method at 1 thread: CPU ms per step (median), the build and query of the
 /// broad phase, and for portals the segment tests and boxes entered beyond their cell per step; the contacts summed
 /// over the steps must agree.
-void report_walk(const std::vector<Method>& methods, const DetectParams& base, int steps, double speed)
+void report_walk(const std::vector<Method>& methods, const DetectParams& base, int steps, double speed, int rooms)
 {
     for (const char* name : {"building", "hall"}) {
-        const study::NamedScene ps = study::partition_scene(name);
+        study::NamedScene ps = study::partition_scene(name);
+        if (rooms > 0) { // rooms × rooms rooms, the hall one cell over them all
+            ps = study::building_scene(rooms, rooms);
+            if (std::string(name) == "hall") {
+                auto one = std::make_shared<CellLayout>();
+                PortalCell c;
+                c.name = "hall";
+                c.hi[0] = c.hi[1] = 4.0 * rooms;
+                c.hi[2] = 3;
+                one->cells.push_back(c);
+                ps.cells = one;
+            }
+        }
+        const double side = rooms > 0 ? 4.0 * rooms : 16.0;
         const TetMesh& m = ps.mesh;
         // Frames: each object's velocity from a fixed sequence of directions.
         std::vector<Eigen::Vector2d> velocity(static_cast<std::size_t>(m.num_objects()));
@@ -312,7 +328,7 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
             frames[static_cast<std::size_t>(k)] = frames[static_cast<std::size_t>(k) - 1];
             for (std::size_t o = 0; o < centre.size(); ++o) {
                 for (int a = 0; a < 2; ++a)
-                    if (centre[o][a] + velocity[o][a] < 0.3 || centre[o][a] + velocity[o][a] > 15.7)
+                    if (centre[o][a] + velocity[o][a] < 0.3 || centre[o][a] + velocity[o][a] > side - 0.3)
                         velocity[o][a] = -velocity[o][a];
                 centre[o] += velocity[o];
             }
@@ -362,7 +378,7 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
 
 int main(int argc, char** argv)
 {
-    int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100;
+    int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100, rooms = 0, leaf_size = 0;
     bool sweep = false, no_meshes = false, no_baseline = false, moving = false, walk = false;
     double speed = 0.01, cell_factor = 1.0, table_factor = 0, walk_speed = 0.05;
     std::string hash = "column", methods_text, partition_scenes = "all";
@@ -399,6 +415,11 @@ int main(int argc, char** argv)
                  "the building and the hall with every object walking (--steps, --walk-speed; --methods, default "
                  "hash, grid, sort-sweep, bvh-refit, portals)");
     app.add_option("--walk-speed", walk_speed, "--walk: distance each object moves per step")->capture_default_str();
+    app.add_option("--leaf-size", leaf_size,
+                   "trees: items per leaf; portals: vertices per slab of a cell (0: the method's default)")
+        ->check(CLI::Range(0, 1 << 30));
+    app.add_option("--rooms", rooms, "--walk: a building of N x N rooms instead of the partition scene's 4 x 4")
+        ->capture_default_str();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -441,6 +462,7 @@ int main(int argc, char** argv)
     base.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
     base.cell_size = cell_factor;
     base.hash = parse_hash_function(hash);
+    base.partition.leaf_size = leaf_size;
     std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
                 "table auto, hash %s\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, repeat, cell_factor, hash.c_str());
@@ -477,7 +499,7 @@ int main(int argc, char** argv)
     if (walk) {
         if (methods.empty())
             methods = {Method::hash, Method::uniform_grid, Method::sort_sweep, Method::bvh_refit, Method::portals};
-        report_walk(methods, base, std::max(2, steps), walk_speed);
+        report_walk(methods, base, std::max(2, steps), walk_speed, rooms);
         return 0;
     }
     if (moving) {
