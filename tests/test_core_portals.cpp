@@ -181,6 +181,26 @@ TEST(CorePortals, EmptyLayoutOneCellAndNoLayoutAreExact)
     EXPECT_TRUE(same_contacts(portal_detector(s, nullptr, 1).detect(s.positions), want));
 }
 
+TEST(CorePortals, ExtremeCellSizesAreExact)
+{
+    // Cells of every scale at once: half of space up to 1e308 (its extent overflows), a sliver 1e-310 thick (its
+    // inverse overflows) and a cell beside it with the scene inside; the locator and the slabs must stay exact.
+    const Scene s = random_scene(21, 5, 3, 0.3);
+    const std::vector<Contact> want = run_oracle(s);
+    auto l = std::make_shared<CellLayout>();
+    l->cells = {cell("west", -1e308, -1e308, -1e308, 0, 1e308, 1e308), cell("sliver", 0, -1, -1, 1e-310, 1, 1),
+                cell("east", 1e-310, -1, -1, 1, 1, 1)};
+    l->portals = {portal(0, 1, 0, -1, -1, 0, 1, 1), portal(1, 2, 1e-310, -0.5, -0.5, 1e-310, 0.5, 0.5)};
+    check_cell_layout(*l);
+    for (int threads : {1, 2}) {
+        Detector det = portal_detector(s, l, threads);
+        EXPECT_TRUE(same_contacts(det.detect(s.positions), want)) << "threads " << threads;
+        Scene moved = s; // everything moves east by 0.3: through the sliver's portals, or past them
+        moved.positions.col(0).array() += 0.3;
+        EXPECT_TRUE(same_contacts(det.detect(moved.positions), run_oracle(moved))) << "threads " << threads;
+    }
+}
+
 TEST(CorePortals, LayoutChecksNameTheCellsAndPortals)
 {
     auto l = *building();

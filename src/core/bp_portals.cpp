@@ -62,7 +62,7 @@ struct Slabs {
     Index first = 0, count = 1;
     Index slab(double x) const
     {
-        return static_cast<Index>(std::clamp<std::int64_t>(cell_coord(x, origin, inv), 0, count - 1));
+        return count == 1 ? 0 : static_cast<Index>(std::clamp<std::int64_t>(cell_coord(x, origin, inv), 0, count - 1));
     }
 };
 
@@ -104,6 +104,11 @@ class Portals final : public BroadPhaseBase {
     /// The cells of the method's own making over the vertices' box (no layout given).
     void make_own_layout(const PartitionScene& s);
     Index outside() const { return static_cast<Index>(m_cells.size()); }
+    /// The locator's bucket coordinate of x on axis a (the monotone cell_coord, clamped to the buckets).
+    std::int64_t bucket_coord(int a, double x) const
+    {
+        return m_dims[a] == 1 ? 0 : std::clamp<std::int64_t>(cell_coord(x, m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
+    }
     /// The first cell (lowest index in its bucket's list) containing p, outside() when none.
     Index locate(const double* p) const;
     /// The cell of a point at p that was in cell `from` at `old`: `from` when it still contains p, else the walk of the
@@ -194,15 +199,17 @@ void Portals::set_layout(const CellLayout& layout)
     const double edge = std::cbrt(vol / (8.0 * static_cast<double>(n)));
     std::int64_t buckets = 1;
     for (int a = 0; a < 3; ++a) {
-        const double k = edge > 0 ? std::ceil(ext[a] / edge) : 1;
-        m_dims[a] = static_cast<std::int64_t>(std::clamp(k, 1.0, 64.0));
+        // Extreme extents (overflow, underflow) get one bucket on the axis: every coordinate maps to it.
+        const double k = edge > 0 && std::isfinite(edge) ? std::ceil(ext[a] / edge) : 1;
+        m_dims[a] = std::isfinite(k) ? static_cast<std::int64_t>(std::clamp(k, 1.0, 64.0)) : 1;
         m_inv[a] = static_cast<double>(m_dims[a]) / ext[a];
+        if (!std::isfinite(m_inv[a])) m_dims[a] = 1;
         buckets *= m_dims[a];
     }
     auto range = [&](const Box& b, std::int64_t lo[3], std::int64_t hi[3]) {
         for (int a = 0; a < 3; ++a) {
-            lo[a] = std::clamp<std::int64_t>(cell_coord(b.lo[a], m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
-            hi[a] = std::clamp<std::int64_t>(cell_coord(b.hi[a], m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
+            lo[a] = bucket_coord(a, b.lo[a]);
+            hi[a] = bucket_coord(a, b.hi[a]);
         }
     };
     m_bucket_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
@@ -261,7 +268,7 @@ Index Portals::locate(const double* p) const
     if (m_cells.empty() || !contains_point(m_union, p)) return outside();
     std::int64_t c[3];
     for (int a = 0; a < 3; ++a)
-        c[a] = std::clamp<std::int64_t>(cell_coord(p[a], m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
+        c[a] = bucket_coord(a, p[a]);
     const auto k = static_cast<std::size_t>((c[0] * m_dims[1] + c[1]) * m_dims[2] + c[2]);
     for (Index i = m_bucket_start[k]; i < m_bucket_start[k + 1]; ++i) {
         const Index cell = m_bucket_cells[static_cast<std::size_t>(i)];
@@ -366,8 +373,8 @@ void Portals::overlapped_cells(const Box& b, std::vector<Index>& out, std::vecto
     if (!m_cells.empty() && intersects(m_union, b)) {
         std::int64_t lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
-            lo[a] = std::clamp<std::int64_t>(cell_coord(b.lo[a], m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
-            hi[a] = std::clamp<std::int64_t>(cell_coord(b.hi[a], m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
+            lo[a] = bucket_coord(a, b.lo[a]);
+            hi[a] = bucket_coord(a, b.hi[a]);
         }
         for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
             for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
@@ -471,8 +478,19 @@ bool Portals::build_phase(const PartitionScene& s, int threads)
     // sort, then a sort per slab); tets by cell.
     const std::size_t cells = m_cells.size() + 1;
     std::vector<Index> per_cell(cells, 0);
-    for (Index c : m_vcell)
+    Box out_box{{0, 0, 0}, {0, 0, 0}}; // the outside vertices' box (y and z), for the outside cell's slabs
+    bool any_out = false;
+    for (Index v = 0; v < n; ++v) {
+        const Index c = m_vcell[static_cast<std::size_t>(v)];
         ++per_cell[static_cast<std::size_t>(c)];
+        if (c != outside()) continue;
+        const double* p = s.positions + 3 * static_cast<std::size_t>(v);
+        for (int a = 1; a < 3; ++a) {
+            out_box.lo[a] = any_out ? std::min(out_box.lo[a], p[a]) : p[a];
+            out_box.hi[a] = any_out ? std::max(out_box.hi[a], p[a]) : p[a];
+        }
+        any_out = true;
+    }
     m_slabs.resize(cells);
     const double per_slab = s.params.leaf_size > 0 ? static_cast<double>(s.params.leaf_size) : slab_vertices;
     Index buckets = 0;
@@ -483,13 +501,17 @@ bool Portals::build_phase(const PartitionScene& s, int threads)
         sl.axis = 1;
         sl.origin = 0;
         sl.inv = 0;
-        if (c + 1 < cells) { // the outside cell keeps one slab
-            const Box& b = m_cells[c];
-            sl.axis = b.hi[2] - b.lo[2] > b.hi[1] - b.lo[1] ? 2 : 1;
-            const double k = std::round(std::sqrt(static_cast<double>(per_cell[c]) / per_slab));
-            sl.count = static_cast<Index>(std::clamp(k, 1.0, 256.0));
+        // A cell's slabs span its box, the outside cell's its vertices' box (a box entered there may reach beyond:
+        // the clamp keeps its slab range covering every vertex it holds).
+        const Box& b = c + 1 < cells ? m_cells[c] : out_box;
+        sl.axis = b.hi[2] - b.lo[2] > b.hi[1] - b.lo[1] ? 2 : 1;
+        const double extent = b.hi[sl.axis] - b.lo[sl.axis];
+        const double k = std::round(std::sqrt(static_cast<double>(per_cell[c]) / per_slab));
+        const double count = std::clamp(k, 1.0, 256.0), inv = count / extent;
+        if (count > 1 && extent > 0 && std::isfinite(inv)) { // else one slab: every coordinate maps to it
+            sl.count = static_cast<Index>(count);
             sl.origin = b.lo[sl.axis];
-            sl.inv = static_cast<double>(sl.count) / (b.hi[sl.axis] - b.lo[sl.axis]);
+            sl.inv = inv;
         }
         buckets += sl.count;
     }
