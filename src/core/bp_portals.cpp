@@ -3,8 +3,8 @@
 // portals by a segment test from its previous position; each tet box is tested against the vertices of the cells it
 // overlaps (its own, and the adjoining ones whose portal, or wall, it reaches).
 //
-// Why no pair is missed. Cells are closed boxes; the "outside" cell (index = number of cells) is the closed complement
-// of their interiors' union, i.e. the points in no closed cell. (1) Every vertex is assigned one cell that contains it
+// Why no pair is missed. Cells are closed boxes with non-empty, pairwise disjoint interiors; the "outside" cell (index
+// = number of cells) holds the points in no closed cell. (1) Every vertex is assigned one cell that contains it
 // (closed): the tracked cell when the point still lies in it, else the cell its segment walk ends in when that cell
 // contains it, else the first cell the locator finds (outside when none does). Whatever the rounding of a walk, the
 // final containment test decides, so the assignment is always a containing cell. (2) Every tet box B is entered in
@@ -12,7 +12,8 @@
 // covering test below). Its home cell (the one holding its centre) only serves the fast path: a box strictly inside
 // its home cell intersects no other closed cell (the interiors do not overlap, and a box that touches a neighbour's
 // face is not strictly inside) and has no point outside. (3) A vertex v in B lies in its cell c (1); then B
-// intersects c (v is in both), so B was entered in c (2), and the query of (c, B) scans c's vertices in B's x-range.
+// intersects c (v is in both), so B was entered in c (2), and the query of (c, B) scans the vertices of c's slabs
+// that B spans, in B's x-range (query_phase).
 // A vertex is in one cell and a box entered at most once per cell, so each pair is found once. Portals and walls thus
 // play the same role for exactness; portals make the tracking cheap (a point leaving its room through a door is found
 // in the next room by the walk, without a locator query).
