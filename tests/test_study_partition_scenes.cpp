@@ -2,7 +2,9 @@
 // properties, positively oriented tets, deterministic, an unknown name refused.
 #include "support.hpp"
 
+#include "tethash/detect.hpp"
 #include "tethash/error.hpp"
+#include "tethash/oracle.hpp"
 #include "tethash/study/scenarios.hpp"
 
 #include <gtest/gtest.h>
@@ -52,7 +54,57 @@ TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
             EXPECT_EQ(near, 60 * 125);
         } else if (name == "thin") {
             EXPECT_EQ(s.mesh.num_objects(), 12);
+        } else if (name == "building" || name == "hall") {
+            EXPECT_EQ(s.mesh.num_objects(), 16 * 10 + 24 * 2);
+            EXPECT_EQ(s.mesh.num_tets(), 208 * 162);
+            ASSERT_TRUE(s.cells);
+            EXPECT_NO_THROW(check_cell_layout(*s.cells));
+            EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
+            EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);
+            EXPECT_GE(lo.minCoeff(), 0.0); // every object inside the building
+            EXPECT_LE(hi.x(), 16.0);
+            EXPECT_LE(hi.y(), 16.0);
+            EXPECT_LE(hi.z(), 3.0);
         }
     }
     EXPECT_THROW(partition_scene("nowhere"), Error);
+}
+
+TEST(StudyPartitionScenes, BuildingObjectsStraddleEveryDoorAndPortalsEqualTheOracle)
+{
+    const NamedScene s = building_scene(3, 2, 7);
+    ASSERT_EQ(s.cells->cells.size(), 6U);
+    ASSERT_EQ(s.cells->portals.size(), 7U); // 2 × 2 across x, 3 × 1 across y
+    // Every door has vertices on both sides of its wall within the door's rectangle.
+    for (const Portal& p : s.cells->portals) {
+        const int axis = p.lo[0] == p.hi[0] ? 0 : 1;
+        bool below = false, above = false;
+        for (Index v = 0; v < s.mesh.num_vertices(); ++v) {
+            const Eigen::Vector3d x = s.mesh.positions.row(v);
+            bool in = true;
+            for (int a = 0; a < 3; ++a)
+                if (a != axis) in = in && x[a] >= p.lo[a] && x[a] <= p.hi[a];
+            if (!in) continue;
+            below = below || x[axis] < p.lo[axis];
+            above = above || x[axis] > p.lo[axis];
+        }
+        EXPECT_TRUE(below && above) << "door " << p.a << " - " << p.b;
+    }
+    const std::vector<Contact> want = brute_force_contacts(s.mesh.positions, s.mesh.tets, s.mesh.vertex_object,
+                                                           s.mesh.tet_object, std::span<const ObjectOptions>{});
+    ASSERT_GT(want.size(), 100U);
+    DetectParams p;
+    p.method = Method::portals;
+    p.partition.cells = s.cells;
+    for (int threads : {1, 2}) {
+        p.threads = threads;
+        Detector det(p);
+        det.set_topology(s.mesh);
+        DetectStats st;
+        const std::vector<Contact>& got = det.detect(s.mesh.positions, &st);
+        ASSERT_EQ(got.size(), want.size()) << "threads " << threads;
+        for (std::size_t k = 0; k < got.size(); ++k)
+            ASSERT_TRUE(got[k].vertex == want[k].vertex && got[k].tet == want[k].tet) << k;
+        EXPECT_GT(st.portal_overlaps, 0); // the doorway objects
+    }
 }

@@ -27,6 +27,8 @@
 
 namespace tethash {
 
+struct CellLayout; // portals.hpp
+
 /// A vertex lying inside (or on the boundary of) a tet it does not belong to.
 /// Plain data, 80 bytes; arrays of it are sorted by (vertex, tet).
 struct Contact {
@@ -67,11 +69,12 @@ enum class Method {
     sort_sweep,        ///< sort and sweep on the axis of largest variance, insertion sort from the last order
     bvh,               ///< bounding-volume hierarchy over the tet boxes, rebuilt every call
     bvh_refit,         ///< the same hierarchy, built once and refitted (rebuilt when refitting has degraded it)
+    portals,           ///< cells and portals (portals.hpp): boxes by the cell of their centre, tracked by segment tests
     automatic,         ///< the method that measured fastest for the scene's kind (docs/results.md)
 };
 /// The names of the text grammar ("hash", "brute", "grid", "hgrid", "octree", "octree-point", "octree-loose", "kd",
-/// "kd-point", "bsp", "bsp-balanced", "sort-sweep", "bvh", "bvh-refit", "auto"); parse_method throws Error naming
-/// `option`, the text and the list.
+/// "kd-point", "bsp", "bsp-balanced", "sort-sweep", "bvh", "bvh-refit", "portals", "auto"); parse_method throws Error
+/// naming `option`, the text and the list.
 Method parse_method(const std::string& text, const std::string& option = "--method");
 const char* to_string(Method m);
 /// Every method but `automatic`, in the order above.
@@ -80,9 +83,12 @@ std::span<const Method> all_methods();
 /// Parameters of the methods other than the hash. 0 = the method's default.
 struct PartitionParams {
     int max_depth = 0;    ///< trees: deepest level (0: the method's default; at most 30)
-    int leaf_size = 0;    ///< trees: items a node holds before it splits (0: the method's default)
+    int leaf_size = 0;    ///< trees: items a node holds before it splits; portals: vertices per slab (0: the default)
     double looseness = 0; ///< loose octree: cell enlargement factor ≥ 1 (0: 2)
     int levels = 0;       ///< hierarchical grid: most levels (0: as many as the tet sizes span, at most 32)
+    /// portals: the cells and portals (checked by set_params); null: a grid of cells of the method's own making over
+    /// the vertices' box, every shared face a portal.
+    std::shared_ptr<const CellLayout> cells;
 };
 
 /// Per-object options. Objects not listed get the defaults.
@@ -179,6 +185,9 @@ struct DetectStats {
     /// the vertices its scan kept).
     std::int64_t candidates = 0;
     std::int64_t nodes = 0; ///< other methods: cells, nodes or levels of the structure (0 for the hash)
+    /// portals: segment tests of points (vertices, tet box centres) that left their cell since the last call, and
+    /// tet boxes entered in a cell besides the one holding their centre (they overlap a portal or a wall).
+    std::int64_t ray_tests = 0, portal_overlaps = 0;
 };
 
 class DetectorImpl;

@@ -22,6 +22,8 @@ std::unique_ptr<BroadPhase> make_broad_phase(Method method)
         return make_bvh(true);
     case Method::octree_loose:
         return make_loose_octree();
+    case Method::portals:
+        return make_portals();
     case Method::octree:
     case Method::octree_point:
     case Method::kd_tree:

@@ -69,6 +69,8 @@ class BroadPhase {
     virtual std::int64_t nodes() const { return 0; }
     /// Builds and updates so far (the refitted BVH's builds and refits, sort and sweep's full and repaired sorts).
     virtual BroadPhaseCounts counts() const { return {}; }
+    /// Adds the method's own counters of the last call to `stats` (the portals' segment tests and overlaps).
+    virtual void add_counters(DetectStats& /*stats*/) const {}
 };
 
 /// The broad phase of `method` (not `hash`, not `automatic`).
@@ -80,6 +82,7 @@ std::unique_ptr<BroadPhase> make_hierarchical_grid();
 std::unique_ptr<BroadPhase> make_sort_sweep();
 std::unique_ptr<BroadPhase> make_bvh(bool refit);
 std::unique_ptr<BroadPhase> make_loose_octree();
+std::unique_ptr<BroadPhase> make_portals();
 /// The splitting-plane tree of `method` (octrees, k-d trees, BSP trees: bp_split_tree.cpp); nullptr for the others.
 std::unique_ptr<BroadPhase> make_split_tree_broad_phase(Method method);
 

@@ -5,6 +5,7 @@
 #include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
+#include "tethash/portals.hpp"
 
 #include <algorithm>
 #include <array>
@@ -163,6 +164,7 @@ constexpr detail::EnumName<Method> k_method_names[] = {
     {Method::sort_sweep, "sort-sweep"},
     {Method::bvh, "bvh"},
     {Method::bvh_refit, "bvh-refit"},
+    {Method::portals, "portals"},
     {Method::automatic, "auto"},
 };
 constexpr std::size_t k_num_methods = sizeof k_method_names / sizeof k_method_names[0];
@@ -245,6 +247,7 @@ void validate_params(const DetectParams& p)
     }
     if (q.levels < 0 || q.levels > 32)
         throw Error("levels must be 1..32 (or 0 for as many as the tet sizes span), got " + std::to_string(q.levels));
+    if (q.cells) check_cell_layout(*q.cells);
 }
 
 } // namespace detail

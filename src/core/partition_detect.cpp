@@ -133,6 +133,7 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
         s.contacts = static_cast<std::int64_t>(contacts.size());
         s.memory_bytes = memory_bytes();
         s.nodes = m_broad->nodes();
+        m_broad->add_counters(s);
     }
 }
 

@@ -101,13 +101,14 @@ std::vector<Row> run_detect_point(StudyPlan& plan, std::int64_t index, const Run
         if (hooks.on_note) hooks.on_note(note);
     }
 
-    const DetectParams dp{.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge,
-                          .cell_size = p.cell_factor,
-                          .table_size = p.table_size,
-                          .hash = p.hash,
-                          .threads = p.threads,
-                          .method = p.method,
-                          .partition = p.partition};
+    DetectParams dp{.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge,
+                    .cell_size = p.cell_factor,
+                    .table_size = p.table_size,
+                    .hash = p.hash,
+                    .threads = p.threads,
+                    .method = p.method,
+                    .partition = p.partition};
+    if (p.method == Method::portals) dp.partition.cells = scene.cells;
     Detector det(dp);
     det.set_topology(mesh);
     Row head = {std::to_string(index),

@@ -65,7 +65,7 @@ bool method_uses(Method method, const std::string& option)
           Method::bsp_tree, Method::bsp_tree_balanced, Method::bvh, Method::bvh_refit}},
         {"--leaf-size",
          {Method::octree, Method::octree_point, Method::kd_tree, Method::kd_tree_point, Method::bsp_tree,
-          Method::bsp_tree_balanced, Method::bvh, Method::bvh_refit}},
+          Method::bsp_tree_balanced, Method::bvh, Method::bvh_refit, Method::portals}},
         {"--looseness", {Method::octree_loose}},
         {"--levels", {Method::hierarchical_grid}},
     };

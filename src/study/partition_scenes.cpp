@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 
 namespace tethash::study {
 
@@ -51,6 +53,14 @@ void place(TetMesh& scene, const TetMesh& object, const Eigen::Matrix3d& r, cons
     }
 }
 
+/// "rI_J", the name of room (i, j).
+std::string fmt_room(int i, int j)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "r%d_%d", i, j);
+    return buf;
+}
+
 Eigen::Vector3d random_point(Rng& rng, const Eigen::Vector3d& lo, double width)
 {
     return lo + width * Eigen::Vector3d(rng.uniform(), rng.uniform(), rng.uniform());
@@ -85,9 +95,70 @@ TetMesh cube_lattice(int nx, int ny, int nz, const Eigen::Vector3d& h)
     return m;
 }
 
+NamedScene building_scene(int nx, int ny, std::uint64_t seed)
+{
+    if (nx < 1 || ny < 1) throw Error("building_scene: expected at least one room per axis");
+    constexpr double room = 4, height = 3, door = 1, door_height = 2, margin = 0.4;
+    NamedScene s;
+    s.name = "building";
+    s.description = std::to_string(nx * ny) + " rooms (" + std::to_string(nx) + " x " + std::to_string(ny) +
+                    ", 4 x 4 x 3) joined by doors, 5 pairs of overlapping 3^3-cube objects (edge 0.1) in each room "
+                    "and one pair in each doorway";
+    Rng rng{seed};
+    auto layout = std::make_shared<CellLayout>();
+    const auto index = [&](int i, int j) { return static_cast<Index>(i * ny + j); };
+    for (int i = 0; i < nx; ++i)
+        for (int j = 0; j < ny; ++j) {
+            PortalCell c;
+            c.name = fmt_room(i, j);
+            c.lo[0] = room * i, c.lo[1] = room * j, c.lo[2] = 0;
+            c.hi[0] = room * (i + 1), c.hi[1] = room * (j + 1), c.hi[2] = height;
+            layout->cells.push_back(c);
+        }
+    const TetMesh object = cube_lattice(3, 3, 3, Eigen::Vector3d::Constant(0.1));
+    // A pair: two objects, the second moved by about a third of the object's size, so that they overlap.
+    const auto pair = [&](const Eigen::Vector3d& at) {
+        place(s.mesh, object, rng.rotation(), at);
+        const Eigen::Vector3d shift(0.1 + 0.05 * rng.uniform(), 0.1 * rng.uniform(), 0.1 * rng.uniform());
+        place(s.mesh, object, rng.rotation(), at + shift);
+    };
+    for (int i = 0; i < nx; ++i)
+        for (int j = 0; j < ny; ++j) {
+            const Eigen::Vector3d lo(room * i + margin, room * j + margin, margin);
+            for (int k = 0; k < 5; ++k)
+                pair(lo + Eigen::Vector3d(rng.uniform() * (room - 2 * margin), rng.uniform() * (room - 2 * margin),
+                                          rng.uniform() * (height - 2 * margin)));
+        }
+    // Doors: between (i, j) and (i + 1, j) in the wall x = 4(i + 1), between (i, j) and (i, j + 1) in y = 4(j + 1).
+    for (int i = 0; i < nx; ++i)
+        for (int j = 0; j < ny; ++j)
+            for (int axis = 0; axis < 2; ++axis) {
+                if ((axis == 0 && i + 1 >= nx) || (axis == 1 && j + 1 >= ny)) continue;
+                Portal p;
+                p.a = index(i, j);
+                p.b = axis == 0 ? index(i + 1, j) : index(i, j + 1);
+                const double wall = room * ((axis == 0 ? i : j) + 1), across = room * ((axis == 0 ? j : i) + 0.5);
+                const int other = 1 - axis;
+                p.lo[axis] = p.hi[axis] = wall;
+                p.lo[other] = across - 0.5 * door;
+                p.hi[other] = across + 0.5 * door;
+                p.lo[2] = 0;
+                p.hi[2] = door_height;
+                layout->portals.push_back(p);
+                Eigen::Vector3d at;
+                at[axis] = wall - 0.05;
+                at[other] = across - 0.1;
+                at[2] = 0.5 + rng.uniform();
+                pair(at);
+            }
+    check_cell_layout(*layout);
+    s.cells = layout;
+    return s;
+}
+
 const std::vector<std::string>& partition_scene_names()
 {
-    static const std::vector<std::string> names = {"bars", "sizes", "corner", "thin"};
+    static const std::vector<std::string> names = {"bars", "sizes", "corner", "thin", "building", "hall"};
     return names;
 }
 
@@ -127,6 +198,22 @@ NamedScene partition_scene(const std::string& name)
             const Eigen::Vector3d c(1.2 * (o % 3), 1.2 * ((o / 3) % 2), 1.2 * (o / 6));
             place(s.mesh, slab, rng.rotation(), c);
         }
+    } else if (name == "building" || name == "hall") {
+        NamedScene b = building_scene(4, 4); // the same objects in both (building_scene's own seed)
+        if (name == "hall") {
+            b.description =
+                "the building's objects (208 3^3-cube objects, edge 0.1, in pairs) in one open hall 16 x 16 "
+                "x 3: one cell, no portal";
+            auto one = std::make_shared<CellLayout>();
+            PortalCell c;
+            c.name = "hall";
+            c.hi[0] = c.hi[1] = 16;
+            c.hi[2] = 3;
+            one->cells.push_back(c);
+            b.cells = one;
+        }
+        b.name = name;
+        return b;
     } else {
         std::string list;
         for (const auto& n : partition_scene_names())

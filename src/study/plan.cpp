@@ -85,7 +85,8 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
                 partition_names.push_back(n);
         } else if (std::find(partition_scene_names().begin(), partition_scene_names().end(), it) ==
                    partition_scene_names().end()) {
-            throw Error("--partition-scenes: unknown scene '" + it + "' (expected bars, sizes, corner, thin or all)");
+            throw Error("--partition-scenes: unknown scene '" + it +
+                        "' (expected bars, sizes, corner, thin, building, hall or all)");
         } else {
             partition_names.push_back(it);
         }
@@ -96,6 +97,7 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
         s.name = ps.name;
         s.source = "partition scene: " + ps.description;
         s.mesh = std::move(ps.mesh);
+        s.cells = std::move(ps.cells);
         s.kind = "partition";
         scenes.push_back(std::move(s));
     }

@@ -5,6 +5,7 @@
 #include "tethash/study/study.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/portals.hpp"
 
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@ struct SceneData {
     TetMesh mesh;
     double mean_edge = 0;
     std::optional<std::vector<Contact>> oracle; ///< computed at the first point of the scene that needs it
+    std::shared_ptr<const CellLayout> cells;    ///< the scene's cells and portals (Method::portals), or null
 };
 
 struct DetectPoint {

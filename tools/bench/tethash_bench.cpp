@@ -8,9 +8,13 @@
 //   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
 //   tethash_bench --methods hash,bvh,kd [--partition-scenes bars,sizes]: the other broad phases on every scene, in the
 //                 same run as the hash and the baseline (medians at 1 thread)
+//   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building and the hall with every
+//   object
+//                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/portals.hpp"
 #include "tethash/study/methods.hpp"
 #include "tethash/study/scenarios.hpp"
 #include "tethash/study/stats_table.hpp"
@@ -27,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -72,7 +77,7 @@ struct Measured {
     DetectStats stats;
 };
 
-Measured measure(const TetMesh& m, DetectParams p, int repeat)
+Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
 {
     Detector det(p);
     det.set_topology(m);
@@ -280,13 +285,102 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
     }
 }
 
+/// --walk: the partition scenes "building" and "hall" with every object moving rigidly at `speed` (length per step)
+/// in a random direction of the floor, turned back at the building's outer walls (objects go through inner walls and
+/// doors alike: nothing stops them). Per method at 1 thread: CPU ms per step (median), the build and query of the
+/// broad phase, and for portals the segment tests and boxes entered beyond their cell per step; the contacts summed
+/// over the steps must agree.
+void report_walk(const std::vector<Method>& methods, const DetectParams& base, int steps, double speed, int rooms)
+{
+    for (const char* name : {"building", "hall"}) {
+        study::NamedScene ps = study::partition_scene(name);
+        if (rooms > 0) { // rooms × rooms rooms, the hall one cell over them all
+            ps = study::building_scene(rooms, rooms);
+            if (std::string(name) == "hall") {
+                auto one = std::make_shared<CellLayout>();
+                PortalCell c;
+                c.name = "hall";
+                c.hi[0] = c.hi[1] = 4.0 * rooms;
+                c.hi[2] = 3;
+                one->cells.push_back(c);
+                ps.cells = one;
+            }
+        }
+        const double side = rooms > 0 ? 4.0 * rooms : 16.0;
+        const TetMesh& m = ps.mesh;
+        // Frames: each object's velocity from a fixed sequence of directions.
+        std::vector<Eigen::Vector2d> velocity(static_cast<std::size_t>(m.num_objects()));
+        for (std::size_t o = 0; o < velocity.size(); ++o) {
+            const double a = 2.399963229728653 * static_cast<double>(o); // golden angle: directions spread evenly
+            velocity[o] = speed * Eigen::Vector2d(std::cos(a), std::sin(a));
+        }
+        std::vector<Eigen::Vector2d> centre(velocity.size(), Eigen::Vector2d::Zero());
+        std::vector<int> count(velocity.size(), 0);
+        for (Index v = 0; v < m.num_vertices(); ++v) {
+            const auto o = static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)]);
+            centre[o] += Eigen::Vector2d(m.positions(v, 0), m.positions(v, 1));
+            ++count[o];
+        }
+        for (std::size_t o = 0; o < centre.size(); ++o)
+            centre[o] /= count[o];
+        std::vector<Positions> frames(static_cast<std::size_t>(steps), m.positions);
+        for (int k = 1; k < steps; ++k) {
+            frames[static_cast<std::size_t>(k)] = frames[static_cast<std::size_t>(k) - 1];
+            for (std::size_t o = 0; o < centre.size(); ++o) {
+                for (int a = 0; a < 2; ++a)
+                    if (centre[o][a] + velocity[o][a] < 0.3 || centre[o][a] + velocity[o][a] > side - 0.3)
+                        velocity[o][a] = -velocity[o][a];
+                centre[o] += velocity[o];
+            }
+            Positions& f = frames[static_cast<std::size_t>(k)];
+            for (Index v = 0; v < m.num_vertices(); ++v) {
+                const auto o = static_cast<std::size_t>(m.vertex_object[static_cast<std::size_t>(v)]);
+                f(v, 0) += velocity[o][0];
+                f(v, 1) += velocity[o][1];
+            }
+        }
+        std::printf("walk: %s, %d objects, %d tets, %d vertices, %d steps of %.3g per step\n", name, m.num_objects(),
+                    m.num_tets(), m.num_vertices(), steps, speed);
+        for (Method method : methods) {
+            DetectParams p = base;
+            p.threads = 1;
+            p.method = method;
+            p.partition.cells = ps.cells;
+            Detector det(p);
+            det.set_topology(m);
+            std::vector<double> cpu, build, query;
+            std::int64_t contacts = 0, rays = 0, overlaps = 0;
+            DetectStats st;
+            for (int k = 0; k < steps; ++k) {
+                const double c0 = thread_cpu_ms();
+                det.detect(frames[static_cast<std::size_t>(k)], &st);
+                if (k == 0) continue; // the first call builds what is kept
+                cpu.push_back(thread_cpu_ms() - c0);
+                build.push_back(st.ms_vertices);
+                query.push_back(st.ms_tets);
+                contacts += st.contacts;
+                rays += st.ray_tests;
+                overlaps += st.portal_overlaps;
+            }
+            const double per = 1.0 / std::max(1, steps - 1);
+            std::printf("  %-13s cpu %8.3f ms/step  build %7.3f  query %7.3f  contacts %lld", to_string(method),
+                        median(cpu), median(build), median(query), static_cast<long long>(contacts));
+            if (method == Method::portals)
+                std::printf("  segment tests %.0f/step  overlaps %.0f/step", static_cast<double>(rays) * per,
+                            static_cast<double>(overlaps) * per);
+            std::printf("\n");
+            std::fflush(stdout);
+        }
+    }
+}
+
 } // namespace
 
 int main(int argc, char** argv)
 {
-    int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100;
-    bool sweep = false, no_meshes = false, no_baseline = false, moving = false;
-    double speed = 0.01, cell_factor = 1.0, table_factor = 0;
+    int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100, rooms = 0, leaf_size = 0;
+    bool sweep = false, no_meshes = false, no_baseline = false, moving = false, walk = false;
+    double speed = 0.01, cell_factor = 1.0, table_factor = 0, walk_speed = 0.05;
     std::string hash = "column", methods_text, partition_scenes = "all";
     CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
                  "threads for the five scenarios of Teschner et al. 2003 and ../shared/meshes, against a plain "
@@ -310,12 +404,21 @@ int main(int argc, char** argv)
     app.add_option("--methods", methods_text,
                    "other broad phases to measure on every scene at 1 thread (detect --method names, or all)");
     app.add_option("--partition-scenes", partition_scenes,
-                   "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, all "
-                   "or none")
+                   "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, "
+                   "building, hall, all or none")
         ->capture_default_str();
     app.add_flag("--moving", moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
     app.add_option("--steps", steps, "--moving: steps (at least 2)")->capture_default_str();
     app.add_option("--speed", speed, "--moving: fastest vertex per step, as a factor of the mean edge")
+        ->capture_default_str();
+    app.add_flag("--walk", walk,
+                 "the building and the hall with every object walking (--steps, --walk-speed; --methods, default "
+                 "hash, grid, sort-sweep, bvh-refit, portals)");
+    app.add_option("--walk-speed", walk_speed, "--walk: distance each object moves per step")->capture_default_str();
+    app.add_option("--leaf-size", leaf_size,
+                   "trees: items per leaf; portals: vertices per slab of a cell (0: the method's default)")
+        ->check(CLI::Range(0, 1 << 30));
+    app.add_option("--rooms", rooms, "--walk: a building of N x N rooms instead of the partition scene's 4 x 4")
         ->capture_default_str();
     try {
         app.parse(argc, argv);
@@ -339,7 +442,7 @@ int main(int argc, char** argv)
                 }
                 if (std::find(known.begin(), known.end(), item) == known.end())
                     throw Error("--partition-scenes: unknown scene '" + item +
-                                "' (expected bars, sizes, corner, thin, all or none)");
+                                "' (expected bars, sizes, corner, thin, building, hall, all or none)");
                 scene_names.push_back(item);
                 item.clear();
             }
@@ -359,6 +462,7 @@ int main(int argc, char** argv)
     base.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
     base.cell_size = cell_factor;
     base.hash = parse_hash_function(hash);
+    base.partition.leaf_size = leaf_size;
     std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
                 "table auto, hash %s\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, repeat, cell_factor, hash.c_str());
@@ -392,6 +496,12 @@ int main(int argc, char** argv)
         return 0;
     }
 
+    if (walk) {
+        if (methods.empty())
+            methods = {Method::hash, Method::uniform_grid, Method::sort_sweep, Method::bvh_refit, Method::portals};
+        report_walk(methods, base, std::max(2, steps), walk_speed, rooms);
+        return 0;
+    }
     if (moving) {
         report_moving(study::teschner_scenario(only > 0 ? only - 1 : 4), base, threads_all, steps, speed);
         return 0;
@@ -424,7 +534,10 @@ int main(int argc, char** argv)
         for (const std::string& n : scene_names) {
             const study::NamedScene ps = study::partition_scene(n);
             std::printf("%s: %s\n", n.c_str(), ps.description.c_str());
-            report(n.c_str(), ps.mesh, base, threads_all, std::max(3, repeat / 3), baseline, table_factor, methods);
+            DetectParams with_cells = base; // the scene's cells and portals, for --method portals
+            with_cells.partition.cells = ps.cells;
+            report(n.c_str(), ps.mesh, with_cells, threads_all, std::max(3, repeat / 3), baseline, table_factor,
+                   methods);
         }
     if (meshes && only < 0) {
         const std::filesystem::path dir = TETHASH_SHARED_MESHES;

@@ -6,6 +6,7 @@
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
+#include "tethash/io/cells.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/penetration.hpp"
@@ -21,6 +22,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,7 @@ struct DetectOptions {
     bool linearize = false;
     std::vector<std::string> obstacles; ///< closed surfaces, each a static BSP obstacle
     bool continuous = false;            ///< the two meshes are frames: contacts over the step between them
+    std::string cells_path;             ///< --cells: the cells and portals of --method portals (io/cells.hpp)
 };
 
 /// One input file of the scene: where its vertices and tets start in the scene, and its own numbering.
@@ -182,9 +185,11 @@ void run_continuous_detection(const DetectOptions& o)
     if (o.meshes.size() != 2)
         throw Error(fmt::format("--continuous: expected two frames of the same meshes (FRAME0 FRAME1), got {} files",
                                 o.meshes.size()));
-    if (o.method == "all" || !o.stats_path.empty() || !o.obstacles.empty() || o.repeat_given || o.skin != "0")
+    if (o.method == "all" || !o.stats_path.empty() || !o.obstacles.empty() || o.repeat_given || o.skin != "0" ||
+        !o.cells_path.empty())
         throw Error(std::string("--continuous: not with ") +
                     (o.method == "all"       ? "--method all"
+                     : !o.cells_path.empty() ? "--cells"
                      : !o.stats_path.empty() ? "--stats"
                      : !o.obstacles.empty()  ? "--obstacle"
                      : o.repeat_given        ? "--repeat"
@@ -219,6 +224,12 @@ void run(const DetectOptions& o)
     for (const auto& [option, text] : {std::pair{"--max-depth", &o.max_depth}, std::pair{"--leaf-size", &o.leaf_size},
                                        std::pair{"--looseness", &o.looseness}, std::pair{"--levels", &o.levels}})
         study::parse_partition_param(option, *text, params);
+    if (!o.cells_path.empty()) {
+        if (!side_by_side && params.method != Method::portals)
+            throw Error("--cells " + o.cells_path + ": read by --method portals (or all) only, not by --method " +
+                        o.method);
+        params.partition.cells = std::make_shared<CellLayout>(io::read_cells(o.cells_path));
+    }
     const int repeat = o.repeat_given ? o.repeat : side_by_side ? 3 : 1;
     if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
     if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty()))
@@ -350,6 +361,9 @@ void run(const DetectOptions& o)
                stats.own_vertex_skips, stats.inside_tests, stats.exact_fallbacks, stats.degenerate_tets);
     fmt::print("broad phase: {}, {} candidates, {} nodes, memory {}\n", to_string(params.method), stats.candidates,
                stats.nodes, study::human_bytes(static_cast<double>(stats.memory_bytes)));
+    if (params.method == Method::portals)
+        fmt::print("portals: {} cells, {} segment tests, {} boxes entered beyond their own cell\n", stats.nodes,
+                   stats.ray_tests, stats.portal_overlaps);
     fmt::print("contacts: {}\n", contacts.size());
     std::vector<ObstacleContact> inside;
     if (obstacles.size() > 0) {
@@ -429,19 +443,26 @@ Registrar reg{
          CLI::Option* repeat = sub.add_option("--repeat", o->repeat,
                                               "Time K calls after the first (which does the set-up and is reported "
                                               "apart); report the median (default 1; 3 with --method all)");
-         sub.add_option("--method", o->method,
-                        "Broad phase: hash, brute, grid, hgrid, octree, octree-point, octree-loose, kd, kd-point, bsp, "
-                        "bsp-balanced, sort-sweep, bvh, bvh-refit, auto; or all: every method side by side (a table "
-                        "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
+         sub.add_option(
+                "--method", o->method,
+                "Broad phase: hash, brute, grid, hgrid, octree, octree-point, octree-loose, kd, kd-point, bsp, "
+                "bsp-balanced, sort-sweep, bvh, bvh-refit, portals, auto; or all: every method side by side (a table "
+                "of time per stage, candidates, memory, nodes, contacts, and whether they agree)")
              ->capture_default_str();
          sub.add_option("--max-depth", o->max_depth, "Trees: deepest level, 1..30 (default: the method's)")
              ->capture_default_str();
-         sub.add_option("--leaf-size", o->leaf_size, "Trees: items a node holds before it splits, >= 1")
+         sub.add_option(
+                "--leaf-size", o->leaf_size,
+                "Trees: items a node holds before it splits; portals: vertices per slab of a cell (default 16), >= 1")
              ->capture_default_str();
          sub.add_option("--looseness", o->looseness, "Loose octree: cell enlargement factor, 1..16 (default 2)")
              ->capture_default_str();
          sub.add_option("--levels", o->levels, "Hierarchical grid: most levels, 1..32 (default: as the tet sizes span)")
              ->capture_default_str();
+         sub.add_option(
+             "--cells", o->cells_path,
+             "Portals: the cells and portals, a text file of lines 'cell NAME XMIN YMIN ZMIN XMAX YMAX ZMAX' "
+             "and 'portal CELL_A CELL_B X0 Y0 Z0 X1 Y1 Z1' (default: a grid of cells of its own)");
          sub.add_option("--contacts", o->contacts_path,
                         "Write the contacts: FILE.csv (scene ids, objects, each side's file and id in that file's "
                         "numbering, barycentric coordinates) or FILE.vtu (the meshes with point data contact, "

@@ -259,8 +259,8 @@ Registrar reg{
                         "1..cores)");
          sub.add_option(
                 "--partition-scenes", a->o.partition_scenes,
-                "scenes of the space-partition comparison: bars, sizes, corner, thin or all (hash at its worst; "
-                "many objects each touching several)")
+                "scenes of the space-partition comparison: bars, sizes, corner, thin, building, hall or all (hash "
+                "at its worst; many objects each touching several; rooms and doors for portals)")
              ->delimiter(',');
          // --methods and --leaf-size are shared with the spheres study (study_spheres.cpp registers them).
          sub.add_option("--max-depth", a->o.max_depth, "trees: deepest levels, list (default: the method's)");

@@ -8,9 +8,12 @@
 
 #include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
+#include "tethash/portals.hpp"
 
 #include <Eigen/Core>
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -55,15 +58,27 @@ std::vector<Scenario> teschner_scenarios();
 ///    corner holds one more small object (the scene's box is mostly empty).
 ///  - "thin": 12 objects of 2 × 20 × 20 cubes of 1 × 0.1 × 0.1 (tets ten times longer than wide), randomly rotated
 ///    and packed so that neighbours overlap.
+///  - "building": building_scene(4, 4): 16 rooms joined by 24 doors, 208 small objects (pairs overlapping) spread
+///    over the rooms and standing in every doorway, with its cells and portals.
+///  - "hall": the building's objects in one open hall: one cell, no portal (where cells and portals cannot help).
 struct NamedScene {
     std::string name;
     std::string description;
     TetMesh mesh; ///< vertex_object / tet_object set
+    /// The cells and portals of the scene (the building's rooms and doors), for Method::portals; null for the
+    /// scenes without (the method then makes its own).
+    std::shared_ptr<const CellLayout> cells;
 };
 /// The names above, in that order.
 const std::vector<std::string>& partition_scene_names();
 /// The scene `name`; throws Error naming the list for an unknown name.
 NamedScene partition_scene(const std::string& name);
+/// A building of nx × ny rooms of 4 × 4 × 3 on one floor (room (i, j) spans x 4i..4i+4, y 4j..4j+4, z 0..3), each
+/// joined to its neighbours by a door 1 wide and 2 high in the middle of their shared wall. In every room 5 pairs of
+/// overlapping objects at random places, in every doorway one such pair straddling the door; each object a
+/// 3 × 3 × 3-cube lattice of edge 0.1 (162 tets, 64 vertices), randomly rotated. Deterministic in `seed`. The
+/// cells and portals are the rooms and doors (room names "rI_J").
+NamedScene building_scene(int nx, int ny, std::uint64_t seed = 0x5ca1ab1eULL);
 /// An nx × ny × nz lattice of boxes of size h (corner at the origin), six tets per box: one object.
 TetMesh cube_lattice(int nx, int ny, int nz, const Eigen::Vector3d& h);
 

@@ -46,7 +46,7 @@ template <auto M> double member(const DetectStats& s)
 
 /// Every field of DetectStats once (tests/test_study_stats_table.cpp checks it), plus derived ratios.
 /// Order: the parameters used, the scene, the work counters, the result and memory, candidate reuse, the timings.
-inline constexpr std::array<StatField, 28> k_detect_stats = {{
+inline constexpr std::array<StatField, 30> k_detect_stats = {{
     {"cell_size", "length", StatKind::real, member<&DetectStats::cell_size>, everywhere, "cell"},
     {"table_size", "buckets", StatKind::count, member<&DetectStats::table_size>, everywhere, "table"},
     {"threads", "", StatKind::count, member<&DetectStats::threads>, in_study | in_detect, nullptr},
@@ -65,6 +65,8 @@ inline constexpr std::array<StatField, 28> k_detect_stats = {{
     {"own_vertex_skips", "", StatKind::count, member<&DetectStats::own_vertex_skips>, everywhere, "own"},
     {"candidates", "", StatKind::count, member<&DetectStats::candidates>, in_study | in_detect, nullptr},
     {"nodes", "", StatKind::count, member<&DetectStats::nodes>, in_study | in_detect, nullptr},
+    {"ray_tests", "", StatKind::count, member<&DetectStats::ray_tests>, in_study | in_detect, nullptr},
+    {"portal_overlaps", "", StatKind::count, member<&DetectStats::portal_overlaps>, in_study | in_detect, nullptr},
     {"inside_tests", "", StatKind::count, member<&DetectStats::inside_tests>, everywhere, "inside tests"},
     {"exact_fallbacks", "", StatKind::count, member<&DetectStats::exact_fallbacks>, everywhere, "exact"},
     {"degenerate_tets", "", StatKind::count, member<&DetectStats::degenerate_tets>, everywhere, "degenerate"},

@@ -1,0 +1,90 @@
+// `tethash detect --method portals --cells FILE`: the contacts of the default method with a cell file of two rooms
+// and a door (and without one), the counters printed; a malformed cell file is refused (exit 2) naming the file and
+// the line, for each kind of problem; --cells with another method is refused.
+#include "cli_support.hpp"
+#include "core_scenes.hpp"
+#include "support.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace tethash;
+using namespace tethash::test;
+
+namespace {
+
+/// Two overlapping lattice objects across the plane x = 0.5, one file each.
+std::string two_objects(const std::filesystem::path& dir)
+{
+    write_text(dir / "a.mesh", medit_text(lattice_object(3, 3, 3, 0.25, Eigen::Vector3d(0, 0, 0))));
+    write_text(dir / "b.mesh", medit_text(lattice_object(3, 3, 3, 0.25, Eigen::Vector3d(0.375, 0.125, 0.3))));
+    return quote(dir / "a.mesh") + " " + quote(dir / "b.mesh");
+}
+
+const char* const k_rooms = "# two rooms and a door\n"
+                            "cell west -1 -1 -1 0.5 2 2\n"
+                            "cell east 0.5 -1 -1 2 2 2   # beside it\n"
+                            "\n"
+                            "portal west east 0.5 0 0 0.5 0.5 1\n";
+
+} // namespace
+
+TEST(CliPortals, CellFileGivesTheDefaultsContacts)
+{
+    const auto dir = temp_dir();
+    const std::string scene = two_objects(dir);
+    const auto def = run_tethash("detect " + scene + " --threads 1 --contacts " + quote(dir / "default.csv"));
+    ASSERT_EQ(def.status, 0) << def.err;
+    const std::string want = read_text(dir / "default.csv");
+    ASSERT_GT(csv_rows(want).size(), 10u);
+    write_text(dir / "rooms.cells", k_rooms);
+    for (const std::string& cells : {std::string(), " --cells " + quote(dir / "rooms.cells")}) {
+        for (const char* threads : {"1", "2"}) {
+            const auto r = run_tethash("detect " + scene + " --threads " + threads + " --method portals" + cells +
+                                       " --contacts " + quote(dir / "portals.csv"));
+            ASSERT_EQ(r.status, 0) << r.err;
+            EXPECT_EQ(read_text(dir / "portals.csv"), want) << cells << " threads " << threads;
+            EXPECT_NE(r.out.find("broad phase: portals"), std::string::npos) << r.out;
+            if (!cells.empty()) {
+                EXPECT_NE(r.out.find("portals: 2 cells"), std::string::npos) << r.out;
+            }
+        }
+    }
+    const auto all =
+        run_tethash("detect " + scene + " --threads 1 --method all --repeat 1 --cells " + quote(dir / "rooms.cells"));
+    ASSERT_EQ(all.status, 0) << all.err;
+    EXPECT_NE(all.out.find("portals"), std::string::npos) << all.out;
+}
+
+TEST(CliPortals, MalformedCellFilesExit2NamingFileAndLine)
+{
+    const auto dir = temp_dir();
+    const std::string scene = two_objects(dir);
+    const std::string head = "cell west -1 -1 -1 0.5 2 2\ncell east 0.5 -1 -1 2 2 2\n";
+    const std::pair<std::string, std::vector<std::string>> cases[] = {
+        {"# nothing\n", {"bad.cells:", "no cell"}},
+        {head + "room hall 0 0 0 1 1 1\n", {"bad.cells:3:", "expected 'cell' or 'portal'"}},
+        {head + "cell hall 3 0 0 4 1\n", {"bad.cells:3:", "8 fields"}},
+        {head + "cell hall 3 0 0 4 1 one\n", {"bad.cells:3:", "max z", "'one'"}},
+        {head + "cell hall 3 0 0 4 1 inf\n", {"bad.cells:3:", "finite"}},
+        {head + "cell hall 4 0 0 3 1 1\n", {"bad.cells:3:", "cell 'hall'", "inverted"}},
+        {head + "cell hall 0 0 0 1 1 1\n", {"bad.cells:3:", "cell 'hall'", "overlaps cell 'west'"}},
+        {head + "cell west 3 0 0 4 1 1\n", {"bad.cells:3:", "used twice"}},
+        {head + "portal west hall 0.5 0 0 0.5 1 1\n", {"bad.cells:3:", "unknown cell 'hall'"}},
+        {head + "cell far 5 0 0 6 1 1\nportal west far 0.5 0 0 0.5 1 1\n", {"bad.cells:4:", "share no face"}},
+        {head + "portal west east 0.4 0 0 0.4 1 1\n", {"bad.cells:3:", "not on the shared face"}},
+        {head + "portal west east 0.5 0 0 0.5 3 1\n", {"bad.cells:3:", "leaves the shared face"}},
+        {head + "portal west east 0.5 0 0 0.5 1\n", {"bad.cells:3:", "9 fields"}},
+    };
+    for (const auto& [text, parts] : cases) {
+        write_text(dir / "bad.cells", text);
+        const auto r = run_tethash("detect " + scene + " --method portals --cells " + quote(dir / "bad.cells"));
+        EXPECT_EQ(r.status, 2) << text << r.err;
+        for (const std::string& part : parts)
+            EXPECT_NE(r.err.find(part), std::string::npos) << "'" << part << "' not in: " << r.err;
+    }
+    expect_refused(run_tethash("detect " + scene + " --method portals --cells " + quote(dir / "missing.cells")),
+                   {"missing.cells"});
+    write_text(dir / "rooms.cells", k_rooms);
+    expect_refused(run_tethash("detect " + scene + " --method bvh --cells " + quote(dir / "rooms.cells")),
+                   {"--cells", "--method portals"});
+}
