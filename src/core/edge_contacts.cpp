@@ -1,0 +1,180 @@
+// Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, a box tree over its
+// triangles (the core's triangle tree), each boundary edge's box queried in it, the object rules, the exact crossing
+// test; per-thread lists merged and sorted.
+#include "tethash/edge_contacts.hpp"
+
+#include "boundary_edges.hpp"
+#include "detect_checks.hpp"
+#include "team.hpp"
+#include "tethash/predicates.hpp"
+#include "triangle_bvh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace tethash {
+
+EdgeFaceCrossing edge_face_crossing(const double* p, const double* q, const double* a, const double* b, const double* c)
+{
+    EdgeFaceCrossing r;
+    const predicates::Orientation op = predicates::orient3d(a, b, c, p);
+    const predicates::Orientation oq = predicates::orient3d(a, b, c, q);
+    // Both ends strictly on opposite sides of the plane (a zero-area triangle gives zeros: never crossed).
+    if (op.sign == 0 || oq.sign == 0 || op.sign == oq.sign) return r;
+    // The line pq meets the closed triangle: the three edge orientations never of opposite strict signs. Each is, up
+    // to a common factor, the barycentric coordinate of the crossing point at the opposite corner.
+    const predicates::Orientation w[3] = {predicates::orient3d(p, q, b, c), predicates::orient3d(p, q, c, a),
+                                          predicates::orient3d(p, q, a, b)};
+    const bool positive = w[0].sign > 0 || w[1].sign > 0 || w[2].sign > 0;
+    const bool negative = w[0].sign < 0 || w[1].sign < 0 || w[2].sign < 0;
+    if (positive && negative) return r;
+    r.crosses = true;
+    // The values carry the exact signs (predicates.hpp), so their magnitudes give nonnegative coordinates; zeros
+    // are exact.
+    double sum = 0;
+    for (int k = 0; k < 3; ++k) {
+        r.face_bary[k] = w[k].sign == 0 ? 0.0 : std::abs(w[k].value);
+        sum += r.face_bary[k];
+    }
+    if (sum > 0) {
+        for (double& v : r.face_bary)
+            v /= sum;
+    } else { // every value underflowed: the sign says which coordinates are nonzero
+        const int nonzero = (w[0].sign != 0) + (w[1].sign != 0) + (w[2].sign != 0);
+        for (int k = 0; k < 3; ++k)
+            r.face_bary[k] = w[k].sign == 0 ? 0.0 : 1.0 / nonzero;
+    }
+    const double dp = std::abs(op.value), dq = std::abs(oq.value);
+    r.edge_t = dp + dq > 0 ? dp / (dp + dq) : 0.5;
+    r.inner_end = op.sign < 0 ? 0 : 1;
+    const Eigen::Vector3d ea(a[0], a[1], a[2]), eb(b[0], b[1], b[2]), ec(c[0], c[1], c[2]);
+    const Eigen::Vector3d n = (eb - ea).cross(ec - ea).normalized();
+    for (int k = 0; k < 3; ++k)
+        r.normal[k] = n[k];
+    return r;
+}
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+/// True when some vertex of the edge and some vertex of the triangle are the same or are joined by a mesh edge
+/// (share a tet): such a pair is never a self contact.
+bool near_in_mesh(const Adjacency& adj, const Index* e, const Index* f)
+{
+    for (int i = 0; i < 2; ++i) {
+        const auto begin = adj.neighbours.begin() + adj.offsets[static_cast<std::size_t>(e[i])];
+        const auto end = adj.neighbours.begin() + adj.offsets[static_cast<std::size_t>(e[i]) + 1];
+        for (int k = 0; k < 3; ++k)
+            if (e[i] == f[k] || std::binary_search(begin, end, f[k])) return true;
+    }
+    return false;
+}
+
+} // namespace
+
+EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
+                                       std::span<const Index> vertex_object, std::span<const Index> tet_object,
+                                       std::span<const ObjectOptions> objects, int threads)
+{
+    const Index n = static_cast<Index>(positions.rows());
+    detail::check_topology(tets, n, vertex_object, tet_object);
+    detail::check_positions(positions, n);
+    check_threads(threads, "find_edge_face_contacts: threads");
+    const detail::ObjectFlags flags = detail::object_flags(vertex_object, tet_object, objects);
+    auto vobj = [&](Index v) { return vertex_object.empty() ? Index(0) : vertex_object[static_cast<std::size_t>(v)]; };
+
+    EdgeFaceResult result;
+    result.faces = boundary_faces(tets);
+    result.edges = detail::edges_of_faces(result.faces);
+    const Triangles& faces = result.faces;
+    const Edges& edges = result.edges;
+    bool any_self = false;
+    for (const unsigned char s : flags.self_collision)
+        any_self = any_self || s != 0;
+    const Adjacency adj = any_self ? vertex_adjacency(tets, n) : Adjacency{};
+
+    auto point = [&](Index v) { return Vec3(positions(v, 0), positions(v, 1), positions(v, 2)); };
+    detail::TriangleBvh tree;
+    tree.build(
+        static_cast<Index>(faces.rows()),
+        [&](Index f, Vec3& a, Vec3& b, Vec3& c) {
+            a = point(faces(f, 0));
+            b = point(faces(f, 1));
+            c = point(faces(f, 2));
+        },
+        4);
+
+#ifdef TETHASH_HAVE_OPENMP
+    if (threads <= 0) threads = omp_get_max_threads();
+#endif
+    threads = std::max(threads, 1);
+    std::vector<std::vector<EdgeFaceContact>> found(static_cast<std::size_t>(threads));
+    std::vector<std::int64_t> candidates(static_cast<std::size_t>(threads), 0);
+    const std::int64_t ne = edges.rows();
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel num_threads(threads) if (threads > 1)
+#endif
+    {
+        const int rank = detail::team_rank(), size = detail::team_size();
+        auto& out = found[static_cast<std::size_t>(rank)];
+        std::int64_t& count = candidates[static_cast<std::size_t>(rank)];
+        std::int64_t begin = 0, end = 0;
+        detail::team_split(ne, rank, size, begin, end);
+        for (std::int64_t e = begin; e < end; ++e) {
+            const Index ev[2] = {edges(e, 0), edges(e, 1)};
+            const Index eo = vobj(ev[0]);
+            const Vec3 p = point(ev[0]), q = point(ev[1]);
+            const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+            tree.for_box(lo, hi, [&](Index f) {
+                const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
+                const Index fo = vobj(fv[0]);
+                if (flags.is_static[static_cast<std::size_t>(eo)] && flags.is_static[static_cast<std::size_t>(fo)])
+                    return;
+                if (eo == fo) {
+                    if (!flags.self_collision[static_cast<std::size_t>(eo)] || near_in_mesh(adj, ev, fv)) return;
+                } else if (ev[0] == fv[0] || ev[0] == fv[1] || ev[0] == fv[2] || ev[1] == fv[0] || ev[1] == fv[1] ||
+                           ev[1] == fv[2]) {
+                    return;
+                }
+                const Vec3 a = point(fv[0]), b = point(fv[1]), c = point(fv[2]);
+                if ((lo.array() > a.cwiseMax(b).cwiseMax(c).array()).any() ||
+                    (hi.array() < a.cwiseMin(b).cwiseMin(c).array()).any())
+                    return;
+                ++count;
+                const EdgeFaceCrossing x = edge_face_crossing(p.data(), q.data(), a.data(), b.data(), c.data());
+                if (!x.crosses) return;
+                EdgeFaceContact ct;
+                ct.edge = static_cast<Index>(e);
+                ct.face = f;
+                ct.edge_vertices[0] = ev[0];
+                ct.edge_vertices[1] = ev[1];
+                for (int k = 0; k < 3; ++k) {
+                    ct.face_vertices[k] = fv[k];
+                    ct.face_bary[k] = x.face_bary[k];
+                }
+                ct.edge_object = eo;
+                ct.face_object = fo;
+                ct.edge_t = x.edge_t;
+                ct.inner_end = x.inner_end;
+                for (int k = 0; k < 3; ++k)
+                    ct.normal[k] = x.normal[k];
+                out.push_back(ct);
+            });
+        }
+    }
+    for (int r = 0; r < threads; ++r) {
+        const auto& part = found[static_cast<std::size_t>(r)];
+        result.contacts.insert(result.contacts.end(), part.begin(), part.end());
+        result.candidates += candidates[static_cast<std::size_t>(r)];
+    }
+    std::sort(result.contacts.begin(), result.contacts.end(), [](const EdgeFaceContact& x, const EdgeFaceContact& y) {
+        return x.edge < y.edge || (x.edge == y.edge && x.face < y.face);
+    });
+    return result;
+}
+
+} // namespace tethash
