@@ -169,6 +169,24 @@ TEST(CoreEdgeContacts, EqualsOracleOnRandomDeformedScenesAtOneAndTwoThreads)
     EXPECT_GT(self, 0);    // the jitter folds some tets: far self crossings too
 }
 
+TEST(CoreEdgeContacts, DetectorKeptAcrossStepsEqualsOracle)
+{
+    // One topology, several deformations: the detector's kept boundary, neighbours and rules stay right.
+    Scene s = test::random_scene(11, 3, 3, 0.2);
+    test::set_object_rules(s, 6);
+    EdgeFaceDetector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    std::size_t total = 0;
+    for (std::uint32_t step = 1; step <= 4; ++step) {
+        deform(s, 100 + step, 0.5);
+        const EdgeFaceResult& r = det.find(s.positions, static_cast<int>(step % 2) + 1);
+        EXPECT_TRUE(same(r, oracle(s))) << "step " << step;
+        total += r.contacts.size();
+    }
+    EXPECT_GT(total, 0u);
+    EXPECT_THROW(det.find(Positions(3, 3)), Error);
+}
+
 TEST(CoreEdgeContacts, EqualsOracleOnDegenerateLattices)
 {
     // Lattices shifted by half a cube or along a face: ends on planes, lines through edges and corners.

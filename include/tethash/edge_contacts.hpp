@@ -71,11 +71,31 @@ struct EdgeFaceCrossing {
 EdgeFaceCrossing edge_face_crossing(const double* p, const double* q, const double* a, const double* b,
                                     const double* c);
 
-/// Every edge-face contact of the boundary of `tets` at `positions` (n × 3), through a box tree over the boundary
-/// triangles. `vertex_object`, `tet_object` (empty: all 0) and `objects` (missing: defaults) as for
-/// Detector::set_topology. `threads`: 0 = every OpenMP thread, 1 = serial; the result does not depend on it.
-/// Throws Error on an index or object id out of range, a wrong row count, a non-finite coordinate or a thread count
-/// out of range.
+/// Finds the edge-face contacts of a fixed topology at positions that change (an FEM code's steps): the boundary,
+/// the vertices' neighbours and the object rules are computed once in set_topology; each find() builds a box tree
+/// over the boundary triangles at the new positions and queries every boundary edge's box in it.
+class EdgeFaceDetector {
+  public:
+    /// `tets` m × 4; `vertex_object`, `tet_object` (empty: all 0) and `objects` (missing: defaults) as for
+    /// Detector::set_topology. Throws Error on an index or object id out of range.
+    void set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object = {},
+                      std::span<const Index> tet_object = {}, std::span<const ObjectOptions> objects = {});
+    /// The contacts at `positions` (n × 3, n as in set_topology), valid until the next call. `threads`: 0 = every
+    /// OpenMP thread, 1 = serial; the result does not depend on it. Throws Error on a wrong row count, a non-finite
+    /// coordinate or a thread count out of range.
+    const EdgeFaceResult& find(const PositionsRef& positions, int threads = 0);
+
+  private:
+    Index m_num_vertices = 0;
+    EdgeFaceResult m_result;
+    std::vector<Index> m_edge_object, m_face_object; ///< per boundary edge / face
+    std::vector<unsigned char> m_self, m_static;     ///< per object
+    std::vector<Index> m_offsets, m_neighbours;      ///< vertex → neighbours through tet edges (vertex_adjacency)
+};
+
+/// Every edge-face contact of the boundary of `tets` at `positions` (n × 3): EdgeFaceDetector's set_topology and one
+/// find(). Throws Error on an index or object id out of range, a wrong row count, a non-finite coordinate or a thread
+/// count out of range.
 EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
                                        std::span<const Index> vertex_object = {},
                                        std::span<const Index> tet_object = {},

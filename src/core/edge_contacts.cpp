@@ -61,41 +61,50 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-/// True when some vertex of the edge and some vertex of the triangle are the same or are joined by a mesh edge
-/// (share a tet): such a pair is never a self contact.
-bool near_in_mesh(const Adjacency& adj, const Index* e, const Index* f)
-{
-    for (int i = 0; i < 2; ++i) {
-        const auto begin = adj.neighbours.begin() + adj.offsets[static_cast<std::size_t>(e[i])];
-        const auto end = adj.neighbours.begin() + adj.offsets[static_cast<std::size_t>(e[i]) + 1];
-        for (int k = 0; k < 3; ++k)
-            if (e[i] == f[k] || std::binary_search(begin, end, f[k])) return true;
-    }
-    return false;
-}
-
 } // namespace
 
-EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
-                                       std::span<const Index> vertex_object, std::span<const Index> tet_object,
-                                       std::span<const ObjectOptions> objects, int threads)
+void EdgeFaceDetector::set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
+                                    std::span<const Index> tet_object, std::span<const ObjectOptions> objects)
 {
-    const Index n = static_cast<Index>(positions.rows());
-    detail::check_topology(tets, n, vertex_object, tet_object);
-    detail::check_positions(positions, n);
-    check_threads(threads, "find_edge_face_contacts: threads");
+    detail::check_topology(tets, num_vertices, vertex_object, tet_object);
     const detail::ObjectFlags flags = detail::object_flags(vertex_object, tet_object, objects);
+    m_num_vertices = num_vertices;
+    m_self = flags.self_collision;
+    m_static = flags.is_static;
     auto vobj = [&](Index v) { return vertex_object.empty() ? Index(0) : vertex_object[static_cast<std::size_t>(v)]; };
+    m_result = EdgeFaceResult{};
+    m_result.faces = boundary_faces(tets);
+    m_result.edges = detail::edges_of_faces(m_result.faces);
+    m_edge_object.resize(static_cast<std::size_t>(m_result.edges.rows()));
+    for (Eigen::Index e = 0; e < m_result.edges.rows(); ++e)
+        m_edge_object[static_cast<std::size_t>(e)] = vobj(m_result.edges(e, 0));
+    m_face_object.resize(static_cast<std::size_t>(m_result.faces.rows()));
+    for (Eigen::Index f = 0; f < m_result.faces.rows(); ++f)
+        m_face_object[static_cast<std::size_t>(f)] = vobj(m_result.faces(f, 0));
+    const bool any_self = std::any_of(m_self.begin(), m_self.end(), [](unsigned char s) { return s != 0; });
+    Adjacency adj = any_self ? vertex_adjacency(tets, num_vertices) : Adjacency{};
+    m_offsets = std::move(adj.offsets);
+    m_neighbours = std::move(adj.neighbours);
+}
 
-    EdgeFaceResult result;
-    result.faces = boundary_faces(tets);
-    result.edges = detail::edges_of_faces(result.faces);
-    const Triangles& faces = result.faces;
-    const Edges& edges = result.edges;
-    bool any_self = false;
-    for (const unsigned char s : flags.self_collision)
-        any_self = any_self || s != 0;
-    const Adjacency adj = any_self ? vertex_adjacency(tets, n) : Adjacency{};
+const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int threads)
+{
+    const Index n = m_num_vertices;
+    detail::check_positions(positions, n);
+    check_threads(threads, "EdgeFaceDetector::find: threads");
+    const Triangles& faces = m_result.faces;
+    const Edges& edges = m_result.edges;
+    // True when some vertex of the edge and some vertex of the triangle are the same or are joined by a mesh edge
+    // (share a tet): such a pair is never a self contact.
+    auto near_in_mesh = [&](const Index* e, const Index* f) {
+        for (int i = 0; i < 2; ++i) {
+            const auto begin = m_neighbours.begin() + m_offsets[static_cast<std::size_t>(e[i])];
+            const auto end = m_neighbours.begin() + m_offsets[static_cast<std::size_t>(e[i]) + 1];
+            for (int k = 0; k < 3; ++k)
+                if (e[i] == f[k] || std::binary_search(begin, end, f[k])) return true;
+        }
+        return false;
+    };
 
     auto point = [&](Index v) { return Vec3(positions(v, 0), positions(v, 1), positions(v, 2)); };
     detail::TriangleBvh tree;
@@ -126,24 +135,24 @@ EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& 
         detail::team_split(ne, rank, size, begin, end);
         for (std::int64_t e = begin; e < end; ++e) {
             const Index ev[2] = {edges(e, 0), edges(e, 1)};
-            const Index eo = vobj(ev[0]);
+            const Index eo = m_edge_object[static_cast<std::size_t>(e)];
+            const bool e_static = m_static[static_cast<std::size_t>(eo)] != 0;
             const Vec3 p = point(ev[0]), q = point(ev[1]);
             const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
             tree.for_box(lo, hi, [&](Index f) {
                 const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
-                const Index fo = vobj(fv[0]);
-                if (flags.is_static[static_cast<std::size_t>(eo)] && flags.is_static[static_cast<std::size_t>(fo)])
-                    return;
-                if (eo == fo) {
-                    if (!flags.self_collision[static_cast<std::size_t>(eo)] || near_in_mesh(adj, ev, fv)) return;
-                } else if (ev[0] == fv[0] || ev[0] == fv[1] || ev[0] == fv[2] || ev[1] == fv[0] || ev[1] == fv[1] ||
-                           ev[1] == fv[2]) {
-                    return;
-                }
                 const Vec3 a = point(fv[0]), b = point(fv[1]), c = point(fv[2]);
                 if ((lo.array() > a.cwiseMax(b).cwiseMax(c).array()).any() ||
                     (hi.array() < a.cwiseMin(b).cwiseMin(c).array()).any())
                     return;
+                const Index fo = m_face_object[static_cast<std::size_t>(f)];
+                if (e_static && m_static[static_cast<std::size_t>(fo)]) return;
+                if (eo == fo) {
+                    if (!m_self[static_cast<std::size_t>(eo)] || near_in_mesh(ev, fv)) return;
+                } else if (ev[0] == fv[0] || ev[0] == fv[1] || ev[0] == fv[2] || ev[1] == fv[0] || ev[1] == fv[1] ||
+                           ev[1] == fv[2]) {
+                    return;
+                }
                 ++count;
                 const EdgeFaceCrossing x = edge_face_crossing(p.data(), q.data(), a.data(), b.data(), c.data());
                 if (!x.crosses) return;
@@ -155,26 +164,37 @@ EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& 
                 for (int k = 0; k < 3; ++k) {
                     ct.face_vertices[k] = fv[k];
                     ct.face_bary[k] = x.face_bary[k];
+                    ct.normal[k] = x.normal[k];
                 }
                 ct.edge_object = eo;
                 ct.face_object = fo;
                 ct.edge_t = x.edge_t;
                 ct.inner_end = x.inner_end;
-                for (int k = 0; k < 3; ++k)
-                    ct.normal[k] = x.normal[k];
                 out.push_back(ct);
             });
         }
     }
+    m_result.contacts.clear();
+    m_result.candidates = 0;
     for (int r = 0; r < threads; ++r) {
         const auto& part = found[static_cast<std::size_t>(r)];
-        result.contacts.insert(result.contacts.end(), part.begin(), part.end());
-        result.candidates += candidates[static_cast<std::size_t>(r)];
+        m_result.contacts.insert(m_result.contacts.end(), part.begin(), part.end());
+        m_result.candidates += candidates[static_cast<std::size_t>(r)];
     }
-    std::sort(result.contacts.begin(), result.contacts.end(), [](const EdgeFaceContact& x, const EdgeFaceContact& y) {
-        return x.edge < y.edge || (x.edge == y.edge && x.face < y.face);
-    });
-    return result;
+    std::sort(m_result.contacts.begin(), m_result.contacts.end(),
+              [](const EdgeFaceContact& x, const EdgeFaceContact& y) {
+                  return x.edge < y.edge || (x.edge == y.edge && x.face < y.face);
+              });
+    return m_result;
+}
+
+EdgeFaceResult find_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
+                                       std::span<const Index> vertex_object, std::span<const Index> tet_object,
+                                       std::span<const ObjectOptions> objects, int threads)
+{
+    EdgeFaceDetector detector;
+    detector.set_topology(tets, static_cast<Index>(positions.rows()), vertex_object, tet_object, objects);
+    return detector.find(positions, threads);
 }
 
 } // namespace tethash
