@@ -204,6 +204,22 @@ TEST(CoreEdgeContacts, EqualsOracleOnDegenerateLattices)
     EXPECT_GT(total, 0);
 }
 
+TEST(CoreEdgeContacts, EqualsOracleWithTrianglesOfVerySizes)
+{
+    // A 10 × 10 slab of 6 tets (huge triangles) pierced by a bundle of 0.1 cubes: the grid's cell (the mean edge)
+    // would put each big triangle in 10^4 cells, so it is coarsened; nothing may be missed.
+    Scene s = test::lattice_object(1, 1, 1, 10.0, Eigen::Vector3d(-5, -5, 0));
+    for (Eigen::Index v = 0; v < s.positions.rows(); ++v)
+        s.positions(v, 2) *= 0.01;
+    Scene b = test::lattice_object(2, 2, 8, 0.1, Eigen::Vector3d(0.013, 0.021, -0.37));
+    deform(b, 5, 0.1);
+    test::append_object(s, b);
+    const EdgeFaceResult want = oracle(s);
+    EXPECT_TRUE(same(find(s, 1), want));
+    EXPECT_TRUE(same(find(s, 2), want));
+    EXPECT_GT(want.contacts.size(), 8u);
+}
+
 TEST(CoreEdgeContacts, ThinSlabsCrossWithNoVertexInsideAnyTet)
 {
     // A: 4 × 4 cubes in x, y, 0.02 thick in z. B: the same slab stood up (its thin side in y), passing through A's

@@ -1,19 +1,21 @@
-// Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, a box tree over its
-// triangles (the core's triangle tree), each boundary edge's box queried in it, the object rules, the exact crossing
+// Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, a hashed cell grid over its
+// triangles, each boundary edge's box queried in it, the object rules, the exact crossing
 // test; per-thread lists merged and sorted.
 #include "tethash/edge_contacts.hpp"
 
 #include "boundary_edges.hpp"
 #include "detect_checks.hpp"
+#include "hash_grid.hpp"
 #include "team.hpp"
 #include "tethash/predicates.hpp"
-#include "triangle_bvh.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace tethash {
 
@@ -60,6 +62,129 @@ EdgeFaceCrossing edge_face_crossing(const double* p, const double* q, const doub
 namespace {
 
 using Vec3 = Eigen::Vector3d;
+using Cell = std::array<std::int32_t, 3>;
+
+/// The broad phase: a uniform grid over the boundary triangles' boxes, its cells hashed into a table by columns (the
+/// Detector's column hash, hash_grid.hpp: the cells of one (x, y) column in consecutive buckets) and filled by a
+/// counting sort in face order, so the table depends on the input only. An edge visits the cells of its box and
+/// meets a triangle in the first cell the two cell boxes share, so each pair once. It replaced the core's box tree
+/// (triangle_bvh.hpp), whose node boxes overlap on overlapping bodies: 10-20 % less time per call on the scenes of
+/// `tethash_bench --edges` (scenario 5: 55 vs 66 ms, the mat: 142 vs 169 ms, on a loaded machine).
+class FaceGrid {
+  public:
+    /// Cell size: the mean boundary edge length, doubled while the triangles would cover more than 64 cells each on
+    /// average (a few huge triangles), and at least 2^-20 of the extent (cell coordinates below 2^21).
+    void build(const PositionsRef& x, const Triangles& faces, const Edges& edges)
+    {
+        const auto nf = static_cast<std::size_t>(faces.rows());
+        m_origin = Vec3::Constant(std::numeric_limits<double>::infinity());
+        Vec3 top = -m_origin;
+        double length = 0;
+        for (Eigen::Index f = 0; f < faces.rows(); ++f)
+            for (int k = 0; k < 3; ++k) {
+                const Vec3 p = x.row(faces(f, k)).transpose();
+                m_origin = m_origin.cwiseMin(p);
+                top = top.cwiseMax(p);
+            }
+        for (Eigen::Index e = 0; e < edges.rows(); ++e)
+            length += (x.row(edges(e, 0)) - x.row(edges(e, 1))).norm();
+        if (nf == 0) return;
+        const double extent = (top - m_origin).maxCoeff();
+        m_cell = edges.rows() > 0 ? length / static_cast<double>(edges.rows()) : 0;
+        m_cell = std::max(m_cell, std::ldexp(extent, -20));
+        if (!(m_cell > 0) || !std::isfinite(m_cell)) m_cell = 1;
+        m_lo.resize(nf);
+        m_hi.resize(nf);
+        std::int64_t total = 0;
+        for (;;) {
+            m_inv = 1 / m_cell;
+            total = 0;
+            for (std::size_t f = 0; f < nf; ++f) {
+                const auto fi = static_cast<Eigen::Index>(f);
+                for (int a = 0; a < 3; ++a) {
+                    const double c0 = x(faces(fi, 0), a), c1 = x(faces(fi, 1), a), c2 = x(faces(fi, 2), a);
+                    m_lo[f][static_cast<std::size_t>(a)] = cell_of(std::min({c0, c1, c2}), a);
+                    m_hi[f][static_cast<std::size_t>(a)] = cell_of(std::max({c0, c1, c2}), a);
+                }
+                total += cells(m_lo[f], m_hi[f]);
+            }
+            if (total <= 64 * static_cast<std::int64_t>(nf)) break;
+            m_cell *= 2;
+        }
+        const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
+        m_mask = static_cast<std::uint64_t>(buckets) - 1;
+        m_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
+        m_key.resize(static_cast<std::size_t>(total));
+        m_face.resize(static_cast<std::size_t>(total));
+        for (std::size_t f = 0; f < nf; ++f)
+            for_cells(m_lo[f], m_hi[f],
+                      [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) { ++m_start[bucket(cx, cy, cz) + 1]; });
+        for (std::size_t b = 0; b + 1 < m_start.size(); ++b)
+            m_start[b + 1] += m_start[b];
+        std::vector<std::int64_t> next(m_start.begin(), m_start.end() - 1);
+        for (std::size_t f = 0; f < nf; ++f)
+            for_cells(m_lo[f], m_hi[f], [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
+                const auto at = static_cast<std::size_t>(next[bucket(cx, cy, cz)]++);
+                m_key[at] = key(cx, cy, cz);
+                m_face[at] = static_cast<Index>(f);
+            });
+    }
+
+    /// Calls visit(f) once for every triangle whose cell box meets the cell box of lo..hi.
+    template <class Visit> void for_box(const Vec3& lo, const Vec3& hi, Visit&& visit) const
+    {
+        if (m_lo.empty()) return;
+        const Cell clo = {cell_of(lo[0], 0), cell_of(lo[1], 1), cell_of(lo[2], 2)};
+        const Cell chi = {cell_of(hi[0], 0), cell_of(hi[1], 1), cell_of(hi[2], 2)};
+        for_cells(clo, chi, [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
+            const std::uint64_t b = bucket(cx, cy, cz), k = key(cx, cy, cz);
+            for (std::int64_t i = m_start[b]; i < m_start[b + 1]; ++i) {
+                if (m_key[static_cast<std::size_t>(i)] != k) continue;
+                const Index f = m_face[static_cast<std::size_t>(i)];
+                const Cell& flo = m_lo[static_cast<std::size_t>(f)];
+                // Only in the first cell the two cell boxes share.
+                if (cx != std::max(clo[0], flo[0]) || cy != std::max(clo[1], flo[1]) || cz != std::max(clo[2], flo[2]))
+                    continue;
+                visit(f);
+            }
+        });
+    }
+
+  private:
+    std::int32_t cell_of(double v, int a) const
+    {
+        // The origin is the boundary's least corner and the extent is at most 2^20 cells: in [0, 2^21).
+        return std::clamp(floor_to_int((v - m_origin[a]) * m_inv), 0, (1 << 21) - 1);
+    }
+    static std::int64_t cells(const Cell& lo, const Cell& hi)
+    {
+        return std::int64_t{hi[0] - lo[0] + 1} * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    }
+    template <class F> static void for_cells(const Cell& lo, const Cell& hi, F&& f)
+    {
+        for (std::int32_t cx = lo[0]; cx <= hi[0]; ++cx)
+            for (std::int32_t cy = lo[1]; cy <= hi[1]; ++cy)
+                for (std::int32_t cz = lo[2]; cz <= hi[2]; ++cz)
+                    f(cx, cy, cz);
+    }
+    static std::uint64_t key(std::int32_t cx, std::int32_t cy, std::int32_t cz)
+    {
+        return static_cast<std::uint64_t>(cx) | static_cast<std::uint64_t>(cy) << 21 |
+               static_cast<std::uint64_t>(cz) << 42;
+    }
+    std::uint64_t bucket(std::int32_t cx, std::int32_t cy, std::int32_t cz) const
+    {
+        return (column_mix(cx, cy) + static_cast<std::uint64_t>(cz)) & m_mask;
+    }
+
+    Vec3 m_origin = Vec3::Zero();
+    double m_cell = 1, m_inv = 1;
+    std::uint64_t m_mask = 0;
+    std::vector<Cell> m_lo, m_hi;      ///< per face: its cell box
+    std::vector<std::int64_t> m_start; ///< per bucket + 1: the bucket's entries m_start[b] .. m_start[b + 1] − 1
+    std::vector<std::uint64_t> m_key;  ///< per entry: the cell
+    std::vector<Index> m_face;         ///< per entry: the triangle
+};
 
 } // namespace
 
@@ -107,15 +232,8 @@ const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int 
     };
 
     auto point = [&](Index v) { return Vec3(positions(v, 0), positions(v, 1), positions(v, 2)); };
-    detail::TriangleBvh tree;
-    tree.build(
-        static_cast<Index>(faces.rows()),
-        [&](Index f, Vec3& a, Vec3& b, Vec3& c) {
-            a = point(faces(f, 0));
-            b = point(faces(f, 1));
-            c = point(faces(f, 2));
-        },
-        4);
+    FaceGrid grid;
+    grid.build(positions, faces, edges);
 
 #ifdef TETHASH_HAVE_OPENMP
     if (threads <= 0) threads = omp_get_max_threads();
@@ -139,7 +257,7 @@ const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int 
             const bool e_static = m_static[static_cast<std::size_t>(eo)] != 0;
             const Vec3 p = point(ev[0]), q = point(ev[1]);
             const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
-            tree.for_box(lo, hi, [&](Index f) {
+            grid.for_box(lo, hi, [&](Index f) {
                 const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
                 const Vec3 a = point(fv[0]), b = point(fv[1]), c = point(fv[2]);
                 if ((lo.array() > a.cwiseMax(b).cwiseMax(c).array()).any() ||
