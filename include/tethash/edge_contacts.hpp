@@ -18,7 +18,8 @@
 ///  - between objects: every boundary edge against every boundary triangle, unless both objects are static;
 ///  - within an object (only when its self_collision is on): the pair is **distant**: no vertex of the edge and no
 ///    vertex of the triangle are the same or share a tet (are joined by a mesh edge). So a triangle and an edge that
-///    touch, or that are one tet apart, never count; two tet layers between them suffice.
+///    touch, or that have a vertex each in one tet, never count; a pair is tested when every vertex of the edge is
+///    at least two mesh edges from every vertex of the triangle.
 /// An edge's object is its first vertex's, a triangle's its first vertex's (objects do not share vertices).
 
 #include "tethash/detect.hpp"
@@ -72,8 +73,8 @@ EdgeFaceCrossing edge_face_crossing(const double* p, const double* q, const doub
                                     const double* c);
 
 /// Finds the edge-face contacts of a fixed topology at positions that change (an FEM code's steps): the boundary,
-/// the vertices' neighbours and the object rules are computed once in set_topology; each find() builds a box tree
-/// over the boundary triangles at the new positions and queries every boundary edge's box in it.
+/// the vertices' neighbours and the object rules are computed once in set_topology; each find() hashes the boundary
+/// triangles' boxes at the new positions into a cell grid and visits the cells of every boundary edge's box.
 class EdgeFaceDetector {
   public:
     /// `tets` m × 4; `vertex_object`, `tet_object` (empty: all 0) and `objects` (missing: defaults) as for

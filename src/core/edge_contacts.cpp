@@ -1,6 +1,6 @@
 // Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, a hashed cell grid over its
-// triangles, each boundary edge's box queried in it, the object rules, the exact crossing
-// test; per-thread lists merged and sorted.
+// triangles, each boundary edge's box queried in it, the object rules, the exact crossing test; per-thread lists
+// merged and sorted.
 #include "tethash/edge_contacts.hpp"
 
 #include "boundary_edges.hpp"
