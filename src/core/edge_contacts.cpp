@@ -63,13 +63,16 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 using Cell = std::array<std::int32_t, 3>;
+struct Box {
+    double lo[3], hi[3];
+};
 
 /// The broad phase: a uniform grid over the boundary triangles' boxes, its cells hashed into a table by columns (the
 /// Detector's column hash, hash_grid.hpp: the cells of one (x, y) column in consecutive buckets) and filled by a
 /// counting sort in face order, so the table depends on the input only. An edge visits the cells of its box and
 /// meets a triangle in the first cell the two cell boxes share, so each pair once. It replaced the core's box tree
 /// (triangle_bvh.hpp), whose node boxes overlap on overlapping bodies: 10-20 % less time per call on the scenes of
-/// `tethash_bench --edges` (scenario 5: 55 vs 66 ms, the mat: 142 vs 169 ms, on a loaded machine).
+/// `tethash_bench --edges` (docs/ccd.md).
 class FaceGrid {
   public:
     /// Cell size: the mean boundary edge length, doubled while the triangles would cover more than 64 cells each on
@@ -95,16 +98,23 @@ class FaceGrid {
         if (!(m_cell > 0) || !std::isfinite(m_cell)) m_cell = 1;
         m_lo.resize(nf);
         m_hi.resize(nf);
+        m_box.resize(nf);
+        for (std::size_t f = 0; f < nf; ++f) {
+            const auto fi = static_cast<Eigen::Index>(f);
+            for (int a = 0; a < 3; ++a) {
+                const double c0 = x(faces(fi, 0), a), c1 = x(faces(fi, 1), a), c2 = x(faces(fi, 2), a);
+                m_box[f].lo[a] = std::min({c0, c1, c2});
+                m_box[f].hi[a] = std::max({c0, c1, c2});
+            }
+        }
         std::int64_t total = 0;
         for (;;) {
             m_inv = 1 / m_cell;
             total = 0;
             for (std::size_t f = 0; f < nf; ++f) {
-                const auto fi = static_cast<Eigen::Index>(f);
                 for (int a = 0; a < 3; ++a) {
-                    const double c0 = x(faces(fi, 0), a), c1 = x(faces(fi, 1), a), c2 = x(faces(fi, 2), a);
-                    m_lo[f][static_cast<std::size_t>(a)] = cell_of(std::min({c0, c1, c2}), a);
-                    m_hi[f][static_cast<std::size_t>(a)] = cell_of(std::max({c0, c1, c2}), a);
+                    m_lo[f][static_cast<std::size_t>(a)] = cell_of(m_box[f].lo[a], a);
+                    m_hi[f][static_cast<std::size_t>(a)] = cell_of(m_box[f].hi[a], a);
                 }
                 total += cells(m_lo[f], m_hi[f]);
             }
@@ -114,8 +124,7 @@ class FaceGrid {
         const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
         m_mask = static_cast<std::uint64_t>(buckets) - 1;
         m_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
-        m_key.resize(static_cast<std::size_t>(total));
-        m_face.resize(static_cast<std::size_t>(total));
+        m_entry.resize(static_cast<std::size_t>(total));
         for (std::size_t f = 0; f < nf; ++f)
             for_cells(m_lo[f], m_hi[f],
                       [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) { ++m_start[bucket(cx, cy, cz) + 1]; });
@@ -125,27 +134,29 @@ class FaceGrid {
         for (std::size_t f = 0; f < nf; ++f)
             for_cells(m_lo[f], m_hi[f], [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
                 const auto at = static_cast<std::size_t>(next[bucket(cx, cy, cz)]++);
-                m_key[at] = key(cx, cy, cz);
-                m_face[at] = static_cast<Index>(f);
+                m_entry[at] = {key(cx, cy, cz), static_cast<Index>(f), m_lo[f], m_box[f]};
             });
     }
 
-    /// Calls visit(f) once for every triangle whose cell box meets the cell box of lo..hi.
+    /// Calls visit(f) once for every triangle whose box meets the box lo..hi.
     template <class Visit> void for_box(const Vec3& lo, const Vec3& hi, Visit&& visit) const
     {
-        if (m_lo.empty()) return;
+        if (m_entry.empty()) return;
         const Cell clo = {cell_of(lo[0], 0), cell_of(lo[1], 1), cell_of(lo[2], 2)};
         const Cell chi = {cell_of(hi[0], 0), cell_of(hi[1], 1), cell_of(hi[2], 2)};
         for_cells(clo, chi, [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
             const std::uint64_t b = bucket(cx, cy, cz), k = key(cx, cy, cz);
             for (std::int64_t i = m_start[b]; i < m_start[b + 1]; ++i) {
-                if (m_key[static_cast<std::size_t>(i)] != k) continue;
-                const Index f = m_face[static_cast<std::size_t>(i)];
-                const Cell& flo = m_lo[static_cast<std::size_t>(f)];
+                const Entry& en = m_entry[static_cast<std::size_t>(i)];
+                if (en.key != k) continue;
                 // Only in the first cell the two cell boxes share.
-                if (cx != std::max(clo[0], flo[0]) || cy != std::max(clo[1], flo[1]) || cz != std::max(clo[2], flo[2]))
+                if (cx != std::max(clo[0], en.lo[0]) || cy != std::max(clo[1], en.lo[1]) ||
+                    cz != std::max(clo[2], en.lo[2]))
                     continue;
-                visit(f);
+                if ((lo[0] > en.box.hi[0]) | (lo[1] > en.box.hi[1]) | (lo[2] > en.box.hi[2]) | (hi[0] < en.box.lo[0]) |
+                    (hi[1] < en.box.lo[1]) | (hi[2] < en.box.lo[2]))
+                    continue;
+                visit(en.face);
             }
         });
     }
@@ -182,8 +193,16 @@ class FaceGrid {
     std::uint64_t m_mask = 0;
     std::vector<Cell> m_lo, m_hi;      ///< per face: its cell box
     std::vector<std::int64_t> m_start; ///< per bucket + 1: the bucket's entries m_start[b] .. m_start[b + 1] − 1
-    std::vector<std::uint64_t> m_key;  ///< per entry: the cell
-    std::vector<Index> m_face;         ///< per entry: the triangle
+    /// An entry: a triangle in a cell, with what the query tests, so that a bucket is read in one sweep (a dense
+    /// sheet puts tens of triangles in a cell; reading their boxes from the positions cost a cache miss each).
+    struct Entry {
+        std::uint64_t key; ///< the cell
+        Index face;        ///< the triangle
+        Cell lo;           ///< the triangle's first cell
+        Box box;           ///< the triangle's box
+    };
+    std::vector<Box> m_box;     ///< per face
+    std::vector<Entry> m_entry; ///< per entry, by bucket
 };
 
 } // namespace
@@ -259,10 +278,6 @@ const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int 
             const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
             grid.for_box(lo, hi, [&](Index f) {
                 const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
-                const Vec3 a = point(fv[0]), b = point(fv[1]), c = point(fv[2]);
-                if ((lo.array() > a.cwiseMax(b).cwiseMax(c).array()).any() ||
-                    (hi.array() < a.cwiseMin(b).cwiseMin(c).array()).any())
-                    return;
                 const Index fo = m_face_object[static_cast<std::size_t>(f)];
                 if (e_static && m_static[static_cast<std::size_t>(fo)]) return;
                 if (eo == fo) {
@@ -272,6 +287,7 @@ const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int 
                     return;
                 }
                 ++count;
+                const Vec3 a = point(fv[0]), b = point(fv[1]), c = point(fv[2]);
                 const EdgeFaceCrossing x = edge_face_crossing(p.data(), q.data(), a.data(), b.data(), c.data());
                 if (!x.crosses) return;
                 EdgeFaceContact ct;
