@@ -3,6 +3,7 @@
 // status and a message naming the function (never a crash).
 #include "core_scenes.hpp"
 
+#include "tethash/edge_contacts.hpp"
 #include "tethash/oracle.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/tethash.h"
@@ -117,6 +118,61 @@ TEST(CoreCapi, SameContactsAsDetectorAndOracle)
         for (const tethash_contact& x : c)
             EXPECT_TRUE(std::isnan(x.depth));
     }
+}
+
+TEST(CoreCapi, EdgeContactsAsCppWithObjectOptions)
+{
+    const test::Scene s = test::random_scene(7, 3, 3, 0.3);
+    std::vector<ObjectOptions> objects(3);
+    objects[1].self_collision = false;
+    objects[0].is_static = objects[2].is_static = true;
+    Handle h;
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 1, 0, 0), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 0, 1, 1), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 2, 1, 1), TETHASH_OK);
+    ASSERT_EQ(tethash_detector_set_threads(h.d, 2), TETHASH_OK);
+    set_topology(h.d, s);
+    int64_t count = -1;
+    ASSERT_EQ(tethash_detector_find_edge_contacts(h.d, s.positions.data(), s.positions.rows(), &count), TETHASH_OK)
+        << tethash_last_error();
+    const EdgeFaceResult want =
+        brute_force_edge_face_contacts(s.tets, s.positions, s.vertex_object, s.tet_object, objects);
+    ASSERT_EQ(count, static_cast<int64_t>(want.contacts.size()));
+    EXPECT_GT(count, 0);
+    const auto n = static_cast<std::size_t>(count);
+    std::vector<int32_t> edge(2 * n), face(3 * n), obj(2 * n), inner(n);
+    std::vector<double> t(n), bary(3 * n), normal(3 * n);
+    EXPECT_EQ(tethash_detector_get_edge_contacts(h.d, count - 1, edge.data(), nullptr, nullptr, nullptr, nullptr,
+                                                 nullptr, nullptr),
+              TETHASH_ERROR_INVALID_ARGUMENT);
+    ASSERT_EQ(tethash_detector_get_edge_contacts(h.d, count, edge.data(), face.data(), obj.data(), t.data(),
+                                                 bary.data(), inner.data(), normal.data()),
+              TETHASH_OK);
+    for (std::size_t i = 0; i < n; ++i) {
+        const EdgeFaceContact& c = want.contacts[i];
+        EXPECT_EQ(edge[2 * i], c.edge_vertices[0]);
+        EXPECT_EQ(edge[2 * i + 1], c.edge_vertices[1]);
+        for (std::size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ(face[3 * i + k], c.face_vertices[k]);
+            EXPECT_EQ(bary[3 * i + k], c.face_bary[k]);
+            EXPECT_EQ(normal[3 * i + k], c.normal[k]);
+        }
+        EXPECT_EQ(obj[2 * i], c.edge_object);
+        EXPECT_EQ(obj[2 * i + 1], c.face_object);
+        EXPECT_EQ(t[i], c.edge_t);
+        EXPECT_EQ(inner[i], c.inner_end);
+        EXPECT_FALSE(objects[static_cast<std::size_t>(c.edge_object)].is_static &&
+                     objects[static_cast<std::size_t>(c.face_object)].is_static);
+    }
+    // A wrong vertex count, and no topology: a status and a message.
+    EXPECT_EQ(tethash_detector_find_edge_contacts(h.d, s.positions.data(), s.positions.rows() - 1, &count),
+              TETHASH_ERROR_INVALID_ARGUMENT);
+    Handle fresh;
+    EXPECT_EQ(tethash_detector_find_edge_contacts(fresh.d, s.positions.data(), s.positions.rows(), &count),
+              TETHASH_ERROR_STATE);
+    EXPECT_EQ(
+        tethash_detector_get_edge_contacts(fresh.d, 0, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr, nullptr),
+        TETHASH_OK);
 }
 
 TEST(CoreCapi, ParametersAndObjectOptionsPassThrough)

@@ -6,6 +6,7 @@
 /// so that each tet only looks at the vertices within its x-extent (still all pairs that can touch).
 
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 
 #include <span>
@@ -30,5 +31,14 @@ std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const T
                                           std::span<const Index> vertex_object = {},
                                           std::span<const Index> tet_object = {},
                                           std::span<const ObjectOptions> objects = {}, OracleStats* stats = nullptr);
+
+/// All edge-face contacts (edge_contacts.hpp) by a loop over every boundary edge and every boundary triangle, with
+/// the same exact test (edge_face_crossing) and rules, the "distant" rule of a self pair checked on the vertices'
+/// tets (no tet holds a vertex of each); `candidates` counts the pairs the rules allow. Same inputs and errors as
+/// find_edge_face_contacts; serial.
+EdgeFaceResult brute_force_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
+                                              std::span<const Index> vertex_object = {},
+                                              std::span<const Index> tet_object = {},
+                                              std::span<const ObjectOptions> objects = {});
 
 } // namespace tethash

@@ -128,6 +128,27 @@ module tethash
       real(c_double), intent(out), optional :: bary(*), depth(*), direction(*)
       integer(c_int) :: status
     end function
+    ! Edge-face contacts (tethash.h): boundary edges crossing boundary triangles at positions(3, num_vertices).
+    function tethash_detector_find_edge_contacts(detector, positions, num_vertices, count) &
+        bind(C, name="tethash_detector_find_edge_contacts") result(status)
+      import :: c_ptr, c_int, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      real(c_double), intent(in) :: positions(*)
+      integer(c_int64_t), value :: num_vertices
+      integer(c_int64_t), intent(out) :: count
+      integer(c_int) :: status
+    end function
+    ! Absent optional arrays are not filled: edge(2, capacity) and face(3, capacity) (0-based vertex ids),
+    ! objects(2, capacity), t(capacity), face_bary(3, capacity), inner_end(capacity), normal(3, capacity).
+    function tethash_detector_get_edge_contacts(detector, capacity, edge, face, objects, t, face_bary, inner_end, &
+                                                normal) bind(C, name="tethash_detector_get_edge_contacts") result(status)
+      import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      integer(c_int64_t), value :: capacity
+      integer(c_int32_t), intent(out), optional :: edge(*), face(*), objects(*), inner_end(*)
+      real(c_double), intent(out), optional :: t(*), face_bary(*), normal(*)
+      integer(c_int) :: status
+    end function
     function tethash_detector_compute_penetration(detector, positions, num_vertices) &
         bind(C, name="tethash_detector_compute_penetration") result(status)
       import :: c_ptr, c_int, c_int64_t, c_double

@@ -126,6 +126,23 @@ tethash_status tethash_detector_compute_penetration(tethash_detector* detector, 
 /** Statistics of the last detection. */
 tethash_status tethash_detector_stats(const tethash_detector* detector, tethash_stats* out_stats);
 
+/** Edge-face contacts (edge_contacts.hpp): boundary edges crossing a boundary triangle of another object, or of a
+ *  distant part of their own (no vertex of the edge and of the triangle the same or in one tet), at `positions`
+ *  (num_vertices x 3, read in place), with the detector's topology, object options and threads. Writes their number
+ *  to `out_count` (may be NULL); they stay readable until the next call or set_topology. Independent of
+ *  tethash_detector_detect (its contacts are kept). */
+tethash_status tethash_detector_find_edge_contacts(tethash_detector* detector, const double* positions,
+                                                   int64_t num_vertices, int64_t* out_count);
+/** Copies the edge-face contacts of the last tethash_detector_find_edge_contacts, sorted by (edge, face), into caller
+ *  arrays of `capacity` rows, each may be NULL: edge (capacity x 2 vertex ids, increasing), face (capacity x 3 vertex
+ *  ids, outward order), objects (capacity x 2: the edge's, the face's), t (capacity: the crossing point is
+ *  (1 - t) x[edge0] + t x[edge1]), face_bary (capacity x 3), inner_end (capacity: 0 or 1, the end of the edge on the
+ *  triangle's inner side), normal (capacity x 3: the triangle's unit normal from its inner to its outer side).
+ *  `capacity` must be at least their count. */
+tethash_status tethash_detector_get_edge_contacts(const tethash_detector* detector, int64_t capacity, int32_t* edge,
+                                                  int32_t* face, int32_t* objects, double* t, double* face_bary,
+                                                  int32_t* inner_end, double* normal);
+
 /** Continuous queries (ccd.hpp): whether two primitives moving linearly from their start positions (t = 0) to their
  *  end positions (t = 1) meet. `start` and `end`: 4 x 3 doubles each, vertex-face (p, a, b, c: the vertex and the
  *  triangle's corners) or edge-edge (ea0, ea1, eb0, eb1). `tolerance` > 0 (in the coordinates' units; 1e-6 for

@@ -5,6 +5,7 @@
 
 #include "tethash/ccd.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/penetration.hpp"
 
@@ -31,6 +32,9 @@ struct tethash_detector {
     std::vector<tethash::ObjectOptions> objects;
     tethash::DetectStats stats;
     bool detected = false; ///< contacts() belong to the current topology
+    tethash::EdgeFaceDetector edges;
+    bool edges_ready = false;                             ///< edges has the current topology and object options
+    const tethash::EdgeFaceResult* edge_result = nullptr; ///< the last edge-face contacts of the current topology
 };
 
 namespace {
@@ -82,6 +86,8 @@ void apply_topology(tethash_detector& d)
     d.detected = false;
     d.penetration_ready = false;
     d.has_topology = false;
+    d.edges_ready = false;
+    d.edge_result = nullptr;
     d.detector.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object, d.objects);
     d.has_topology = true;
 }
@@ -410,6 +416,58 @@ tethash_status tethash_detector_stats(const tethash_detector* detector, tethash_
     out_stats->contacts = s.contacts;
     out_stats->reused = s.reused;
     out_stats->threads = s.threads;
+    return TETHASH_OK;
+}
+
+tethash_status tethash_detector_find_edge_contacts(tethash_detector* detector, const double* positions,
+                                                   int64_t num_vertices, int64_t* out_count)
+{
+    const char* where = "tethash_detector_find_edge_contacts";
+    if (out_count) *out_count = 0;
+    if (const tethash_status s = check_positions(where, detector, &tethash_detector::has_topology, "no topology set",
+                                                 positions, num_vertices);
+        s != TETHASH_OK)
+        return s;
+    return guard(where, [&] {
+        tethash_detector& d = *detector;
+        d.edge_result = nullptr;
+        if (!d.edges_ready) {
+            const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+            d.edges.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object, d.objects);
+            d.edges_ready = true;
+        }
+        const Eigen::Map<const tethash::Positions> map(positions, static_cast<Eigen::Index>(num_vertices), 3);
+        d.edge_result = &d.edges.find(map, d.detector.params().threads);
+        if (out_count) *out_count = static_cast<int64_t>(d.edge_result->contacts.size());
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_get_edge_contacts(const tethash_detector* detector, int64_t capacity, int32_t* edge,
+                                                  int32_t* face, int32_t* objects, double* t, double* face_bary,
+                                                  int32_t* inner_end, double* normal)
+{
+    const char* where = "tethash_detector_get_edge_contacts";
+    if (!detector) return null_argument(where, "detector");
+    const std::size_t count = detector->edge_result ? detector->edge_result->contacts.size() : 0;
+    if (capacity < 0 || static_cast<std::size_t>(capacity) < count)
+        return invalid(where, "capacity " + std::to_string(capacity) + " is less than the " + std::to_string(count) +
+                                  " edge-face contacts");
+    for (std::size_t i = 0; i < count; ++i) {
+        const tethash::EdgeFaceContact& c = detector->edge_result->contacts[i];
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (edge && k < 2) edge[2 * i + k] = c.edge_vertices[k];
+            if (face) face[3 * i + k] = c.face_vertices[k];
+            if (face_bary) face_bary[3 * i + k] = c.face_bary[k];
+            if (normal) normal[3 * i + k] = c.normal[k];
+        }
+        if (objects) {
+            objects[2 * i] = c.edge_object;
+            objects[2 * i + 1] = c.face_object;
+        }
+        if (t) t[i] = c.edge_t;
+        if (inner_end) inner_end[i] = c.inner_end;
+    }
     return TETHASH_OK;
 }
 

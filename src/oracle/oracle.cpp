@@ -1,6 +1,7 @@
 // Brute-force reference: all vertices × all tets (x-sorted to skip pairs whose x-extents cannot meet).
 #include "tethash/oracle.hpp"
 
+#include "../core/boundary_edges.hpp"
 #include "../core/detect_checks.hpp"
 #include "tethash/predicates.hpp"
 
@@ -89,6 +90,78 @@ std::vector<Contact> brute_force_contacts(const PositionsRef& positions, const T
         stats->exact_evaluations = exact;
     }
     return out;
+}
+
+EdgeFaceResult brute_force_edge_face_contacts(const TetsRef& tets, const PositionsRef& positions,
+                                              std::span<const Index> vertex_object, std::span<const Index> tet_object,
+                                              std::span<const ObjectOptions> objects)
+{
+    const Index n = static_cast<Index>(positions.rows());
+    detail::check_topology(tets, n, vertex_object, tet_object);
+    detail::check_positions(positions, n);
+    const detail::ObjectFlags flags = detail::object_flags(vertex_object, tet_object, objects);
+    auto vobj = [&](Index v) { return vertex_object.empty() ? Index(0) : vertex_object[static_cast<std::size_t>(v)]; };
+    const Adjacency incident = vertex_tets(tets, n);
+    // Whether vertices u and w are the same or lie in one tet (sorted tet lists intersect).
+    auto share_tet = [&](Index u, Index w) {
+        if (u == w) return true;
+        const auto* a = incident.neighbours.data() + incident.offsets[static_cast<std::size_t>(u)];
+        const auto* a_end = incident.neighbours.data() + incident.offsets[static_cast<std::size_t>(u) + 1];
+        const auto* b = incident.neighbours.data() + incident.offsets[static_cast<std::size_t>(w)];
+        const auto* b_end = incident.neighbours.data() + incident.offsets[static_cast<std::size_t>(w) + 1];
+        while (a != a_end && b != b_end) {
+            if (*a == *b) return true;
+            if (*a < *b)
+                ++a;
+            else
+                ++b;
+        }
+        return false;
+    };
+    EdgeFaceResult result;
+    result.faces = boundary_faces(tets);
+    result.edges = detail::edges_of_faces(result.faces);
+    for (Index e = 0; e < result.edges.rows(); ++e)
+        for (Index f = 0; f < result.faces.rows(); ++f) {
+            const Index ev[2] = {result.edges(e, 0), result.edges(e, 1)};
+            const Index fv[3] = {result.faces(f, 0), result.faces(f, 1), result.faces(f, 2)};
+            const Index eo = vobj(ev[0]), fo = vobj(fv[0]);
+            if (flags.is_static[static_cast<std::size_t>(eo)] && flags.is_static[static_cast<std::size_t>(fo)])
+                continue;
+            if (eo == fo && !flags.self_collision[static_cast<std::size_t>(eo)]) continue;
+            bool near = false;
+            for (const Index u : ev)
+                for (const Index w : fv)
+                    near = near || (eo == fo ? share_tet(u, w) : u == w);
+            if (near) continue;
+            ++result.candidates;
+            double p[2][3], c[3][3];
+            for (int a = 0; a < 3; ++a) {
+                for (int k = 0; k < 2; ++k)
+                    p[k][a] = positions(ev[k], a);
+                for (int k = 0; k < 3; ++k)
+                    c[k][a] = positions(fv[k], a);
+            }
+            const EdgeFaceCrossing x = edge_face_crossing(p[0], p[1], c[0], c[1], c[2]);
+            if (!x.crosses) continue;
+            EdgeFaceContact ct;
+            ct.edge = e;
+            ct.face = f;
+            for (int k = 0; k < 2; ++k)
+                ct.edge_vertices[k] = ev[k];
+            for (int k = 0; k < 3; ++k) {
+                ct.face_vertices[k] = fv[k];
+                ct.face_bary[k] = x.face_bary[k];
+            }
+            ct.edge_object = eo;
+            ct.face_object = fo;
+            ct.edge_t = x.edge_t;
+            ct.inner_end = x.inner_end;
+            for (int k = 0; k < 3; ++k)
+                ct.normal[k] = x.normal[k];
+            result.contacts.push_back(ct);
+        }
+    return result;
 }
 
 } // namespace tethash

@@ -4,7 +4,9 @@
  * Vertex 7 lies in tet 0 with barycentric coordinates (0.5, 0.2, 0.2, 0.1); nothing else touches. Every edge from
  * vertex 7 leaves tet 0 through its face z = 0 (outward normal -z), 0.1 below the vertex, so the penetration depth
  * is 0.1 and the direction (0, 0, -1). Moving vertex 7 to z = -0.1 in the caller's array (no new registration)
- * leaves no contact. Exit status 0 when everything holds, 1 otherwise. */
+ * leaves no contact. The edges from the base to vertex 7 (4-7, 5-7, 6-7) cross tet 0's face z = 0 at t = 1 / 1.1 of
+ * the way, their inner end (vertex 7) above it, the triangle's normal (0, 0, -1): three edge-face contacts, none
+ * after the move. Exit status 0 when everything holds, 1 otherwise. */
 #include <tethash/tethash.h>
 
 #include <math.h>
@@ -75,10 +77,35 @@ int main(void)
     check(strstr(tethash_last_error(), "num_vertices") != NULL, "message names num_vertices");
     printf("expected error: %s\n", tethash_last_error());
 
+    /* Edge-face contacts: the three edges into tet 0 through its base. */
+    check(tethash_detector_find_edge_contacts(d, xyz, 8, &count) == TETHASH_OK, "find_edge_contacts");
+    check(count == 3, "three edge-face contacts");
+    if (count == 3) {
+        int32_t edge[6], face[9], objects[6], inner[3];
+        double t[3], normal[9];
+        check(tethash_detector_get_edge_contacts(d, 3, edge, face, objects, t, NULL, inner, normal) == TETHASH_OK,
+              "get_edge_contacts");
+        for (int i = 0; i < 3; ++i) {
+            check(edge[2 * i] == 4 + i && edge[2 * i + 1] == 7, "edges 4-7, 5-7, 6-7");
+            check(face[3 * i] + face[3 * i + 1] + face[3 * i + 2] == 3 && face[3 * i] <= 2 && face[3 * i + 1] <= 2,
+                  "face 0 1 2");
+            check(objects[2 * i] == 1 && objects[2 * i + 1] == 0, "edge of object 1 through a face of object 0");
+            check(near(t[i], 1 / 1.1) && inner[i] == 1, "crossing 1 / 1.1 along, vertex 7 inside");
+            check(near(normal[3 * i], 0) && near(normal[3 * i + 1], 0) && near(normal[3 * i + 2], -1), "normal -z");
+        }
+        printf("edge-face contact: edge %d %d, t %.6f, normal %.3f %.3f %.3f\n", edge[0], edge[1], t[0], normal[0],
+               normal[1], normal[2]);
+    }
+    check(tethash_detector_get_edge_contacts(d, 2, NULL, NULL, NULL, NULL, NULL, NULL, NULL) ==
+              TETHASH_ERROR_INVALID_ARGUMENT,
+          "capacity below the count refused");
+
     /* The caller moves its own array; the next detection reads it in place. */
     xyz[7 * 3 + 2] = -0.1;
     check(tethash_detector_detect(d, xyz, 8, &count) == TETHASH_OK, "detect after the move");
     check(count == 0, "no contact after the move");
+    check(tethash_detector_find_edge_contacts(d, xyz, 8, &count) == TETHASH_OK && count == 0,
+          "no edge-face contact after the move");
 
     tethash_detector_destroy(d);
 

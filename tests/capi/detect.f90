@@ -1,6 +1,7 @@
 ! A Fortran program using the detector through the `tethash` module, on the scene of detect.c, checked against the
 ! result worked out by hand there: vertex 8 (0-based 7) at (0.2, 0.2, 0.1) inside tet 1 (0-based 0), barycentric
-! (0.5, 0.2, 0.2, 0.1), penetration depth 0.1 along -z; no contact after the caller moves it to z = -0.1.
+! (0.5, 0.2, 0.2, 0.1), penetration depth 0.1 along -z, and the three edge-face contacts of the edges into it; no
+! contact after the caller moves it to z = -0.1.
 ! Stops with status 1 on any failure.
 program detect_fortran
   use, intrinsic :: iso_c_binding
@@ -18,6 +19,8 @@ program detect_fortran
   integer :: failures
   real(c_double) :: ccd_start(3, 4), ccd_end(3, 4), toi
   integer(c_int32_t) :: hit
+  integer(c_int32_t) :: edge(2, 3), inner_end(3)
+  real(c_double) :: t(3), normal(3, 3)
 
   failures = 0
   x = reshape([0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, &
@@ -57,6 +60,17 @@ program detect_fortran
   call expect(tethash_detector_detect(d, x, 7_c_int64_t, count) == TETHASH_ERROR_INVALID_ARGUMENT, "wrong size refused")
   call expect(index(tethash_error_message(), "num_vertices") > 0, "message names num_vertices")
   print *, 'expected error: ', tethash_error_message()
+
+  ! Edge-face contacts: the edges 4-7, 5-7, 6-7 enter tet 0 through its base z = 0, 1 / 1.1 of the way along.
+  call ok(tethash_detector_find_edge_contacts(d, x, 8_c_int64_t, count), "find_edge_contacts")
+  call expect(count == 3, "three edge-face contacts")
+  if (count == 3) then
+    call ok(tethash_detector_get_edge_contacts(d, 3_c_int64_t, edge=edge, t=t, inner_end=inner_end, normal=normal), &
+            "get_edge_contacts")
+    call expect(all(edge(1, :) == [4, 5, 6]) .and. all(edge(2, :) == 7), "edges 4-7, 5-7, 6-7")
+    call expect(all(abs(t - 1d0 / 1.1d0) < 1d-12) .and. all(inner_end == 1), "t and inner end")
+    call expect(all(abs(normal(3, :) + 1d0) < 1d-12), "normal -z")
+  end if
 
   ! The caller moves its own array; the next detection reads it in place.
   x(3, 8) = -0.1d0

@@ -6,12 +6,15 @@
 //   tethash_bench [--repeat K] [--threads N] [--scenario I] [--sweep] [--no-meshes] [--no-baseline] [--cell-factor F]
 //                 [--hash column|teschner] [--table-factor F]
 //   tethash_bench --moving [--scenario I] [--steps N] [--speed F] [--threads N]: a moving scene (candidate reuse)
+//   tethash_bench --edges [--scenario I] [--no-meshes]: the edge-face contacts (edge_contacts.hpp) beside the
+//                 vertex-in-tet detection on the same scenes
 //   tethash_bench --methods hash,bvh,kd [--partition-scenes bars,sizes]: the other broad phases on every scene, in the
 //                 same run as the hash and the baseline (medians at 1 thread)
 //   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building and the hall with every
 //   object
 //                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/portals.hpp"
@@ -376,10 +379,41 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
 
 } // namespace
 
+/// --edges: the edge-face contacts of one scene: set-up (boundary, neighbours; once per topology), find() at 1 thread
+/// (CPU time of the thread, median) and at `threads_all` (wall, median), beside the vertex-in-tet detection at 1
+/// thread.
+void report_edges(const char* name, const TetMesh& m, const DetectParams& base, int threads_all, int repeat)
+{
+    EdgeFaceDetector det;
+    const auto t0 = Clock::now();
+    det.set_topology(m.tets, m.num_vertices(), m.vertex_object, m.tet_object);
+    const double setup_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    det.find(m.positions, 1); // warm-up
+    std::vector<double> one, all;
+    for (int r = 0; r < repeat; ++r) {
+        const double c0 = thread_cpu_ms();
+        det.find(m.positions, 1);
+        one.push_back(thread_cpu_ms() - c0);
+        const auto w0 = Clock::now();
+        det.find(m.positions, threads_all);
+        all.push_back(std::chrono::duration<double, std::milli>(Clock::now() - w0).count());
+    }
+    const EdgeFaceResult& r = det.find(m.positions, 1);
+    DetectParams p = base;
+    p.threads = 1;
+    const Measured v = measure(m, p, repeat);
+    std::printf("%-28s %6lld edges %6lld faces  set-up %7.3f ms  find %7.3f ms (1 thread, cpu) %7.3f ms (%d threads)  "
+                "%7lld candidates %6zu edge-face contacts | vertex-in-tet %7.3f ms (1 thread, cpu) %6lld contacts\n",
+                name, static_cast<long long>(r.edges.rows()), static_cast<long long>(r.faces.rows()), setup_ms,
+                median(one), median(all), threads_all, static_cast<long long>(r.candidates), r.contacts.size(),
+                v.cpu_ms, static_cast<long long>(v.stats.contacts));
+    std::fflush(stdout);
+}
+
 int main(int argc, char** argv)
 {
     int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100, rooms = 0, leaf_size = 0;
-    bool sweep = false, no_meshes = false, no_baseline = false, moving = false, walk = false;
+    bool sweep = false, no_meshes = false, no_baseline = false, moving = false, walk = false, edges = false;
     double speed = 0.01, cell_factor = 1.0, table_factor = 0, walk_speed = 0.05;
     std::string hash = "column", methods_text, partition_scenes = "all";
     CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
@@ -407,6 +441,9 @@ int main(int argc, char** argv)
                    "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, "
                    "building, hall, all or none")
         ->capture_default_str();
+    app.add_flag("--edges", edges,
+                 "the edge-face contacts (set-up, find at 1 and all threads) beside vertex-in-tet detection, on the "
+                 "scenarios (--scenario I: one) and the shared meshes (two copies overlapping; --no-meshes: none)");
     app.add_flag("--moving", moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
     app.add_option("--steps", steps, "--moving: steps (at least 2)")->capture_default_str();
     app.add_option("--speed", speed, "--moving: fastest vertex per step, as a factor of the mean edge")
@@ -502,6 +539,41 @@ int main(int argc, char** argv)
         report_walk(methods, base, std::max(2, steps), walk_speed, rooms);
         return 0;
     }
+    if (edges) {
+        for (int k = 0; k < 5; ++k) {
+            if (only > 0 && only != k + 1) continue;
+            const study::Scenario sc = study::teschner_scenario(k);
+            const std::string name = "scenario " + std::to_string(k + 1);
+            report_edges(name.c_str(), sc.mesh, base, threads_all, repeat);
+        }
+        const std::filesystem::path dir = TETHASH_SHARED_MESHES;
+        if (meshes && only < 0 && std::filesystem::exists(dir)) {
+            std::vector<std::filesystem::path> files;
+            for (const auto& e : std::filesystem::directory_iterator(dir))
+                files.push_back(e.path());
+            std::sort(files.begin(), files.end());
+            for (const auto& f : files) {
+                if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;
+                try {
+                    TetMesh one = io::read_mesh(f.string());
+                    // Two copies, the second shifted by a fifth of the size: overlapping objects, as in the main run.
+                    const Eigen::RowVector3d lo = one.positions.colwise().minCoeff(),
+                                             hi = one.positions.colwise().maxCoeff();
+                    one.vertex_object.clear();
+                    one.tet_object.clear();
+                    one.ensure_object_ids();
+                    TetMesh two = one;
+                    two.positions.rowwise() += 0.2 * (hi - lo);
+                    one.append(two);
+                    report_edges(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3));
+                } catch (const std::exception& e) {
+                    std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
+                }
+            }
+        }
+        return 0;
+    }
+
     if (moving) {
         report_moving(study::teschner_scenario(only > 0 ? only - 1 : 4), base, threads_all, steps, speed);
         return 0;

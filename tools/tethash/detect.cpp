@@ -5,6 +5,7 @@
 
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/cells.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -48,6 +49,8 @@ struct DetectOptions {
     std::vector<std::string> obstacles; ///< closed surfaces, each a static BSP obstacle
     bool continuous = false;            ///< the two meshes are frames: contacts over the step between them
     std::string cells_path;             ///< --cells: the cells and portals of --method portals (io/cells.hpp)
+    bool edges = false;                 ///< also the edge-face contacts (edge_contacts.hpp)
+    std::string edge_contacts_path;     ///< their CSV (implies edges)
 };
 
 /// One input file of the scene: where its vertices and tets start in the scene, and its own numbering.
@@ -132,6 +135,42 @@ std::string contacts_csv(const std::vector<Contact>& contacts, const std::vector
     return csv;
 }
 
+/// Edge-face contacts as CSV: a header comment saying which column is which, then one row per contact sorted by
+/// (edge, face).
+std::string edge_contacts_csv(const EdgeFaceResult& r, const std::vector<InputFile>& files)
+{
+    std::string csv =
+        "# tethash detect --edges: each row is a boundary edge crossing a boundary triangle of another object or of a "
+        "distant part of its own (no vertex of the edge and of the triangle the same or in one tet).\n"
+        "# e0, e1: the edge's vertices; f0, f1, f2: the triangle's (outward order); 0-based ids in the scene (the "
+        "input files joined in argument order).\n"
+        "# edge_object, face_object: objects; edge_file, face_file: the input file (0-based argument position, "
+        "listed below); e0_in_file .. f2_in_file: the vertex ids in that file's own numbering.\n"
+        "# t: the crossing point is (1 - t) x[e0] + t x[e1]; b0..b2: its barycentric coordinates in the triangle.\n"
+        "# inner_end: the end of the edge (0: e0, 1: e1) on the triangle's inner side; n0..n2: the triangle's unit "
+        "normal, from its inner to its outer side (the direction that takes the inner end back out).\n";
+    for (std::size_t k = 0; k < files.size(); ++k)
+        csv += fmt::format("# file {}: {}\n", k, files[k].path);
+    csv += "e0,e1,f0,f1,f2,edge_object,face_object,edge_file,e0_in_file,e1_in_file,face_file,f0_in_file,f1_in_file,"
+           "f2_in_file,t,b0,b1,b2,inner_end,n0,n1,n2\n";
+    auto in_file = [&](std::size_t file, Index v) {
+        const io::ReadNotes& notes = files[file].notes;
+        return file_id(notes, notes.vertex_ids, v - files[file].first_vertex);
+    };
+    for (const EdgeFaceContact& c : r.contacts) {
+        const std::size_t fe = file_of(files, c.edge_vertices[0], &InputFile::first_vertex);
+        const std::size_t ff = file_of(files, c.face_vertices[0], &InputFile::first_vertex);
+        csv += fmt::format(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},"
+            "{:.17g}\n",
+            c.edge_vertices[0], c.edge_vertices[1], c.face_vertices[0], c.face_vertices[1], c.face_vertices[2],
+            c.edge_object, c.face_object, fe, in_file(fe, c.edge_vertices[0]), in_file(fe, c.edge_vertices[1]), ff,
+            in_file(ff, c.face_vertices[0]), in_file(ff, c.face_vertices[1]), in_file(ff, c.face_vertices[2]), c.edge_t,
+            c.face_bary[0], c.face_bary[1], c.face_bary[2], c.inner_end, c.normal[0], c.normal[1], c.normal[2]);
+    }
+    return csv;
+}
+
 /// Contacts as a VTU of the scene: point data contact (number of tets the vertex lies in), penetration_depth
 /// (the largest over its contacts, 0 where none) and contact_tet (the scene id of the first such tet, -1 where
 /// none); cell data object (written from the mesh) and contacts (vertices inside the tet).
@@ -185,6 +224,10 @@ void run_continuous_detection(const DetectOptions& o)
     if (o.meshes.size() != 2)
         throw Error(fmt::format("--continuous: expected two frames of the same meshes (FRAME0 FRAME1), got {} files",
                                 o.meshes.size()));
+    if (o.edges || !o.edge_contacts_path.empty())
+        throw Error(std::string(o.edges ? "--edges" : "--edge-contacts") +
+                    ": not with --continuous (edge-face contacts are of one instant; continuous detection reports "
+                    "the edge-edge pairs that meet during the step)");
     if (o.method == "all" || !o.stats_path.empty() || !o.obstacles.empty() || o.repeat_given || o.skin != "0" ||
         !o.cells_path.empty())
         throw Error(std::string("--continuous: not with ") +
@@ -232,10 +275,13 @@ void run(const DetectOptions& o)
     }
     const int repeat = o.repeat_given ? o.repeat : side_by_side ? 3 : 1;
     if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
-    if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty()))
-        throw Error(std::string(!o.contacts_path.empty() ? "--contacts"
-                                : !o.stats_path.empty()  ? "--stats"
-                                                         : "--obstacle") +
+    const bool edges = o.edges || !o.edge_contacts_path.empty();
+    if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty() || edges))
+        throw Error(std::string(!o.contacts_path.empty()       ? "--contacts"
+                                : !o.stats_path.empty()        ? "--stats"
+                                : !o.obstacles.empty()         ? "--obstacle"
+                                : o.edge_contacts_path.empty() ? "--edges"
+                                                               : "--edge-contacts") +
                     ": not with --method all, which prints the comparison table (give one --method NAME)");
     params.threads = set_threads(parse_threads(o.threads));
     check_objects_from_labels_value(o.objects_from_labels);
@@ -248,6 +294,12 @@ void run(const DetectOptions& o)
                         "' (expected .csv for a table or .vtu for the meshes with contact fields)");
     }
     if (!o.stats_path.empty()) io::check_output_file(o.stats_path, "--stats");
+    if (!o.edge_contacts_path.empty()) {
+        io::check_output_file(o.edge_contacts_path, "--edge-contacts");
+        if (io::extension_of(o.edge_contacts_path) != ".csv")
+            throw Error("--edge-contacts " + o.edge_contacts_path + ": unknown format '" +
+                        io::extension_of(o.edge_contacts_path) + "' (expected .csv)");
+    }
     // Obstacles: read and built (checked closed, not self-intersecting) before the work.
     ObstacleSet obstacles;
     for (const std::string& path : o.obstacles) {
@@ -380,6 +432,18 @@ void run(const DetectOptions& o)
         }
         fmt::print("obstacle contacts: {} ({:.3f} ms, depth and direction included)\n", inside.size(), obstacle_ms);
     }
+    EdgeFaceResult edge_result;
+    double edges_ms = 0;
+    if (edges) {
+        const auto t0 = std::chrono::steady_clock::now();
+        edge_result = find_edge_face_contacts(scene.tets, scene.positions, vobj, tobj, objects, params.threads);
+        edges_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        fmt::print("edge-face contacts: {} ({:.3f} ms; {} boundary edges, {} boundary faces, {} candidates)\n",
+                   edge_result.contacts.size(), edges_ms, edge_result.edges.rows(), edge_result.faces.rows(),
+                   edge_result.candidates);
+        if (!o.edge_contacts_path.empty())
+            io::write_text_file(o.edge_contacts_path, edge_contacts_csv(edge_result, files));
+    }
 
     if (!o.contacts_path.empty()) {
         if (io::extension_of(o.contacts_path) == ".vtu") {
@@ -404,8 +468,9 @@ void run(const DetectOptions& o)
             .member("vertices", nv)
             .member("tets", nt)
             .member("contacts", contacts.size())
-            .member("obstacle_contacts", inside.size())
-            .member("hash", to_string(params.hash))
+            .member("obstacle_contacts", inside.size());
+        if (edges) j.member("edge_face_contacts", edge_result.contacts.size()).member("edge_face_ms", edges_ms);
+        j.member("hash", to_string(params.hash))
             .member("method", to_string(params.method))
             .member("repeat", repeat)
             .member("median_ms", median_ms)
@@ -483,6 +548,13 @@ Registrar reg{
                       "the boundary vertex-face and edge-edge pairs that meet during the step between them (linear "
                       "motion), with a time of impact no later than each pair's first contact; --contacts FILE.csv "
                       "writes them");
+         sub.add_flag("--edges", o->edges,
+                      "Also report the edge-face contacts: boundary edges crossing a boundary triangle of another "
+                      "object or of a distant part of their own (no vertex of the edge and of the triangle in one "
+                      "tet); exact, the same rules (--no-self, --static)");
+         sub.add_option("--edge-contacts", o->edge_contacts_path,
+                        "Write the edge-face contacts (implies --edges): FILE.csv (the edge's and triangle's vertices, "
+                        "objects, file ids, crossing point, inner end, normal)");
          add_objects_from_labels_option(sub, o->objects_from_labels);
          add_linearize_option(sub, o->linearize);
          sub.callback([o, repeat] {

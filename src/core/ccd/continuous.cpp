@@ -3,6 +3,7 @@
 // is the box itself), the narrow phase of ccd.hpp, per-thread lists merged and sorted.
 #include "tethash/continuous.hpp"
 
+#include "../boundary_edges.hpp"
 #include "../team.hpp"
 #include "../triangle_bvh.hpp"
 #include "tethash/error.hpp"
@@ -57,21 +58,8 @@ Boundary boundary_of(const TetsRef& tets)
 {
     Boundary b;
     b.faces = boundary_faces(tets);
-    std::vector<std::array<Index, 2>> edges;
-    edges.reserve(static_cast<std::size_t>(3 * b.faces.rows()));
-    for (Eigen::Index f = 0; f < b.faces.rows(); ++f)
-        for (int c = 0; c < 3; ++c) {
-            const Index i = b.faces(f, c), j = b.faces(f, (c + 1) % 3);
-            edges.push_back({std::min(i, j), std::max(i, j)});
-            b.vertices.push_back(i);
-        }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    b.edges.resize(static_cast<Eigen::Index>(edges.size()), 2);
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-        b.edges(static_cast<Eigen::Index>(e), 0) = edges[e][0];
-        b.edges(static_cast<Eigen::Index>(e), 1) = edges[e][1];
-    }
+    b.edges = detail::edges_of_faces(b.faces);
+    b.vertices.assign(b.faces.data(), b.faces.data() + b.faces.size());
     std::sort(b.vertices.begin(), b.vertices.end());
     b.vertices.erase(std::unique(b.vertices.begin(), b.vertices.end()), b.vertices.end());
     return b;
