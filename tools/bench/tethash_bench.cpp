@@ -34,6 +34,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -379,6 +380,34 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
 
 } // namespace
 
+/// Each tet mesh of ../shared/meshes (sorted; a TetGen pair once) as two overlapping copies, the
+/// second shifted by a fifth of the size, each copy its own object; a file that does not read is reported skipped.
+void for_each_shared_mesh_pair(const std::function<void(const char* name, const TetMesh& two)>& run)
+{
+    const std::filesystem::path dir = TETHASH_SHARED_MESHES;
+    if (!std::filesystem::exists(dir)) return;
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+        if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;
+        try {
+            TetMesh one = io::read_mesh(f.string());
+            const Eigen::RowVector3d lo = one.positions.colwise().minCoeff(), hi = one.positions.colwise().maxCoeff();
+            one.vertex_object.clear();
+            one.tet_object.clear();
+            one.ensure_object_ids();
+            TetMesh two = one;
+            two.positions.rowwise() += 0.2 * (hi - lo);
+            one.append(two);
+            run(f.filename().string().c_str(), one);
+        } catch (const std::exception& e) {
+            std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
+        }
+    }
+}
+
 /// --edges: the edge-face contacts of one scene: set-up (boundary, neighbours; once per topology), find() at 1 thread
 /// (CPU time of the thread, median) and at `threads_all` (wall, median), beside the vertex-in-tet detection at 1
 /// thread.
@@ -546,31 +575,10 @@ int main(int argc, char** argv)
             const std::string name = "scenario " + std::to_string(k + 1);
             report_edges(name.c_str(), sc.mesh, base, threads_all, repeat);
         }
-        const std::filesystem::path dir = TETHASH_SHARED_MESHES;
-        if (meshes && only < 0 && std::filesystem::exists(dir)) {
-            std::vector<std::filesystem::path> files;
-            for (const auto& e : std::filesystem::directory_iterator(dir))
-                files.push_back(e.path());
-            std::sort(files.begin(), files.end());
-            for (const auto& f : files) {
-                if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;
-                try {
-                    TetMesh one = io::read_mesh(f.string());
-                    // Two copies, the second shifted by a fifth of the size: overlapping objects, as in the main run.
-                    const Eigen::RowVector3d lo = one.positions.colwise().minCoeff(),
-                                             hi = one.positions.colwise().maxCoeff();
-                    one.vertex_object.clear();
-                    one.tet_object.clear();
-                    one.ensure_object_ids();
-                    TetMesh two = one;
-                    two.positions.rowwise() += 0.2 * (hi - lo);
-                    one.append(two);
-                    report_edges(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3));
-                } catch (const std::exception& e) {
-                    std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
-                }
-            }
-        }
+        if (meshes && only < 0)
+            for_each_shared_mesh_pair([&](const char* name, const TetMesh& two) {
+                report_edges(name, two, base, threads_all, std::max(3, repeat / 3));
+            });
         return 0;
     }
 
@@ -611,33 +619,9 @@ int main(int argc, char** argv)
             report(n.c_str(), ps.mesh, with_cells, threads_all, std::max(3, repeat / 3), baseline, table_factor,
                    methods);
         }
-    if (meshes && only < 0) {
-        const std::filesystem::path dir = TETHASH_SHARED_MESHES;
-        if (std::filesystem::exists(dir)) {
-            std::vector<std::filesystem::path> files;
-            for (const auto& e : std::filesystem::directory_iterator(dir))
-                files.push_back(e.path());
-            std::sort(files.begin(), files.end());
-            for (const auto& f : files) {
-                if (!io::is_tet_mesh_path(f.string()) || f.extension() == ".node") continue;
-                try {
-                    TetMesh one = io::read_mesh(f.string());
-                    // Two copies, the second shifted by a fraction of the size: overlapping objects.
-                    const Eigen::RowVector3d lo = one.positions.colwise().minCoeff(),
-                                             hi = one.positions.colwise().maxCoeff();
-                    one.vertex_object.clear();
-                    one.tet_object.clear();
-                    one.ensure_object_ids();
-                    TetMesh two = one;
-                    two.positions.rowwise() += 0.2 * (hi - lo);
-                    one.append(two);
-                    report(f.filename().string().c_str(), one, base, threads_all, std::max(3, repeat / 3), baseline,
-                           table_factor, methods);
-                } catch (const std::exception& e) {
-                    std::printf("%-28s skipped: %s\n", f.filename().string().c_str(), e.what());
-                }
-            }
-        }
-    }
+    if (meshes && only < 0)
+        for_each_shared_mesh_pair([&](const char* name, const TetMesh& two) {
+            report(name, two, base, threads_all, std::max(3, repeat / 3), baseline, table_factor, methods);
+        });
     return 0;
 }

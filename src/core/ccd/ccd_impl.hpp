@@ -132,6 +132,27 @@ inline void set_motion(const Points& x, Motion& m)
     }
 }
 
+/// The splitting weights of m (after set_motion): for t, the sum of the four points' displacements (the most F can
+/// change from t = 0 to 1), per axis; for u and v, the largest extent along each axis, at either end of the step, of
+/// the segments that u and v run along (rows u_from → u_to and v_from → v_to of the query's four points).
+inline void set_weights(const Points& x, Motion& m, int u_from, int u_to, int v_from, int v_to)
+{
+    double wt = 0, wu = 0, wv = 0;
+    for (int k = 0; k < 3; ++k) {
+        double sum = 0;
+        for (int i = 0; i < 4; ++i)
+            sum += std::abs(m.dx[i][k]);
+        wt = std::max(wt, sum);
+        for (int s = 0; s < 8; s += 4) {
+            wu = std::max(wu, std::abs(x[s + u_to][k] - x[s + u_from][k]));
+            wv = std::max(wv, std::abs(x[s + v_to][k] - x[s + v_from][k]));
+        }
+    }
+    m.weight[0] = wt;
+    m.weight[1] = wu;
+    m.weight[2] = wv;
+}
+
 /// True when n · F has one strict sign over the box. n · F is multilinear too, so its range is inside its corner
 /// values'; each is computed with the corner values' errors (e_k per axis: Σ |n_k| e_k) plus the dot product's
 /// rounding (3 roundings: 3.01 ε Σ |n_k| |F_k|). Any direction serves; `big[k]` bounds |F_k| at the corners.

@@ -47,20 +47,7 @@ CcdResult edge_edge_ccd(const Eigen::Vector3d& ea0_0, const Eigen::Vector3d& ea1
     }
     detail::Motion m;
     detail::set_motion(x, m);
-    double wt = 0, wu = 0, wv = 0;
-    for (int k = 0; k < 3; ++k) {
-        double sum = 0;
-        for (int i = 0; i < 4; ++i)
-            sum += std::abs(m.dx[i][k]);
-        wt = std::max(wt, sum);
-        for (int s = 0; s < 8; s += 4) {
-            wu = std::max(wu, std::abs(x[s + 1][k] - x[s][k]));
-            wv = std::max(wv, std::abs(x[s + 3][k] - x[s + 2][k]));
-        }
-    }
-    m.weight[0] = wt;
-    m.weight[1] = wu;
-    m.weight[2] = wv;
+    detail::set_weights(x, m, 0, 1, 2, 3); // u along edge a, v along edge b
     return detail::inclusion_search(m, EdgeEdgeRange{m}, false, params);
 }
 

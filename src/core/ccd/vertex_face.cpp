@@ -52,20 +52,7 @@ CcdResult vertex_face_ccd(const Eigen::Vector3d& p0, const Eigen::Vector3d& a0, 
     }
     detail::Motion m;
     detail::set_motion(x, m);
-    double wt = 0, wu = 0, wv = 0;
-    for (int k = 0; k < 3; ++k) {
-        double sum = 0;
-        for (int i = 0; i < 4; ++i)
-            sum += std::abs(m.dx[i][k]);
-        wt = std::max(wt, sum);
-        for (int s = 0; s < 8; s += 4) {
-            wu = std::max(wu, std::abs(x[s + 2][k] - x[s + 1][k]));
-            wv = std::max(wv, std::abs(x[s + 3][k] - x[s + 1][k]));
-        }
-    }
-    m.weight[0] = wt;
-    m.weight[1] = wu;
-    m.weight[2] = wv;
+    detail::set_weights(x, m, 1, 2, 1, 3); // u along a → b, v along a → c
     return detail::inclusion_search(m, VertexFaceRange{m}, true, params);
 }
 
