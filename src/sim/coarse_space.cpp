@@ -17,6 +17,10 @@ constexpr size_t max_nodes_per_object = 400;
 
 /// The weight-to-bending number ρ g L³ / (E t²) above which a thin sheet's weight folds it (no lattice, below).
 constexpr double sheet_folds = 10.0;
+/// The ω h up to which a sheet that folds converges with the sweeps alone. Above it the sweeps cannot carry the
+/// sheet's long waves (docs/simulator.md: a 5 cm mat landing on its edge stayed standing, buckled, with 4.3 times the
+/// drop's energy stored in its springs), and the lattice's corrections are what makes the step converge.
+constexpr double sheet_sweeps_alone = 20.0;
 
 /// The rotation closest to the 3 × 3 matrix s (its polar factor; a reflection turned into a rotation).
 Eigen::Matrix3d closest_rotation(const Eigen::Matrix3d& s)
@@ -65,15 +69,16 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
         // (its corrections slowed the sweeps: mean height 0.11-0.18 m at 0.5 s where the converged step is at
         // 0.044). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
         // large: 1,500 for the mat of young 1e5 at 1 m. A stiff sheet keeps its lattice: the mat of young 1e9 at 1 m
-        // (0.15) ended its drop at 124 times its start energy with the sweeps alone, at 0.99 with the lattice.
+        // (0.15) ended its drop at 124 times its start energy with the sweeps alone, at 0.99 with the lattice. So does
+        // a sheet whose ω h the sweeps alone cannot converge (sheet_sweeps_alone): the mat at 1 cm to 15 cm.
         const Eigen::Vector3d extent3 = hi - lo;
+        const double omega_h = std::sqrt(model.object_frequency_sq[o]) * h;
         if (extent3.minCoeff() < 0.5 * std::max(2.0 * model.object_mean_edge[o], extent3.maxCoeff() / 6.0)) {
             const double stiffness = model.object_frequency_sq[o] * model.object_mean_edge[o] *
                                      model.object_mean_edge[o] * extent3.minCoeff() * extent3.minCoeff();
             const double weight = model.gravity.norm() * std::pow(extent3.maxCoeff(), 3);
-            if (!(weight <= sheet_folds * stiffness)) continue;
+            if (!(weight <= sheet_folds * stiffness) && omega_h <= sheet_sweeps_alone) continue;
         }
-        const double omega_h = std::sqrt(model.object_frequency_sq[o]) * h;
         const double cells_per_extent = 6.0 * std::max(1.0, omega_h / 4.0);
         const double extent = (hi - lo).maxCoeff();
         double cell = std::max(2.0 * model.object_mean_edge[o], extent / cells_per_extent);
