@@ -7,6 +7,7 @@
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/oracle.hpp"
+#include "tethash/predicates.hpp"
 
 #include <gtest/gtest.h>
 
@@ -430,6 +431,88 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
 TEST(CoreDetect, ScanKernelFollowsTethashSimd)
 {
     test::expect_kernel_follows_tethash_simd(detail::scan_kernel_name());
+}
+
+TEST(CoreDetect, PlaneFilterKeepsExactlyWhatItCannotRejectInOrder)
+{
+    // filter_candidates (the kernel TETHASH_SIMD chooses) against exact orientations: a candidate it leaves out is
+    // outside the closed tet; every candidate inside or on it is kept, in input order, with its index; a face left
+    // out of a kept candidate's undecided mask has the exact sign of its value. Points on the tets' faces and edges
+    // (up to rounding) and at their corners make the undecided cases.
+    std::mt19937 rng(28);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::uniform_int_distribution<int> pick(0, 3);
+    int kept_total = 0, undecided_total = 0, left_out_total = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        Positions P(64 + 4, 3);
+        for (int v = 0; v < 4; ++v)
+            P.row(v) = Eigen::RowVector3d(u(rng), u(rng), u(rng));
+        if (trial % 4 == 0) P.row(3) = (P.row(0) + P.row(1) + P.row(2)) / 3.0; // a flat tet: skipped below
+        for (int i = 4; i < P.rows(); ++i) {
+            const double w0 = u(rng), w1 = u(rng), w2 = u(rng);
+            switch (i % 4) {
+            case 0: { // on a face, up to rounding: three corners weighted a, b, 1 - a - b
+                const int k = pick(rng);
+                const double a = 0.25 * (w0 + 1), b = 0.25 * (w1 + 1);
+                P.row(i) = a * P.row(k) + b * P.row((k + 1) % 4) + (1 - a - b) * P.row((k + 2) % 4);
+                break;
+            }
+            case 1: // a corner
+                P.row(i) = P.row(pick(rng));
+                break;
+            case 2: // an edge point
+                P.row(i) = P.row(0) + 0.5 * (w1 + 1) * (P.row(1) - P.row(0));
+                break;
+            default:
+                P.row(i) = Eigen::RowVector3d(w0, w1, w2);
+            }
+        }
+        const double* A = P.data();
+        const double *B = A + 3, *C = A + 6, *D = A + 9;
+        detail::FacePlanes f;
+        bool exact = false;
+        const int sign = detail::face_planes(A, B, C, D, f, exact);
+        EXPECT_EQ(sign, predicates::orient3d_exact(A, B, C, D).sign);
+        if (sign == 0) continue;
+        std::vector<Index> cand;
+        for (Index i = 4; i < P.rows(); ++i)
+            cand.push_back(i);
+        const auto n = static_cast<std::int32_t>(cand.size());
+        std::vector<double> val(4 * cand.size());
+        std::vector<std::int8_t> code(cand.size());
+        std::vector<std::int32_t> kept(cand.size());
+        const std::int32_t k =
+            detail::filter_candidates(f, P.data(), cand.data(), n, val.data(), code.data(), kept.data());
+        ASSERT_LE(k, n);
+        std::int32_t next = 0; // the next kept entry to match
+        for (std::int32_t j = 0; j < n; ++j) {
+            const double* p = P.data() + 3 * static_cast<std::size_t>(cand[static_cast<std::size_t>(j)]);
+            const int s0 = predicates::orient3d_exact(p, B, C, D).sign * sign;
+            const int s1 = predicates::orient3d_exact(A, p, C, D).sign * sign;
+            const int s2 = predicates::orient3d_exact(A, B, p, D).sign * sign;
+            const int s3 = predicates::orient3d_exact(A, B, C, p).sign * sign;
+            const int exact_sign[4] = {s0, s1, s2, s3};
+            const bool inside = s0 >= 0 && s1 >= 0 && s2 >= 0 && s3 >= 0;
+            if (next < k && kept[static_cast<std::size_t>(next)] == j) {
+                for (int i = 0; i < 4; ++i) {
+                    if (code[static_cast<std::size_t>(next)] & (1 << i)) continue;
+                    const double v = val[4 * static_cast<std::size_t>(next) + static_cast<std::size_t>(i)];
+                    EXPECT_EQ(v > 0 ? 1 : (v < 0 ? -1 : 0), exact_sign[i]) << "trial " << trial << " face " << i;
+                }
+                undecided_total += code[static_cast<std::size_t>(next)] != 0;
+                ++next;
+                ++kept_total;
+            } else {
+                EXPECT_FALSE(inside) << "trial " << trial << " candidate " << j << " left out but inside";
+                ++left_out_total;
+            }
+        }
+        EXPECT_EQ(next, k) << "kept indices out of order or out of range";
+    }
+    // The scenes exercise every outcome.
+    EXPECT_GT(kept_total, 0);
+    EXPECT_GT(undecided_total, 0);
+    EXPECT_GT(left_out_total, 0);
 }
 
 TEST(CoreDetectParams, NumbersAreWholeStringsAndFinite)

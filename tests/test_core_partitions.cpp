@@ -3,15 +3,18 @@
 // over each method's parameters, over moving scenes (structures kept across calls: refits, sweep orders, static
 // parts) and over thread counts.
 #include "../src/core/broad_phase.hpp"
+#include "../src/core/inside_batch.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/oracle.hpp"
+#include "tethash/predicates.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <random>
 #include <string>
 
@@ -340,4 +343,53 @@ TEST(CorePartitions, RefittedBvhAndSweepFollowTheMotionAndRebuildWhenDegraded)
     EXPECT_GT(refit->counts().builds, builds_after_small) << "strong motion degrades the tree: rebuilt";
     EXPECT_LT(refit->counts().builds, 30) << "not rebuilt on every step";
     EXPECT_EQ(refit->counts().updates, 29) << "every later call refits first";
+}
+
+TEST(CorePartitions, BatchedInsideTestIsTheOraclesBitForBit)
+{
+    // inside_tets (four pairs per step with the AVX2 kernels, TETHASH_SIMD=scalar: one at a time) against
+    // predicates::inside_tet pair by pair: the same answer, the same barycentric coordinates bit for bit and the same
+    // count of exact evaluations, on every (vertex, tet) pair of scenes with random, inverted and flat tets and of
+    // lattice-aligned ones (vertices exactly on faces, edges and corners: the undecided lanes).
+    Scene flat = test::random_scene(5, 3, 2, 0.3);
+    test::make_coincident(flat, 5);
+    const Scene scenes[] = {test::random_scene(3, 3, 2, 0.4), flat,
+                            test::lattice_pair(2, 0.5, Eigen::Vector3d(0.25, 0, 0.5), Eigen::Vector3d(1, -2, 0.5))};
+    for (const Scene& s : scenes) {
+        const Index n = static_cast<Index>(s.positions.rows()), m = static_cast<Index>(s.tets.rows());
+        std::vector<Index> vertex, tet;
+        for (Index t = 0; t < m; ++t)
+            for (Index v = 0; v < n; ++v) {
+                vertex.push_back(v);
+                tet.push_back(t);
+            }
+        const auto count = static_cast<std::int32_t>(vertex.size());
+        const Positions& P = s.positions;
+        const std::vector<Index> tets(s.tets.data(), s.tets.data() + s.tets.size());
+        std::vector<std::uint8_t> inside(vertex.size());
+        std::vector<double> bary(4 * vertex.size());
+        const std::int64_t exact =
+            detail::inside_tets(P.data(), tets.data(), vertex.data(), tet.data(), count, inside.data(), bary.data());
+        std::int64_t want_exact = 0, insides = 0;
+        for (std::int32_t j = 0; j < count; ++j) {
+            const Index* tv = tets.data() + 4 * static_cast<std::size_t>(tet[static_cast<std::size_t>(j)]);
+            const predicates::InsideResult r = predicates::inside_tet(
+                P.data() + 3 * static_cast<std::size_t>(vertex[static_cast<std::size_t>(j)]),
+                P.data() + 3 * static_cast<std::size_t>(tv[0]), P.data() + 3 * static_cast<std::size_t>(tv[1]),
+                P.data() + 3 * static_cast<std::size_t>(tv[2]), P.data() + 3 * static_cast<std::size_t>(tv[3]));
+            want_exact += r.exact_evaluations;
+            ASSERT_EQ(inside[static_cast<std::size_t>(j)] != 0, r.inside) << "pair " << j;
+            if (!r.inside) continue;
+            ++insides;
+            for (int i = 0; i < 4; ++i)
+                EXPECT_EQ(std::memcmp(&bary[4 * static_cast<std::size_t>(j) + static_cast<std::size_t>(i)], &r.bary[i],
+                                      sizeof(double)),
+                          0)
+                    << "pair " << j << " bary[" << i << "] " << bary[4 * static_cast<std::size_t>(j) + i] << " vs "
+                    << r.bary[i];
+        }
+        EXPECT_EQ(exact, want_exact);
+        EXPECT_GT(insides, 0);
+        EXPECT_GT(want_exact, 0); // the lattice makes undecided pairs
+    }
 }

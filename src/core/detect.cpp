@@ -92,9 +92,10 @@ std::int64_t DetectorImpl::memory_bytes() const
                                    last_chunk.capacity() * sizeof(std::int64_t));
     for (const ThreadState& ts : threads)
         m += static_cast<std::int64_t>(
-            ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() + ts.values.capacity() * sizeof(double) +
-            ts.runs.capacity() * sizeof(CandidateRun) + ts.contacts.capacity() * sizeof(RawContact) +
-            ts.sorted.capacity() * sizeof(RawContact) + sizeof(ThreadState));
+            ts.candidates.capacity() * sizeof(Index) + ts.codes.capacity() + ts.kept.capacity() * sizeof(std::int32_t) +
+            ts.values.capacity() * sizeof(double) + ts.runs.capacity() * sizeof(CandidateRun) +
+            ts.contacts.capacity() * sizeof(RawContact) + ts.sorted.capacity() * sizeof(RawContact) +
+            sizeof(ThreadState));
     return m;
 }
 

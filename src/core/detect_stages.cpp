@@ -191,14 +191,15 @@ void DetectorImpl::stage_inside(ThreadState& ts, const CandidateRun* runs, std::
         if (ts.codes.size() < static_cast<std::size_t>(count)) {
             ts.codes.resize(std::max<std::size_t>(static_cast<std::size_t>(count), 2 * ts.codes.size()));
             ts.values.resize(4 * ts.codes.size());
+            ts.kept.resize(ts.codes.size());
         }
-        detail::filter_candidates(f, P, cand, count, ts.values.data(), ts.codes.data());
+        const std::int32_t num_kept =
+            detail::filter_candidates(f, P, cand, count, ts.values.data(), ts.codes.data(), ts.kept.data());
         ts.counters.inside_tests += count;
-        for (std::int32_t j = 0; j < count; ++j) {
-            const int code = ts.codes[static_cast<std::size_t>(j)];
-            if (code < 0) continue;
-            const Index v = cand[j];
-            double* val = ts.values.data() + 4 * static_cast<std::size_t>(j);
+        for (std::int32_t k = 0; k < num_kept; ++k) {
+            const int code = ts.codes[static_cast<std::size_t>(k)];
+            const Index v = cand[ts.kept[static_cast<std::size_t>(k)]];
+            double* val = ts.values.data() + 4 * static_cast<std::size_t>(k);
             if (code) {
                 const double* p = P + 3 * static_cast<std::size_t>(v);
                 bool outside = false;

@@ -49,8 +49,9 @@ struct Counters {
 struct alignas(64) ThreadState {
     std::vector<Index> candidates; // grown only, never shrunk; `used` entries valid
     std::size_t used = 0;
-    std::vector<double> values;     // stage 3: 4 plane values per candidate of a run
-    std::vector<std::int8_t> codes; // stage 3: filter outcome per candidate of a run
+    std::vector<double> values;     // stage 3: 4 plane values per candidate the filter kept, of a run
+    std::vector<std::int8_t> codes; // stage 3: undecided faces per candidate the filter kept, of a run
+    std::vector<std::int32_t> kept; // stage 3: which candidates of a run the filter kept (not certainly outside)
     std::vector<CandidateRun> runs; // grown only; `num_runs` entries valid
     std::size_t num_runs = 0;
     std::vector<RawContact> contacts;

@@ -1,9 +1,11 @@
 // The exact stage every broad phase other than the hash feeds (docs/partitions.md): object rules,
-// the closed exact inside test (predicates.hpp, the oracle's), then one sort by (vertex, tet). Which thread found a
+// the closed exact inside test (predicates.hpp, the oracle's; four pairs at a time with AVX2, inside_batch.hpp),
+// then one sort by (vertex, tet). Which thread found a
 // pair and in which order does not matter: the barycentric coordinates depend on the point and the tet only, and the
 // sort fixes the order, so the output is bit for bit the same for every method and thread count.
 #include "partition_detect.hpp"
 
+#include "inside_batch.hpp"
 #include "team.hpp"
 #include "tethash/predicates.hpp"
 #include "timing.hpp"
@@ -12,6 +14,11 @@
 #include <cassert>
 
 namespace tethash::detail {
+
+namespace {
+/// Pairs per block of the exact stage (each thread's buffers: 36 bytes per pair).
+constexpr std::size_t batch_size = 1024;
+} // namespace
 
 void PartitionDetector::reset()
 {
@@ -26,6 +33,9 @@ std::int64_t PartitionDetector::memory_bytes() const
     for (const auto& f : m_found)
         m += static_cast<std::int64_t>(f.capacity() * sizeof(Found));
     m += static_cast<std::int64_t>(m_all.capacity() * sizeof(Found));
+    for (const Batch& b : m_batches)
+        m += static_cast<std::int64_t>((b.vertex.capacity() + b.tet.capacity()) * sizeof(Index) + b.inside.capacity() +
+                                       b.bary.capacity() * sizeof(double));
     return m;
 }
 
@@ -41,6 +51,7 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
     m_sinks.resize(static_cast<std::size_t>(T));
     m_found.resize(static_cast<std::size_t>(T));
     m_counts.assign(static_cast<std::size_t>(T), Counts{});
+    m_batches.resize(static_cast<std::size_t>(T));
     for (CandidateSink& s : m_sinks)
         s.pairs.clear();
 
@@ -57,26 +68,42 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
         std::vector<Found>& found = m_found[static_cast<std::size_t>(r)];
         found.clear();
         Counts& counts = m_counts[static_cast<std::size_t>(r)];
+        // The pairs that pass the object rules, a block at a time, then their inside tests at once (four per step
+        // with AVX2), in the sink's order.
+        Batch& batch = m_batches[static_cast<std::size_t>(r)];
+        batch.vertex.resize(batch_size);
+        batch.tet.resize(batch_size);
+        batch.inside.resize(batch_size);
+        batch.bary.resize(4 * batch_size);
+        std::int32_t n = 0;
+        auto flush = [&]() {
+            counts.inside_tests += n;
+            counts.exact += inside_tets(P, scene.tets, batch.vertex.data(), batch.tet.data(), n, batch.inside.data(),
+                                        batch.bary.data());
+            for (std::int32_t j = 0; j < n; ++j) {
+                if (!batch.inside[static_cast<std::size_t>(j)]) continue;
+                Found& f = found.emplace_back();
+                f.vertex = batch.vertex[static_cast<std::size_t>(j)];
+                f.tet = batch.tet[static_cast<std::size_t>(j)];
+                std::copy_n(batch.bary.data() + 4 * static_cast<std::size_t>(j), 4, f.bary);
+            }
+            n = 0;
+        };
         for (const CandidatePair& c : m_sinks[static_cast<std::size_t>(r)].pairs) {
-            const Index* tv = scene.tets + 4 * static_cast<std::size_t>(c.tet);
             // A tet's own vertices are left out by the broad phases (broad_phase.hpp).
-            assert(c.vertex != tv[0] && c.vertex != tv[1] && c.vertex != tv[2] && c.vertex != tv[3]);
+            assert([&] {
+                const Index* tv = scene.tets + 4 * static_cast<std::size_t>(c.tet);
+                return c.vertex != tv[0] && c.vertex != tv[1] && c.vertex != tv[2] && c.vertex != tv[3];
+            }());
             const Index vo = vertex_object[c.vertex], to = tet_object[c.tet];
             if (vo == to && !flags.self_collision[static_cast<std::size_t>(to)]) continue;
             if (flags.is_static[static_cast<std::size_t>(to)] && flags.is_static[static_cast<std::size_t>(vo)])
                 continue;
-            ++counts.inside_tests;
-            const predicates::InsideResult res = predicates::inside_tet(
-                P + 3 * static_cast<std::size_t>(c.vertex), P + 3 * static_cast<std::size_t>(tv[0]),
-                P + 3 * static_cast<std::size_t>(tv[1]), P + 3 * static_cast<std::size_t>(tv[2]),
-                P + 3 * static_cast<std::size_t>(tv[3]));
-            counts.exact += res.exact_evaluations;
-            if (!res.inside) continue;
-            Found& f = found.emplace_back();
-            f.vertex = c.vertex;
-            f.tet = c.tet;
-            std::copy(res.bary, res.bary + 4, f.bary);
+            batch.vertex[static_cast<std::size_t>(n)] = c.vertex;
+            batch.tet[static_cast<std::size_t>(n)] = c.tet;
+            if (++n == static_cast<std::int32_t>(batch_size)) flush();
         }
+        flush();
         if (with_stats) { // degenerate tets, as the hash path counts them: every tet once
             std::int64_t begin = 0, end = 0;
             team_split(scene.num_tets, r, team_size(), begin, end);

@@ -28,10 +28,17 @@ class PartitionDetector {
     struct alignas(64) Counts {
         std::int64_t inside_tests = 0, exact = 0, degenerate = 0;
     };
+    /// A thread's pairs that passed the object rules, tested a block at a time (inside_batch.hpp).
+    struct Batch {
+        std::vector<Index> vertex, tet;
+        std::vector<std::uint8_t> inside;
+        std::vector<double> bary;
+    };
     Method m_method = Method::hash;
     std::unique_ptr<BroadPhase> m_broad;
     std::vector<CandidateSink> m_sinks;
     std::vector<std::vector<Found>> m_found;
+    std::vector<Batch> m_batches;
     std::vector<Counts> m_counts;
     std::vector<Found> m_all;
 };

@@ -178,35 +178,43 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
 }
 #endif
 
-void filter_scalar(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
-                   std::int8_t* code)
+std::int32_t filter_scalar(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                           std::int8_t* code, std::int32_t* kept)
 {
     constexpr double E = predicates::orient3d_error_bound;
+    std::int32_t k = 0;
     for (std::int32_t j = 0; j < count; ++j) {
         const double* p = P + 3 * static_cast<std::size_t>(cand[j]);
         int undecided = 0;
         bool outside = false;
+        double v[4];
         for (int i = 0; i < 4; ++i) {
             const double dx = p[0] - f.rx[i], dy = p[1] - f.ry[i], dz = p[2] - f.rz[i];
-            const double v = f.nx[i] * dx + f.ny[i] * dy + f.nz[i] * dz;
+            v[i] = f.nx[i] * dx + f.ny[i] * dy + f.nz[i] * dz;
             const double bound = E * (std::fabs(dx) * f.mx[i] + std::fabs(dy) * f.my[i] + std::fabs(dz) * f.mz[i]);
-            val[4 * j + i] = v;
-            outside |= v < -bound;
-            if (v <= bound) undecided |= 1 << i;
+            outside |= v[i] < -bound;
+            if (v[i] <= bound) undecided |= 1 << i;
         }
-        code[j] = static_cast<std::int8_t>(outside ? -1 : undecided);
+        if (outside) continue;
+        for (int i = 0; i < 4; ++i)
+            val[4 * k + i] = v[i];
+        code[k] = static_cast<std::int8_t>(undecided);
+        kept[k++] = j;
     }
+    return k;
 }
 
 #ifdef TETHASH_X86
-__attribute__((target("avx2"))) void filter_avx2(const FacePlanes& f, const double* P, const Index* cand,
-                                                 std::int32_t count, double* val, std::int8_t* code)
+__attribute__((target("avx2"))) std::int32_t filter_avx2(const FacePlanes& f, const double* P, const Index* cand,
+                                                         std::int32_t count, double* val, std::int8_t* code,
+                                                         std::int32_t* kept)
 {
     const __m256d rx = _mm256_load_pd(f.rx), ry = _mm256_load_pd(f.ry), rz = _mm256_load_pd(f.rz);
     const __m256d nx = _mm256_load_pd(f.nx), ny = _mm256_load_pd(f.ny), nz = _mm256_load_pd(f.nz);
     const __m256d mx = _mm256_load_pd(f.mx), my = _mm256_load_pd(f.my), mz = _mm256_load_pd(f.mz);
     const __m256d E = _mm256_set1_pd(predicates::orient3d_error_bound);
     const __m256d sign = _mm256_set1_pd(-0.0);
+    std::int32_t k = 0;
     for (std::int32_t j = 0; j < count; ++j) {
         const double* p = P + 3 * static_cast<std::size_t>(cand[j]);
         const __m256d dx = _mm256_sub_pd(_mm256_broadcast_sd(p), rx);
@@ -218,11 +226,14 @@ __attribute__((target("avx2"))) void filter_avx2(const FacePlanes& f, const doub
             _mm256_add_pd(_mm256_mul_pd(_mm256_andnot_pd(sign, dx), mx), _mm256_mul_pd(_mm256_andnot_pd(sign, dy), my)),
             _mm256_mul_pd(_mm256_andnot_pd(sign, dz), mz));
         const __m256d bound = _mm256_mul_pd(E, perm);
-        _mm256_storeu_pd(val + 4 * j, v);
         const int out = _mm256_movemask_pd(_mm256_cmp_pd(v, _mm256_xor_pd(bound, sign), _CMP_LT_OQ));
-        const int und = _mm256_movemask_pd(_mm256_cmp_pd(v, bound, _CMP_LE_OQ));
-        code[j] = static_cast<std::int8_t>(out ? -1 : und);
+        // Most candidates are certainly outside: only the others are written (values, undecided faces, index).
+        if (out) continue;
+        _mm256_storeu_pd(val + 4 * k, v);
+        code[k] = static_cast<std::int8_t>(_mm256_movemask_pd(_mm256_cmp_pd(v, bound, _CMP_LE_OQ)));
+        kept[k++] = j;
     }
+    return k;
 }
 #endif
 
@@ -277,7 +288,8 @@ __attribute__((target("avx2"))) void faces_avx2(const double* A, const double* B
 }
 #endif
 
-using FilterFn = void (*)(const FacePlanes&, const double*, const Index*, std::int32_t, double*, std::int8_t*);
+using FilterFn = std::int32_t (*)(const FacePlanes&, const double*, const Index*, std::int32_t, double*, std::int8_t*,
+                                  std::int32_t*);
 
 std::int32_t scan_ranges_scalar(const VertexTable& t, const ScanRange* ranges, std::int32_t count, const ScanQuery& q,
                                 Index* out, ScanCounters& c)
@@ -366,10 +378,10 @@ std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std
     return chosen(table, &r, 1, q, out, counters);
 }
 
-void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
-                       std::int8_t* code)
+std::int32_t filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                               std::int8_t* code, std::int32_t* kept)
 {
-    chosen_filter(f, P, cand, count, val, code);
+    return chosen_filter(f, P, cand, count, val, code, kept);
 }
 
 int face_planes(const double* A, const double* B, const double* C, const double* D, FacePlanes& f, bool& exact)

@@ -60,10 +60,11 @@ struct alignas(32) FacePlanes {
 /// the same error bound as the candidate filter; `exact` is set when it needed exact arithmetic.
 int face_planes(const double* A, const double* B, const double* C, const double* D, FacePlanes& f, bool& exact);
 
-/// Filtered plane tests of `count` candidates (vertex ids `cand`, positions `P` n × 3): for candidate j writes the
-/// four values to val[4j..4j+3] and returns in code[j] −1 if p is certainly outside, else the bit mask of faces
-/// whose sign the filter could not decide (0: certainly inside).
-void filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
-                       std::int8_t* code);
+/// Filtered plane tests of `count` candidates (vertex ids `cand`, positions `P` n × 3). The candidates the filter
+/// does not find certainly outside are kept, in order: the k-th kept one's index j in kept[k], its four values in
+/// val[4k..4k+3] and in code[k] the bit mask of faces whose sign the filter could not decide (0: certainly inside).
+/// Returns how many were kept.
+std::int32_t filter_candidates(const FacePlanes& f, const double* P, const Index* cand, std::int32_t count, double* val,
+                               std::int8_t* code, std::int32_t* kept);
 
 } // namespace tethash::detail
