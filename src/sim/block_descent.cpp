@@ -109,6 +109,8 @@ constexpr double coarse_reach = 1.0;
 /// Sweeps an automatic substep takes at least: one, so that a body in free fall (its start is the answer) pays one
 /// sweep, not three (the hand's drop: 1.08× Bullet's mean step with three, 1.01× with one, the same end state).
 constexpr int min_sweeps_automatic = 1;
+/// Times a step that gained energy is taken again, each with the convergence tests ten times tighter.
+constexpr int max_tighter = 2;
 
 class BlockDescent final : public StepIntegrator {
   public:
@@ -117,6 +119,13 @@ class BlockDescent final : public StepIntegrator {
     int substep(Positions& x, Positions& v, double h) override;
     bool converged() const override { return m_converged; }
     void finish_step(Positions& x, const std::vector<std::int32_t>& inverted) override;
+    bool tighten() override
+    {
+        if (m_ctx.scene.iterations > 0 || m_tighter >= max_tighter) return false;
+        ++m_tighter;
+        return true;
+    }
+    void relax() override { m_tighter = 0; }
 
   private:
     void setup();
@@ -180,6 +189,7 @@ class BlockDescent final : public StepIntegrator {
     std::vector<double> m_group_moved;    ///< per group: Σ dᵀ H d of the current sweep
     std::vector<double> m_moved_history;  ///< Σ dᵀ H d of each sweep of the substep
     bool m_converged = true;              ///< the last substep's sweeps met the tolerance
+    int m_tighter = 0; ///< times the step is being taken again for energy it gained (tighten): tolerances / 10 each
     mutable std::vector<char> m_entered; ///< vertex id → it stepped into a contact in this substep (leaving_fraction)
     double m_energy_ref = 0;             ///< the energy the scene has to spend (energy_scale at the first substep)
     // Contacts of the substep: per contact depth, direction, weighted stiffness and damping, relative
@@ -812,13 +822,14 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     const int min_sweeps =
         automatic ? std::min(min_sweeps_automatic, m_ctx.scene.max_iterations) : m_ctx.scene.iterations;
     const int max_sweeps = automatic ? m_ctx.scene.max_iterations : m_ctx.scene.iterations;
-    const double tol2 = m_ctx.scene.convergence * m_ctx.scene.convergence;
+    const double tighter = std::pow(0.1, m_tighter);
+    const double tol2 = m_ctx.scene.convergence * m_ctx.scene.convergence * tighter;
     // Stop when no vertex moved more than this fraction of its clamp length (a fifth of its object's mean edge).
     const double stop = 5 * m_ctx.scene.sweep_tolerance;
     // A step refined into k times the scene's substeps gives each a k-th of the energy tolerance, so that what a
     // step may leave unconverged does not grow with its refinement (a 5 cm octocat of young 1e9 took 100 substeps a
     // step and ended its drop with 5.6 times its start energy, every substep converged).
-    const double refined_share = std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
+    const double refined_share = tighter * std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
     int sweeps = 0;
     double omega = 1, moved_max = 0;
     m_moved_history.clear();
@@ -828,6 +839,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         m_prev1 = m_prev2;
     }
     bool use_coarse = !m_coarse.empty();
+    bool met_base = false;
     bool first_coarse = true;
     while (sweeps < max_sweeps) {
         if (m_ctx.interrupted()) break; // Ctrl-C: the simulation rolls the step back
@@ -837,7 +849,8 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         if (rho > 0) accelerate(sweeps, rho, omega, xp);
         if (sw.largest <= stop) break;
         moved_max = std::max(moved_max, sw.moved);
-        const bool small_energy = 0.5 * sw.moved <= energy_tolerance * refined_share * m_energy_ref;
+        const double energy_limit = energy_tolerance * refined_share * m_energy_ref;
+        const bool small_energy = 0.5 * sw.moved <= energy_limit;
         // A contact or friction that switches between sweeps and corrections can hold the moves in a cycle (seen
         // at 1 m: the same six moves over and over, each far below the energy tolerance): once the moves stop
         // shrinking over a cycle of corrections, more sweeps change nothing.
@@ -850,11 +863,16 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
             m_converged = true;
             break;
         }
+        // Taken again with tighter tolerances (tighten): reaching the cap after meeting the scene's own counts as
+        // converged.
+        met_base = m_tighter > 0 && (sw.moved <= tol2 / tighter * moved_max || stalled) &&
+                   0.5 * sw.moved <= energy_limit / tighter;
         if (use_coarse && sweeps % sweeps_per_correction == 0 && sweeps < max_sweeps) {
             use_coarse = coarse_correction(xp, h, first_coarse) >= 0;
             first_coarse = false;
         }
     }
+    if (!m_converged && met_base) m_converged = true;
     if (m_ctx.scene.inversion_guard) m_inversions.restore_in_substep(xp);
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;

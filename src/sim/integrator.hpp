@@ -37,6 +37,10 @@ class StepIntegrator {
     /// After a step is taken (no refinement to follow), with the tets it leaves inverted (rows of the model's volume
     /// terms): a last change of positions only (velocities stay). Nothing by default.
     virtual void finish_step(Positions& /*x*/, const std::vector<std::int32_t>& /*inverted*/) {}
+    /// The step is taken again because it gained energy: iterate to a tighter tolerance this time. False when the
+    /// integrator cannot (a direct or explicit method, or already at its tightest); `relax` when the step is taken.
+    virtual bool tighten() { return false; }
+    virtual void relax() {}
 };
 
 std::unique_ptr<StepIntegrator> make_symplectic_euler(const StepContext& ctx);

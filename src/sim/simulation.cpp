@@ -180,6 +180,10 @@ void SimulationImpl::set_auto_max_substeps()
     auto_max_substeps = 8 * factor * scene.substeps;
 }
 
+/// A step may gain this fraction of the energy the scene has to spend (RunHealth::energy_scale) before it is taken
+/// again with tighter tolerances.
+constexpr double energy_step_slack = 1e-3;
+
 int SimulationImpl::approach_substeps(int most) const
 {
     // Contacts are found at the start of each substep, and margin and speculative contacts reach a quarter of a
@@ -462,6 +466,15 @@ void Simulation::step()
             if (refine()) continue;
             fail(bad);
         }
+        // A passive scene's step cannot gain energy: one that did stopped its iterations short (slow convergence
+        // where contacts switch: a stiff body's bounce) and is taken again with tighter tolerances.
+        if (energy_now > s.health.energy_end + energy_step_slack * s.health.energy_scale && s.integrator->tighten()) {
+            x = s.x_save;
+            s.v = s.v_save;
+            st.unconverged = 0;
+            ++st.tightened;
+            continue;
+        }
         s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now);
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
@@ -473,6 +486,7 @@ void Simulation::step()
     // vbd turns back what the step left inverted (positions only); the count above, which the refinement and the
     // crumple check read, is the step's own.
     s.integrator->finish_step(x, s.inverted_tets);
+    s.integrator->relax();
     if (substeps > s.refined && substeps > approach) {
         s.refined = substeps;
         s.refined_until = s.t + 0.05;

@@ -321,7 +321,7 @@ void run_simulate(SimulateOptions o)
     const bool tty = stderr_is_terminal();
     double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, max_depth = 0,
            depth_sum = 0;
-    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0;
+    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0, tightened = 0;
     const auto start = std::chrono::steady_clock::now();
     auto last_print = start;
     const int plain_every = std::max(1, scene.steps / 10);
@@ -353,6 +353,7 @@ void run_simulate(SimulateOptions o)
             ms_integrate += st.ms_integrate;
             contacts += st.contacts;
             iterations += st.solver_iterations;
+            tightened += st.tightened > 0 ? 1 : 0;
             if (st.substeps > scene.substeps) {
                 ++refined;
                 refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
@@ -423,9 +424,12 @@ void run_simulate(SimulateOptions o)
                      scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
     if (refined)
         std::fprintf(stdout,
-                     "refined steps: %lld of %d taken in up to %lld substeps (tets inverted or a blow-up at "
-                     "%d; max_substeps bounds it)\n",
+                     "steps in more substeps: %lld of %d, up to %lld substeps (objects approaching fast, tets "
+                     "inverted, iterations unconverged or a blow-up at %d; max_substeps bounds it)\n",
                      static_cast<long long>(refined), n, static_cast<long long>(refined_substeps), scene.substeps);
+    if (tightened)
+        std::fprintf(stdout, "steps taken again with tighter tolerances (they gained energy): %lld of %d\n",
+                     static_cast<long long>(tightened), n);
     std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
                  contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
     std::fprintf(stdout,

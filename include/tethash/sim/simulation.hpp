@@ -48,6 +48,7 @@ struct StepStats {
     int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
     int substeps = 1;               ///< substeps the step took (scene substeps, or more where it was refined)
     int unconverged = 0;            ///< substeps whose iterations reached their cap unconverged (vbd: max_iterations)
+    int tightened = 0;              ///< times the step was taken again with tighter tolerances for energy it gained
 };
 
 /// How far a run can be trusted, kept over its steps so far (Simulation::health()). A passive scene (everything
