@@ -104,7 +104,9 @@ FIGURES = []  # (name, files written), in order, for the report
 def finish(fig, meta, scene, name, args):
     footer = "scene: %s | %s\ncommand: %s" % (scene, machine_text(meta), command_text(meta))
     fig.text(0.01, 0.005, footer, fontsize=6.5, va="bottom", ha="left", wrap=True, color="0.3")
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    # Room for the footer's two lines (about 0.45 inch) and, on tall figures, for the title above the panels.
+    height = fig.get_size_inches()[1]
+    fig.tight_layout(rect=(0, min(0.07, 0.45 / height), 1, 1 if height < 8 else 1 - 0.25 / height))
     written = []
     for ext in args.formats:
         path = os.path.join(args.out, "%s%s.%s" % (args.prefix, name, ext))
@@ -476,10 +478,11 @@ def plot_methods(pts, meta, args):
 
     panels = (("ms_total", "time per detection (ms, median)"), ("inside_tests", "pairs tested (inside tests)"),
               ("memory_bytes", "working memory (MB)"))
-    width = min(14.0, 2.6 + 0.62 * len(scenes) * len(panels))
-    height = min(12.0, 1.6 + 0.24 * len(labels))
-    fig, axes = plt.subplots(1, len(panels), figsize=(width, height), sharey=True, squeeze=False)
-    for ax, (col, title) in zip(axes[0], panels):
+    # One panel under the other, a column of 0.8 inch per scene (room for five characters in bold).
+    width = min(13.0, 2.4 + 0.8 * len(scenes))
+    height = min(18.0, 1.2 + len(panels) * (0.9 + 0.22 * len(labels)))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(width, height), sharex=True, squeeze=False)
+    for ax, (col, title) in zip(axes[:, 0], panels):
         z = np.full((len(labels), len(scenes)), np.nan)
         for p in ran:
             v = num(p[col])
@@ -497,10 +500,10 @@ def plot_methods(pts, meta, args):
                     ax.text(c, r, short(z[r, c]), ha="center", va="center", fontsize=6.5,
                             fontweight="bold" if ratio[r, c] <= 1.0 else "normal")
         ax.set_xticks(range(len(scenes)))
-        ax.set_xticklabels(scenes, rotation=35, ha="right", fontsize=7)
+        ax.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
         ax.set_yticks(range(len(labels)))
         ax.set_yticklabels(labels, fontsize=7)
-        ax.set_title(title + "\ncolour: ratio to the best of the scene (bold)", fontsize=8)
+        ax.set_title(title + "; colour: ratio to the best of the scene (bold)", fontsize=8)
         ax.grid(False)
     fig.suptitle("Broad-phase methods side by side (threads %s)" % ",".join(sorted({p["threads"] for p in ran})))
     finish(fig, meta, ", ".join(scenes), "methods", args)
