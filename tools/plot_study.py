@@ -3,7 +3,7 @@
 (or --out FOLDER), and report.html, one page with the figures, the table, the command and the machine. Which
 figures depend on the sweep and on the columns that vary.
 
-usage: plot_study.py DIR [--out FOLDER] [--formats png,svg] [--prefix NAME]
+usage: plot_study.py DIR [--out FOLDER] [--formats png,svg] [--prefix NAME] [--no-report]
 """
 import argparse
 import csv
@@ -563,6 +563,7 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--formats", default="png,svg")
     ap.add_argument("--prefix", default="")
+    ap.add_argument("--no-report", action="store_true", help="figures only, no report.html")
     args = ap.parse_args()
     args.out = args.out or args.dir
     args.formats = [f for f in args.formats.split(",") if f]
@@ -594,7 +595,8 @@ def main():
             plot_methods(pts, meta, args)
         else:
             plot_detection(pts, meta, args, sweep)
-        write_report(rows, meta, args, sweep)
+        if not args.no_report:
+            write_report(rows, meta, args, sweep)
     except OSError as e:
         print("plot_study.py: error: cannot write figures to %s: %s" % (args.out, e), file=sys.stderr)
         return 1
