@@ -165,6 +165,14 @@ TEST(CliRender, SimulateRenderWritesTheAnimationAtTheEnd)
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--render 'x.jpg'"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out2" / "frame_00000.vtu"));
+    // A scene that writes no frames has nothing to draw: said before the run.
+    std::string none = kScene;
+    none.replace(none.find("every = 2"), 9, "every = 0");
+    write_text(dir / "none.toml", none);
+    const auto n = run_tethash("simulate " + quote(dir / "none.toml") + " --out " + quote(dir / "out3") + " --render");
+    EXPECT_EQ(n.status, 2);
+    EXPECT_NE(n.err.find("writes no frames"), std::string::npos) << n.err;
+    EXPECT_EQ(n.out.find("steps:"), std::string::npos) << n.out;
 }
 
 TEST(CliRender, BadInputExits2AndAFolderThatTakesNoFileExits1)

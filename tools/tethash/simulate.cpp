@@ -275,6 +275,8 @@ void run_simulate(SimulateOptions o)
     if (!o.render.empty()) {
         render::check_render_path(o.render, "--render");
         render_options = o.render_flags.options();
+        if (scene.output.every == 0)
+            throw Error("--render: the scene writes no frames ([output] every = 0): nothing to draw");
     }
     sim::Simulation sim(scene);
     sim.set_interrupt_flag(&g_interrupted);
@@ -306,6 +308,9 @@ void run_simulate(SimulateOptions o)
     // part 1 of the series: ParaView and `tethash render` show it beside the frames (part 0).
     std::string static_file;
     auto write_frame = [&]() {
+        const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
+        io::write_vtu((std::filesystem::path(o.out) / name).string(), sim.mesh(), sim.output_fields());
+        // After the first frame (a folder that takes no frame gets no static surface either).
         if (series.empty()) {
             const sim::StaticSurface st = sim.static_surface();
             if (st.surface.triangles.rows() > 0) {
@@ -314,8 +319,6 @@ void run_simulate(SimulateOptions o)
                                       st.triangle_object);
             }
         }
-        const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
-        io::write_vtu((std::filesystem::path(o.out) / name).string(), sim.mesh(), sim.output_fields());
         series.push_back({sim.time(), name, 0});
         if (!static_file.empty()) series.push_back({sim.time(), static_file, 1});
         io::write_pvd_parts(pvd, series);
@@ -477,10 +480,7 @@ void run_simulate(SimulateOptions o)
     if (every > 0)
         std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView; run.json says how far to trust them)\n",
                      frames, o.out.c_str());
-    if (render_options) {
-        if (every <= 0) throw Error("--render: the scene writes no frames ([output] every = 0): nothing to draw");
-        render_run(render::open_series(o.out), *render_options, o.render);
-    }
+    if (render_options) render_run(render::open_series(o.out), *render_options, o.render);
     if (o.strict && !problems.empty())
         throw RunFailure("--strict: the run cannot be trusted (" + std::to_string(problems.size()) + " problem" +
                          (problems.size() == 1 ? "" : "s") + " above)");
