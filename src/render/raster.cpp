@@ -106,10 +106,12 @@ void Canvas::fill(const Eigen::Vector3d* p, Rgb c)
         }
         const double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
         if (!(std::abs(area) > 1e-12)) continue;
-        const int x0 = std::max(0, static_cast<int>(std::floor(std::min({sx[0], sx[1], sx[2]}) - 0.5)));
-        const int x1 = std::min(w - 1, static_cast<int>(std::ceil(std::max({sx[0], sx[1], sx[2]}) - 0.5)));
-        const int y0 = std::max(0, static_cast<int>(std::floor(std::min({sy[0], sy[1], sy[2]}) - 0.5)));
-        const int y1 = std::min(h - 1, static_cast<int>(std::ceil(std::max({sy[0], sy[1], sy[2]}) - 0.5)));
+        // The pixel box, clamped in floating point first: a corner just past the near plane projects far out.
+        const auto pixel = [](double v, int size) { return static_cast<int>(std::clamp(v, -1.0, double(size))); };
+        const int x0 = std::max(0, pixel(std::floor(std::min({sx[0], sx[1], sx[2]}) - 0.5), w));
+        const int x1 = std::min(w - 1, pixel(std::ceil(std::max({sx[0], sx[1], sx[2]}) - 0.5), w));
+        const int y0 = std::max(0, pixel(std::floor(std::min({sy[0], sy[1], sy[2]}) - 0.5), h));
+        const int y1 = std::min(h - 1, pixel(std::ceil(std::max({sy[0], sy[1], sy[2]}) - 0.5), h));
         if (x0 > x1 || y0 > y1) continue;
         const double inv = 1.0 / area;
         // Edge functions e_i(x, y) = A_i x + B_i y + C_i, the barycentric weight of corner i times the area.
