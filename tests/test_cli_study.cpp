@@ -150,6 +150,30 @@ TEST(CliStudy, PlotScriptWritesFiguresWhenMatplotlibIsPresent)
     const std::string svg = test::read_text(dir / "s" / "stages_vs_cell.svg");
     EXPECT_NE(svg.find("cell size / mean edge length"), std::string::npos); // labelled axes
     EXPECT_NE(svg.find("command:"), std::string::npos);                     // the footer names the command
+    // ... without the absolute paths of the machine that ran it (the mesh given as a path under the test folder).
+    EXPECT_EQ(svg.find(dir.string()), std::string::npos) << "an absolute path in the footer";
+    EXPECT_NE(svg.find("a.vtu+"), std::string::npos); // relative to the repository, or the file's name
+    // The exactness figure's cell sizes on the log axis of the stages and candidates figures: ticks 0.5, 1, 2, not
+    // the linear 0.50, 0.75, ..., 2.00 (nor 1.2, 1.4, ...).
+    const std::string exact = test::read_text(dir / "s" / "exactness.svg");
+    for (const char* tick : {">0.5</text>", ">1</text>", ">2</text>"})
+        EXPECT_NE(exact.find(tick), std::string::npos) << tick;
+    for (const char* tick : {">1.2</text>", ">1.25</text>", ">1.4</text>", ">1.5</text>", ">0.75</text>"})
+        EXPECT_EQ(exact.find(tick), std::string::npos) << tick;
+    // One page per study: well-formed (it parses as XML), the command and the machine, every figure it links there.
+    test::write_text(dir / "check_report.py",
+                     "import os, sys, xml.etree.ElementTree as ET\n"
+                     "d = sys.argv[1]\n"
+                     "root = ET.parse(os.path.join(d, 'report.html')).getroot()\n"
+                     "text = ''.join(root.itertext())\n"
+                     "links = [e.get('src') for e in root.iter('img')] + [e.get('href') for e in root.iter('a')]\n"
+                     "missing = [l for l in links if not os.path.exists(os.path.join(d, l))]\n"
+                     "print(len([e for e in root.iter('img')]), len(root.find('.//table').findall('.//tr')),\n"
+                     "      'command:' in text and 'machine:' in text, missing)\n");
+    const auto report = test::run_shell(py + " " + quote(dir / "check_report.py") + " " + quote(dir / "s"));
+    EXPECT_EQ(report.status, 0) << report.err;
+    // 5 figures (stages, candidates, exactness, table size, depth error), 6 points and the header, nothing missing.
+    EXPECT_EQ(report.out, "5 7 True []\n") << report.out;
 
     const auto t = run_tethash("study table-size --mesh " + mesh + " --table-size x0.1:x10:3 --repeat 1 --out " +
                                quote(dir / "t"));

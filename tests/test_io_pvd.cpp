@@ -44,3 +44,22 @@ TEST(IoPvd, ReadErrorsNameFileAndLine)
     write_text(dir / "u.pvd", "<VTKFile type=\"UnstructuredGrid\"></VTKFile>\n");
     EXPECT_THROW(io::read_pvd((dir / "u.pvd").string()), Error);
 }
+
+TEST(IoPvd, PartsRoundTripAndABadPartIsNamed)
+{
+    const auto dir = temp_dir();
+    const std::vector<io::PvdEntry> entries = {
+        {0, "frame_0.vtu", 0}, {0, "static.vtu", 1}, {0.5, "frame_1.vtu", 0}, {0.5, "static.vtu", 1}};
+    io::write_pvd_parts((dir / "s.pvd").string(), entries);
+    const std::vector<io::PvdEntry> back = io::read_pvd_parts((dir / "s.pvd").string());
+    ASSERT_EQ(back.size(), entries.size());
+    for (std::size_t i = 0; i < back.size(); ++i) {
+        EXPECT_EQ(back[i].time, entries[i].time);
+        EXPECT_EQ(back[i].file, entries[i].file);
+        EXPECT_EQ(back[i].part, entries[i].part);
+    }
+    EXPECT_EQ(io::read_pvd((dir / "s.pvd").string()).size(), 4u); // every part
+    write_text(dir / "p.pvd", "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\">\n<Collection>\n"
+                              "<DataSet timestep=\"0\" part=\"one\" file=\"a.vtu\"/>\n</Collection>\n</VTKFile>\n");
+    expect_error([&] { io::read_pvd_parts((dir / "p.pvd").string()); }, {"p.pvd:4: expected a part number"});
+}

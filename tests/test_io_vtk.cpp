@@ -5,6 +5,7 @@
 #include "tethash/error.hpp"
 
 #include <cmath>
+#include <map>
 
 using namespace tethash;
 using namespace tethash::test;
@@ -131,3 +132,47 @@ TEST(IoVtk, SharedRaptorVtu)
 }
 
 // ---- meshio interoperability ------------------------------------------------------------------
+
+// The static surfaces a simulation writes beside its frames: triangles with an "object" cell array, read back with
+// every data array (read_vtu_contents), and the fields of a tet frame read back per point and per cell.
+TEST(IoVtk, SurfaceAndFieldsReadBackWithTheirContents)
+{
+    const auto dir = temp_dir();
+    meshing::SurfaceMesh s;
+    s.vertices.resize(4, 3);
+    s.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0.5;
+    s.triangles.resize(2, 3);
+    s.triangles << 0, 1, 2, 0, 2, 3;
+    io::write_vtu_surface((dir / "s.vtu").string(), s, {3, -1});
+    const io::VtuContents c = io::read_vtu_contents((dir / "s.vtu").string());
+    EXPECT_EQ(c.mesh.num_tets(), 0);
+    EXPECT_EQ(c.mesh.positions, s.vertices);
+    EXPECT_EQ(c.triangles, s.triangles);
+    ASSERT_EQ(c.fields.cell.size(), 1u);
+    EXPECT_EQ(c.fields.cell[0].name, "object");
+    EXPECT_EQ(c.fields.cell[0].values, (std::vector<double>{3, -1}));
+    EXPECT_THROW(io::write_vtu_surface((dir / "t.vtu").string(), s, {1}), Error); // one id per triangle
+    EXPECT_FALSE(std::filesystem::exists(dir / "t.vtu"));
+
+    TetMesh m;
+    m.positions.resize(4, 3);
+    m.positions << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+    m.tets.resize(1, 4);
+    m.tets << 0, 1, 2, 3;
+    io::Fields f;
+    f.point.push_back({"heat", 1, {1, 2, 3, 4}});
+    f.point.push_back({"velocity", 3, std::vector<double>(12, 0.5)});
+    f.cell.push_back({"stress", 1, {7}});
+    io::write_vtu((dir / "m.vtu").string(), m, f);
+    const io::VtuContents d = io::read_vtu_contents((dir / "m.vtu").string());
+    EXPECT_EQ(d.mesh.tets, m.tets);
+    EXPECT_EQ(d.triangles.rows(), 0);
+    ASSERT_EQ(d.tet_cells, (std::vector<std::int64_t>{0}));
+    std::map<std::string, std::vector<double>> got;
+    for (const auto* list : {&d.fields.point, &d.fields.cell})
+        for (const io::Field& x : *list)
+            got[x.name] = x.values;
+    EXPECT_EQ(got["heat"], (std::vector<double>{1, 2, 3, 4}));
+    EXPECT_EQ(got["velocity"], std::vector<double>(12, 0.5));
+    EXPECT_EQ(got["stress"], (std::vector<double>{7}));
+}

@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """Figures of a tethash study: reads DIR/study.csv and DIR/study.json, writes PNG and SVG into DIR
-(or --out FOLDER). Which figures depend on the sweep and on the columns that vary.
+(or --out FOLDER), and report.html, one page with the figures, the table, the command and the machine. Which
+figures depend on the sweep and on the columns that vary.
 
-usage: plot_study.py DIR [--out FOLDER] [--formats png,svg] [--prefix NAME]
+usage: plot_study.py DIR [--out FOLDER] [--formats png,svg] [--prefix NAME] [--no-report]
 """
 import argparse
 import csv
 import json
+import html
 import math
 import os
+import re
 import statistics
 import sys
 
@@ -71,23 +74,46 @@ def machine_text(meta):
     return "machine: %s, %s cores, %s" % (m.get("cpu", "?"), m.get("cores", "?"), m.get("compiler", "?"))
 
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def portable_path(token):
+    """An absolute path as a reader elsewhere can use it: relative to the repository when inside it, else its last
+    component (the folders of the machine that ran the study say nothing to a reader)."""
+    if not token.startswith("/"):
+        return token
+    real = os.path.normpath(token)
+    if real == ROOT or real.startswith(ROOT + os.sep):
+        return os.path.relpath(real, ROOT)
+    return os.path.basename(real) or token
+
+
 def command_text(meta):
     c = meta.get("command")
     if meta.get("shards"):
         c = meta["shards"][0].get("command", c)
-    return c or "?"
+    if not c:
+        return "?"
+    # Every absolute path in it, also inside a token (a.vtu+b.vtu, --out=DIR, lists).
+    return re.sub(r"(?<![\w.~-])/[^\s'\"+,=:;]+", lambda m: portable_path(m.group(0)), c)
+
+
+FIGURES = []  # (name, files written), in order, for the report
 
 
 def finish(fig, meta, scene, name, args):
     footer = "scene: %s | %s\ncommand: %s" % (scene, machine_text(meta), command_text(meta))
     fig.text(0.01, 0.005, footer, fontsize=6.5, va="bottom", ha="left", wrap=True, color="0.3")
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    # Room for the footer's two lines (about 0.45 inch) and, on tall figures, for the title above the panels.
+    height = fig.get_size_inches()[1]
+    fig.tight_layout(rect=(0, min(0.07, 0.45 / height), 1, 1 if height < 8 else 1 - 0.25 / height))
     written = []
     for ext in args.formats:
         path = os.path.join(args.out, "%s%s.%s" % (args.prefix, name, ext))
         fig.savefig(path, dpi=120)
         written.append(path)
     plt.close(fig)
+    FIGURES.append((name, written))
     for p in written:
         print("figure:", p)
 
@@ -105,6 +131,21 @@ def plain_ticks(ax, axis="x"):
     a.set_major_locator(LogLocator(base=2))
     a.set_major_formatter(fmt)
     a.set_minor_formatter(FuncFormatter(lambda v, _: ""))
+
+
+def log_axis(ax, axis="x"):
+    """A log axis labelled at 1, 2 and 5 times the powers of ten, as plain numbers, without minor labels: the
+    default labels every minor tick on a narrow range, and they overlap."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    a = ax.xaxis if axis == "x" else ax.yaxis
+    (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
+    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
+    decades = math.log10(hi / lo) if lo > 0 and hi > lo else 1
+    # 1, 2, 5 per decade on a narrow range; every decade, or every few, on a wide one.
+    subs = (1.0, 2.0, 5.0) if decades <= 2.5 else (1.0,)
+    a.set_major_locator(LogLocator(base=10, subs=subs, numticks=12 if decades <= 2.5 else 8))
+    a.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+    a.set_minor_formatter(NullFormatter())
 
 
 def positive(values):
@@ -211,8 +252,13 @@ def plot_detection(pts, meta, args, sweep):
             ax.plot(x, [num(p["extra"]) for p in sp], "x", ms=5, label="extra (found, not in oracle)")
             ax.set_xlabel(xlab)
             ax.set_ylabel("contacts")
-            if spans_decades(x):
+            # The x axis of the sweep's other figures: cell sizes on a log axis in plain numbers (as the stages and
+            # candidates), table sizes on a log axis (as the table figure), threads and points linear.
+            if xcol == "cell_factor" and len(set(x)) > 1:
                 ax.set_xscale("log")
+                plain_ticks(ax)
+            elif xcol == "table_size" and len(set(x)) > 1:
+                log_axis(ax)
             ax.legend(fontsize=7)
             ax.set_title("Exactness vs the brute-force oracle, every point (%s)" % scene)
             finish(fig, meta, scene, "exactness" + tag, args)
@@ -376,14 +422,14 @@ def plot_integrator(pts, meta, args):
         axes[1].axhline(num(ok[0]["ref_max_penetration"]), color="k", ls=":", lw=0.8, label="reference")
         axes[2].axhline(abs(num(ok[0]["ref_energy_drift"])), color="k", ls=":", lw=0.8, label="reference")
     for ax in axes:
-        ax.set_xscale("log")
+        log_axis(ax)
         ax.set_xlabel("wall time per simulated second (s/s)")
-    axes[0].set_yscale("log")
+    log_axis(axes[0], "y")
     axes[0].set_ylabel("vertex position error (length units)")
     axes[0].set_title("Work-precision: error vs reference run")
     axes[1].set_ylabel("final max penetration depth (length units)")
     axes[1].set_title("Penetration at the end")
-    axes[2].set_yscale("log")
+    log_axis(axes[2], "y")
     axes[2].set_ylabel("|E(T) − E(0)| (energy units)")
     axes[2].set_title("Energy drift")
     axes[0].legend(fontsize=6)
@@ -409,40 +455,106 @@ def method_label(p):
 
 
 def plot_methods(pts, meta, args):
-    """The method sweep: per scene, one bar per method (and parameters) for the median total time, the pairs the
-    exact test checked (the same for every method when the broad phases agree) and the working memory; methods that could not run are left out (their error is in
-    the CSV)."""
+    """The method sweep as three tables in colour, one row per method (and parameters), one column per scene: the
+    median time per detection, the pairs the exact test checked and the working memory, each cell coloured by its
+    ratio to the best method of its scene (log scale) and labelled with its value. Methods that could not run are
+    left out (their error is in the CSV). Its size does not grow with the methods and scenes beyond what the labels
+    need: a bar chart of 15 methods on 9 scenes was 3,333 pixels wide with a legend nobody could match to bars."""
     ran = [p for p in pts if not p.get("error")]
     if not ran:
         print("figures: no method ran (see the error column)")
         return
+    import numpy as np
+    from matplotlib.colors import LogNorm
     scenes = list(dict.fromkeys(p["scene"] for p in ran))
     labels = list(dict.fromkeys(method_label(p) for p in ran))
+    def short(v):
+        """At most 4 or 5 characters: 0.237, 14.6, 1460, 45k, 1.5M."""
+        if v >= 1e6:
+            return "%.3gM" % (v / 1e6)
+        if v >= 1e4:
+            return "%.3gk" % (v / 1e3)
+        return "%.0f" % v if v >= 100 else "%.3g" % v
+
     panels = (("ms_total", "time per detection (ms, median)"), ("inside_tests", "pairs tested (inside tests)"),
-              ("memory_bytes", "working memory (bytes)"))
-    fig, axes = plt.subplots(len(panels), 1, figsize=(max(6.0, 0.9 + 0.16 * len(labels) * len(scenes)), 8.5),
-                             sharex=True)
-    width = 0.8 / max(1, len(labels))
-    cmap = plt.get_cmap("tab20")
-    for ax, (col, title) in zip(axes, panels):
-        ys = []
-        for k, lab in enumerate(labels):
-            xs, y = [], []
-            for i, sc in enumerate(scenes):
-                v = [num(p[col]) for p in ran if p["scene"] == sc and method_label(p) == lab]
-                if v:
-                    xs.append(i - 0.4 + width * (k + 0.5))
-                    y.append(v[0])
-            ax.bar(xs, positive(y), width=width, color=cmap(k % 20), label=lab if ax is axes[0] else None)
-            ys += y
-        ax.set_ylabel(title)
-        if spans_decades(ys, 10):
-            ax.set_yscale("log")
-    axes[-1].set_xticks(range(len(scenes)))
-    axes[-1].set_xticklabels(scenes, rotation=20, ha="right")
-    axes[0].legend(fontsize=6, ncol=min(5, len(labels)), loc="lower left", bbox_to_anchor=(0, 1.02))
+              ("memory_bytes", "working memory (MB)"))
+    # One panel under the other, a column of 0.8 inch per scene (room for five characters in bold).
+    width = min(13.0, 2.4 + 0.8 * len(scenes))
+    height = min(18.0, 1.2 + len(panels) * (0.9 + 0.22 * len(labels)))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(width, height), sharex=True, squeeze=False)
+    for ax, (col, title) in zip(axes[:, 0], panels):
+        z = np.full((len(labels), len(scenes)), np.nan)
+        for p in ran:
+            v = num(p[col])
+            if col == "memory_bytes":
+                v /= 1e6
+            z[labels.index(method_label(p)), scenes.index(p["scene"])] = v
+        best = np.nanmin(np.where(z > 0, z, np.nan), axis=0)
+        ratio = z / best
+        ratio[~(ratio > 0)] = np.nan
+        top = np.nanmax(ratio) if np.isfinite(ratio).any() else 2
+        ax.imshow(ratio, aspect="auto", cmap="RdYlGn_r", norm=LogNorm(vmin=1, vmax=max(2.0, top)))
+        for r in range(len(labels)):
+            for c in range(len(scenes)):
+                if np.isfinite(z[r, c]):
+                    ax.text(c, r, short(z[r, c]), ha="center", va="center", fontsize=6.5,
+                            fontweight="bold" if ratio[r, c] <= 1.0 else "normal")
+        ax.set_xticks(range(len(scenes)))
+        ax.set_xticklabels(scenes, rotation=30, ha="right", fontsize=7)
+        ax.set_yticks(range(len(labels)))
+        ax.set_yticklabels(labels, fontsize=7)
+        ax.set_title(title + "; colour: ratio to the best of the scene (bold)", fontsize=8)
+        ax.grid(False)
     fig.suptitle("Broad-phase methods side by side (threads %s)" % ",".join(sorted({p["threads"] for p in ran})))
     finish(fig, meta, ", ".join(scenes), "methods", args)
+
+
+def write_report(rows, meta, args, sweep):
+    """report.html beside the figures: one page with the command, the machine, every figure drawn and the table of
+    points (medians over the repeats), well-formed (it parses as XML) and with relative links only."""
+    e = html.escape
+    title = "tethash study: %s" % (sweep or "?")
+    out = []
+    out.append("<!DOCTYPE html>")
+    out.append('<html lang="en"><head><meta charset="utf-8"/><title>%s</title>' % e(title))
+    out.append("<style>body{font-family:sans-serif;margin:1.5em;max-width:1200px}img{max-width:100%;"
+               "border:1px solid #ddd}figure{margin:1em 0}table{border-collapse:collapse;font-size:12px}"
+               "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}th{background:#eee}"
+               "div.table{overflow-x:auto}code{background:#f4f4f4;padding:2px 4px}</style></head><body>")
+    out.append("<h1>%s</h1>" % e(title))
+    out.append("<p>command: <code>%s</code></p>" % e(command_text(meta)))
+    out.append("<p>%s</p>" % e(machine_text(meta)))
+    out.append("<h2>Figures</h2>")
+    if not FIGURES:
+        out.append("<p>none for this sweep (see the table)</p>")
+    for name, files in FIGURES:
+        pick = [f for f in files if f.endswith(".png")] or [f for f in files if f.endswith(".svg")]
+        if not pick:
+            continue
+        src = os.path.relpath(pick[0], args.out)
+        out.append('<figure><img src="%s" alt="%s"/><figcaption>%s</figcaption></figure>' % (e(src), e(name), e(name)))
+    cols = list(rows[0].keys())
+    pts = points(rows)
+    limit = 500
+    csv_link = os.path.relpath(os.path.join(args.dir, "study.csv"), args.out)
+    out.append("<h2>Table</h2>")
+    out.append('<p>%d points (timings: medians over the repeats)%s; every row: <a href="%s">study.csv</a></p>' %
+               (len(pts), ", the first %d shown" % limit if len(pts) > limit else "", e(csv_link)))
+    out.append('<div class="table"><table><thead><tr>%s</tr></thead><tbody>' %
+               "".join("<th>%s</th>" % e(c) for c in cols))
+    for p in pts[:limit]:
+        cells = []
+        for c in cols:
+            v = p.get(c, "")
+            cells.append("<td>%s</td>" % e("%.4g" % v if isinstance(v, float) else str(v)))
+        out.append("<tr>%s</tr>" % "".join(cells))
+    out.append("</tbody></table></div></body></html>")
+    path = os.path.join(args.out, "%sreport.html" % args.prefix)
+    tmp = path + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write("\n".join(out) + "\n")
+    os.replace(tmp, path)
+    print("report:", path)
 
 
 def main():
@@ -451,6 +563,7 @@ def main():
     ap.add_argument("--out", default=None)
     ap.add_argument("--formats", default="png,svg")
     ap.add_argument("--prefix", default="")
+    ap.add_argument("--no-report", action="store_true", help="figures only, no report.html")
     args = ap.parse_args()
     args.out = args.out or args.dir
     args.formats = [f for f in args.formats.split(",") if f]
@@ -482,6 +595,8 @@ def main():
             plot_methods(pts, meta, args)
         else:
             plot_detection(pts, meta, args, sweep)
+        if not args.no_report:
+            write_report(rows, meta, args, sweep)
     except OSError as e:
         print("plot_study.py: error: cannot write figures to %s: %s" % (args.out, e), file=sys.stderr)
         return 1

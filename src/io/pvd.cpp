@@ -12,21 +12,38 @@ namespace tethash::io {
 
 void write_pvd(const std::string& path, const std::vector<std::pair<double, std::string>>& entries)
 {
+    std::vector<PvdEntry> parts;
+    parts.reserve(entries.size());
+    for (const auto& [time, file] : entries)
+        parts.push_back({time, file, 0});
+    write_pvd_parts(path, parts);
+}
+
+void write_pvd_parts(const std::string& path, const std::vector<PvdEntry>& entries)
+{
     std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                       "byte_order=\"LittleEndian\">\n  <Collection>\n";
-    for (const auto& [time, file] : entries) {
+    for (const auto& [time, file, part] : entries) {
         if (!std::isfinite(time))
             throw Error(path + ": time " + detail::format_double(time) + " of '" + file + "' is not finite");
         if (file.empty())
             throw Error(path + ": an entry at time " + detail::format_double(time) + " has an empty file name");
-        xml += "    <DataSet timestep=\"" + detail::format_double(time) + "\" group=\"\" part=\"0\" file=\"" +
-               detail::xml_escape(file) + "\"/>\n";
+        xml += "    <DataSet timestep=\"" + detail::format_double(time) + "\" group=\"\" part=\"" +
+               std::to_string(part) + "\" file=\"" + detail::xml_escape(file) + "\"/>\n";
     }
     xml += "  </Collection>\n</VTKFile>\n";
     write_text_file(path, xml);
 }
 
 std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
+{
+    std::vector<std::pair<double, std::string>> r;
+    for (PvdEntry& e : read_pvd_parts(path))
+        r.emplace_back(e.time, std::move(e.file));
+    return r;
+}
+
+std::vector<PvdEntry> read_pvd_parts(const std::string& path)
 {
     const std::string data = read_file(path);
     const detail::XmlDocument doc = detail::parse_xml(path, data);
@@ -39,7 +56,7 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
                     "\"");
     const detail::XmlElement* col = doc.root.child("Collection");
     if (!col) throw Error(at(doc.root.line) + ": expected <Collection>, found none");
-    std::vector<std::pair<double, std::string>> r;
+    std::vector<PvdEntry> r;
     for (const auto& ds : col->children) {
         if (ds.name != "DataSet") continue;
         const std::string* file = ds.attr("file");
@@ -52,7 +69,14 @@ std::vector<std::pair<double, std::string>> read_pvd(const std::string& path)
                 throw Error(at(ds.line) + ": expected a number for timestep, found \"" + *ts + "\"");
             t = *v;
         }
-        r.emplace_back(t, *file);
+        int part = 0;
+        if (const std::string* p = ds.attr("part")) {
+            const auto v = detail::parse_int(*p);
+            if (!v || *v < 0 || *v > 1000000)
+                throw Error(at(ds.line) + ": expected a part number for part, found \"" + *p + "\"");
+            part = static_cast<int>(*v);
+        }
+        r.push_back({t, *file, part});
     }
     return r;
 }

@@ -29,6 +29,8 @@ class VtuReader : FileReaderBase {
   public:
     using FileReaderBase::FileReaderBase;
     TetMesh read();
+    /// read() also fills `extra` with the triangles and every data array (read_vtu_contents).
+    void set_contents(VtuContents* extra) { m_extra = extra; }
 
   private:
     std::string attr(const XmlElement& el, const char* key, bool required = true) const
@@ -62,6 +64,7 @@ class VtuReader : FileReaderBase {
     bool m_big_endian = false;
     bool m_header64 = false;
     bool m_zlib = false;
+    VtuContents* m_extra = nullptr;
 };
 
 std::int64_t VtuReader::int_attr(const XmlElement& el, const char* key, std::int64_t min_value) const
@@ -383,8 +386,9 @@ TetMesh VtuReader::read()
 
     std::vector<double> coords;
     std::vector<std::int64_t> tet_cells;
-    std::vector<Index> tet_ids;
+    std::vector<Index> tet_ids, triangle_ids;
     std::map<std::int64_t, std::int64_t> skipped;
+    std::map<std::string, Field> point_fields, cell_fields; // read_vtu_contents: every array of 1 or 3 components
     std::map<std::string, NamedArray> point_arrays, cell_arrays;
     std::int64_t total_points = 0, total_cells = 0;
 
@@ -451,6 +455,21 @@ TetMesh VtuReader::read()
                                                            " values, the last offset)");
             for (std::size_t c = 0; c < ncz; ++c) {
                 const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+                if (types[c] == 5 && m_extra) {
+                    const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
+                    if (offsets[c] - first != 3)
+                        fail(at_value(tda, c), "cell " + std::to_string(c) + " has type 5 (triangle) but " +
+                                                   std::to_string(offsets[c] - first) + " points, expected 3");
+                    for (int k = 0; k < 3; ++k) {
+                        const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
+                        if (v < 0 || v >= np)
+                            fail(at_value(cda, static_cast<std::size_t>(first + k)),
+                                 "triangle (cell " + std::to_string(c) + ") refers to point " + std::to_string(v) +
+                                     ", but the piece has only " + std::to_string(np) + " points (0-based ids)");
+                        triangle_ids.push_back(static_cast<Index>(v + total_points));
+                    }
+                    m_extra->triangle_cells.push_back(total_cells + static_cast<std::int64_t>(c));
+                }
                 if (types[c] != 10 && !quadratic) {
                     ++skipped[types[c]];
                     continue;
@@ -483,6 +502,15 @@ TetMesh VtuReader::read()
                 if (da.name != "DataArray" || !da.attr("Name")) continue;
                 const std::string& name = *da.attr("Name");
                 const std::string* nc_attr = da.attr("NumberOfComponents");
+                if (m_extra && (!nc_attr || *nc_attr == "1" || *nc_attr == "3")) {
+                    const int comps = nc_attr && *nc_attr == "3" ? 3 : 1;
+                    auto values =
+                        read_array<double>(da, count * static_cast<std::size_t>(comps), "DataArray '" + name + "'");
+                    Field& f = (cell ? cell_fields : point_fields)[name];
+                    if (f.name.empty()) f = Field{name, comps, {}};
+                    // A piece without the array (or with other components) leaves it short: dropped below.
+                    if (f.components == comps) f.values.insert(f.values.end(), values.begin(), values.end());
+                }
                 if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
                 auto values = read_array<double>(da, count, "DataArray '" + name + "'");
                 NamedArray& a = into[name];
@@ -503,6 +531,17 @@ TetMesh VtuReader::read()
     mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
     std::copy(tet_ids.begin(), tet_ids.end(), mesh.tets.data());
     note_skipped_cells(skipped);
+    if (m_extra) {
+        m_extra->triangles.resize(static_cast<Eigen::Index>(triangle_ids.size() / 3), 3);
+        std::copy(triangle_ids.begin(), triangle_ids.end(), m_extra->triangles.data());
+        m_extra->tet_cells = tet_cells;
+        for (auto& [k, f] : point_fields)
+            if (f.values.size() == static_cast<std::size_t>(total_points) * static_cast<std::size_t>(f.components))
+                m_extra->fields.point.push_back(std::move(f));
+        for (auto& [k, f] : cell_fields)
+            if (f.values.size() == static_cast<std::size_t>(total_cells) * static_cast<std::size_t>(f.components))
+                m_extra->fields.cell.push_back(std::move(f));
+    }
     std::vector<NamedArray> pa, ca;
     for (auto& [k, a] : point_arrays)
         pa.push_back(std::move(a));
@@ -526,6 +565,15 @@ bool vtu_zlib_supported()
 TetMesh read_vtu(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
     return VtuReader(path, notes, options).read();
+}
+
+VtuContents read_vtu_contents(const std::string& path, ReadNotes* notes, const ReadOptions& options)
+{
+    VtuContents c;
+    VtuReader reader(path, notes, options);
+    reader.set_contents(&c);
+    c.mesh = reader.read();
+    return c;
 }
 
 } // namespace tethash::io

@@ -17,13 +17,14 @@ namespace tethash::io {
 using namespace vtk_detail;
 using detail::xml_escape;
 
-void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)
-{
-    std::vector<OutArray> point_arrays, cell_arrays;
-    collect_out_arrays(path, mesh, fields, true, point_arrays, cell_arrays);
-    const std::size_t n = static_cast<std::size_t>(mesh.num_vertices()), m = static_cast<std::size_t>(mesh.num_tets());
+namespace {
 
-    const bool offsets64 = 4 * m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+/// The cells of one kind (`nodes` per cell, VTK type `type`): `cells` holds m × nodes point ids, row-major.
+void write_vtu_cells(const std::string& path, const Positions& positions, const Index* cells, std::size_t m, int nodes,
+                     char type, const std::vector<OutArray>& point_arrays, const std::vector<OutArray>& cell_arrays)
+{
+    const std::size_t n = static_cast<std::size_t>(positions.rows()), k = static_cast<std::size_t>(nodes);
+    const bool offsets64 = k * m > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
     // Every array as (XML attributes, byte size, writer of its little-endian data).
     struct Block {
         std::string section; // "PointData", "CellData", "Points", "Cells"
@@ -52,22 +53,22 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
     blocks.push_back(
         {"Points", "type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"", 3 * n * 8, [&](std::string& out) {
              for (std::size_t i = 0; i < 3 * n; ++i)
-                 append_bytes<double>(out, mesh.positions.data()[i], false);
+                 append_bytes<double>(out, positions.data()[i], false);
          }});
-    blocks.push_back({"Cells", "type=\"Int32\" Name=\"connectivity\"", 4 * m * 4, [&](std::string& out) {
-                          for (std::size_t i = 0; i < 4 * m; ++i)
-                              append_bytes<std::int32_t>(out, mesh.tets.data()[i], false);
+    blocks.push_back({"Cells", "type=\"Int32\" Name=\"connectivity\"", k * m * 4, [&](std::string& out) {
+                          for (std::size_t i = 0; i < k * m; ++i)
+                              append_bytes<std::int32_t>(out, cells[i], false);
                       }});
     blocks.push_back({"Cells", std::string("type=\"") + (offsets64 ? "Int64" : "Int32") + "\" Name=\"offsets\"",
                       m * (offsets64 ? 8 : 4), [&](std::string& out) {
                           for (std::size_t t = 1; t <= m; ++t) {
                               if (offsets64)
-                                  append_bytes<std::int64_t>(out, static_cast<std::int64_t>(4 * t), false);
+                                  append_bytes<std::int64_t>(out, static_cast<std::int64_t>(k * t), false);
                               else
-                                  append_bytes<std::int32_t>(out, static_cast<std::int32_t>(4 * t), false);
+                                  append_bytes<std::int32_t>(out, static_cast<std::int32_t>(k * t), false);
                           }
                       }});
-    blocks.push_back({"Cells", "type=\"UInt8\" Name=\"types\"", m, [&](std::string& out) { out.append(m, '\x0a'); }});
+    blocks.push_back({"Cells", "type=\"UInt8\" Name=\"types\"", m, [&](std::string& out) { out.append(m, type); }});
 
     bool header64 = false;
     for (const Block& b : blocks)
@@ -115,6 +116,38 @@ void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& field
     }
     xml += "\n  </AppendedData>\n</VTKFile>\n";
     write_text_file(path, xml);
+}
+
+} // namespace
+
+void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields)
+{
+    std::vector<OutArray> point_arrays, cell_arrays;
+    collect_out_arrays(path, mesh, fields, true, point_arrays, cell_arrays);
+    write_vtu_cells(path, mesh.positions, mesh.tets.data(), static_cast<std::size_t>(mesh.num_tets()), 4, '\x0a',
+                    point_arrays, cell_arrays);
+}
+
+void write_vtu_surface(const std::string& path, const meshing::SurfaceMesh& surface,
+                       const std::vector<Index>& triangle_object)
+{
+    const Index n = static_cast<Index>(surface.vertices.rows());
+    if (triangle_object.size() != static_cast<std::size_t>(surface.triangles.rows()))
+        throw Error(path + ": " + std::to_string(triangle_object.size()) + " object ids for " +
+                    std::to_string(surface.triangles.rows()) + " triangles");
+    for (Index i = 0; i < 3 * static_cast<Index>(surface.triangles.rows()); ++i)
+        if (surface.triangles.data()[i] < 0 || surface.triangles.data()[i] >= n)
+            throw Error(path + ": triangle " + std::to_string(i / 3) + " refers to vertex " +
+                        std::to_string(surface.triangles.data()[i]) + " of " + std::to_string(n));
+    for (Index i = 0; i < 3 * n; ++i)
+        if (!std::isfinite(surface.vertices.data()[i]))
+            throw Error(path + ": vertex " + std::to_string(i / 3) + " has a non-finite coordinate");
+    OutArray object;
+    object.name = "object";
+    object.integer = true;
+    object.ints = &triangle_object;
+    write_vtu_cells(path, surface.vertices, surface.triangles.data(),
+                    static_cast<std::size_t>(surface.triangles.rows()), 3, '\x05', {}, {object});
 }
 
 } // namespace tethash::io

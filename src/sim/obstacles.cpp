@@ -56,6 +56,7 @@ SceneObstacles take_obstacles(Scene& scene)
         transform_positions(o, surface.vertices);
         out.set.add(Bsp(surface.vertices, surface.triangles, "object '" + o.name + "' (" + o.mesh + ")"));
         out.names.push_back(o.name);
+        out.surfaces.push_back(std::move(surface));
     }
     for (std::size_t p = 0; p < scene.pins.size(); ++p) {
         PinRegion& pin = scene.pins[p];

@@ -5,6 +5,7 @@
 
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/meshing/surface_mesh.hpp"
 #include "tethash/sim/scene.hpp"
 
 #include <string>
@@ -15,6 +16,7 @@ namespace tethash::sim {
 struct SceneObstacles {
     ObstacleSet set;
     std::vector<std::string> names;
+    std::vector<meshing::SurfaceMesh> surfaces; ///< each obstacle's surface, transformed (for the output frames)
     Index first_object = 0; ///< obstacle k is object first_object + k in the contacts (after the tet objects)
 
     Index size() const { return set.size(); }

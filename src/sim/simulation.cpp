@@ -675,6 +675,59 @@ std::vector<std::string> RunHealth::problems() const
     return out;
 }
 
+StaticSurface Simulation::static_surface() const
+{
+    const SimulationImpl& s = *m_impl;
+    StaticSurface out;
+    Index nv = 0, nt = 0;
+    for (const meshing::SurfaceMesh& m : s.obstacles.surfaces) {
+        nv += static_cast<Index>(m.vertices.rows());
+        nt += static_cast<Index>(m.triangles.rows());
+    }
+    const Ground& g = s.model.ground;
+    if (g.enabled) nv += 4, nt += 2;
+    out.surface.vertices.resize(nv, 3);
+    out.surface.triangles.resize(nt, 3);
+    Index v0 = 0, t0 = 0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t k = 0; k < s.obstacles.surfaces.size(); ++k) {
+        const meshing::SurfaceMesh& m = s.obstacles.surfaces[k];
+        out.surface.vertices.middleRows(v0, m.vertices.rows()) = m.vertices;
+        out.surface.triangles.middleRows(t0, m.triangles.rows()) = m.triangles.array() + v0;
+        out.triangle_object.insert(out.triangle_object.end(), static_cast<std::size_t>(m.triangles.rows()),
+                                   s.obstacles.first_object + static_cast<Index>(k));
+        for (Index i = 0; i < m.vertices.rows(); ++i) {
+            lo = lo.cwiseMin(m.vertices.row(i).transpose());
+            hi = hi.cwiseMax(m.vertices.row(i).transpose());
+        }
+        v0 += static_cast<Index>(m.vertices.rows());
+        t0 += static_cast<Index>(m.triangles.rows());
+    }
+    if (g.enabled) {
+        for (Index i = 0; i < s.mesh().num_vertices(); ++i) {
+            lo = lo.cwiseMin(s.mesh().positions.row(i).transpose());
+            hi = hi.cwiseMax(s.mesh().positions.row(i).transpose());
+        }
+        if (!(lo.array() <= hi.array()).all()) lo = hi = Eigen::Vector3d::Zero();
+        const Eigen::Vector3d n = g.normal.normalized();
+        Eigen::Vector3d centre = 0.5 * (lo + hi);
+        centre -= (n.dot(centre) - g.height) * n; // onto the plane n·x = height
+        const double half = std::max(0.5, 2 * (hi - lo).norm());
+        // Two directions in the plane: e1 orthogonal to n (from the axis least along n), e2 = n × e1.
+        Eigen::Index least = 0;
+        n.cwiseAbs().minCoeff(&least);
+        const Eigen::Vector3d e1 = n.cross(Eigen::Vector3d::Unit(least)).normalized(), e2 = n.cross(e1);
+        const double corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+        for (int c = 0; c < 4; ++c)
+            out.surface.vertices.row(v0 + c) = (centre + half * (corner[c][0] * e1 + corner[c][1] * e2)).transpose();
+        // Counter-clockwise seen from the side n points to (e1, e2, n right-handed): the normal is n.
+        out.surface.triangles.row(t0) << v0, v0 + 1, v0 + 2;
+        out.surface.triangles.row(t0 + 1) << v0, v0 + 2, v0 + 3;
+        out.triangle_object.insert(out.triangle_object.end(), 2, -1);
+    }
+    return out;
+}
+
 io::Fields Simulation::output_fields() const
 {
     const SimulationImpl& s = *m_impl;

@@ -1,5 +1,6 @@
 // tethash simulate: runs a scene (TOML, or the built-in default) and writes VTU frames + a .pvd series.
 #include "command.hpp"
+#include "render_options.hpp"
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -21,6 +22,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 namespace tethash::cli {
 namespace {
@@ -34,7 +36,7 @@ extern "C" void on_interrupt(int)
     std::signal(SIGINT, SIG_DFL);
 }
 
-/// Removes frame_NNNNN.vtu, scene.pvd and run.json from `dir`; returns how many files it removed.
+/// Removes frame_NNNNN.vtu, static.vtu, scene.pvd and run.json from `dir`; returns how many files it removed.
 int remove_previous_frames(const std::string& dir)
 {
     int removed = 0;
@@ -44,7 +46,7 @@ int remove_previous_frames(const std::string& dir)
         const bool frame =
             name.size() == 15 && name.compare(0, 6, "frame_") == 0 && name.compare(11, 4, ".vtu") == 0 &&
             std::all_of(name.begin() + 6, name.begin() + 11, [](char c) { return c >= '0' && c <= '9'; });
-        if ((frame || name == "scene.pvd" || name == "run.json") && entry.is_regular_file()) {
+        if ((frame || name == "scene.pvd" || name == "run.json" || name == "static.vtu") && entry.is_regular_file()) {
             std::error_code rm;
             if (std::filesystem::remove(entry.path(), rm))
                 ++removed;
@@ -71,6 +73,8 @@ struct SimulateOptions {
     std::string up = "z";
     double young = 1e5, density = 1000;
     bool template_scene = false;
+    std::string render; ///< --render FILE: the run drawn at its end ("" none)
+    RenderFlags render_flags;
 };
 
 /// A file name whose extension is a mesh's (tet mesh or surface), not a scene's.
@@ -198,9 +202,15 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
         .member("volume_ratio_end", h.volume_end)
         .member("inverted_tets_end", h.inverted_end)
         .member("tets", h.tets)
-        .member("wall_seconds", wall)
-        .key("problems")
-        .begin_array(study::JsonWriter::block_layout);
+        .member("wall_seconds", wall);
+    // The scene's up axis (the ground's normal, else against gravity), for the camera of `tethash render`.
+    Eigen::Vector3d up(0, 0, 1);
+    if (sim.model().ground.enabled)
+        up = sim.model().ground.normal.normalized();
+    else if (sim.scene().gravity.norm() > 0)
+        up = -sim.scene().gravity.normalized();
+    j.key("up").begin_array().value(up.x()).value(up.y()).value(up.z()).end_array();
+    j.key("problems").begin_array(study::JsonWriter::block_layout);
     for (const std::string& p : h.problems())
         j.value(p);
     j.end_array().end_object();
@@ -260,6 +270,14 @@ void run_simulate(SimulateOptions o)
     const int all = set_threads(scene.detect.threads);
     const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
 
+    // --render: its file and options checked before the run, not after it.
+    std::optional<render::RenderOptions> render_options;
+    if (!o.render.empty()) {
+        render::check_render_path(o.render, "--render");
+        render_options = o.render_flags.options();
+        if (scene.output.every == 0)
+            throw Error("--render: the scene writes no frames ([output] every = 0): nothing to draw");
+    }
     sim::Simulation sim(scene);
     sim.set_interrupt_flag(&g_interrupted);
     for (const std::string& w : sim.warnings())
@@ -284,13 +302,26 @@ void run_simulate(SimulateOptions o)
         io::write_text_file(path, mesh_scene);
         std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n", path.c_str());
     }
-    std::vector<std::pair<double, std::string>> series;
+    std::vector<io::PvdEntry> series;
     const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
+    // What does not move (the bsp obstacles, the ground) is written once, static.vtu, and listed at every time as
+    // part 1 of the series: ParaView and `tethash render` show it beside the frames (part 0).
+    std::string static_file;
     auto write_frame = [&]() {
         const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
         io::write_vtu((std::filesystem::path(o.out) / name).string(), sim.mesh(), sim.output_fields());
-        series.emplace_back(sim.time(), name);
-        io::write_pvd(pvd, series);
+        // After the first frame (a folder that takes no frame gets no static surface either).
+        if (series.empty()) {
+            const sim::StaticSurface st = sim.static_surface();
+            if (st.surface.triangles.rows() > 0) {
+                static_file = "static.vtu";
+                io::write_vtu_surface((std::filesystem::path(o.out) / static_file).string(), st.surface,
+                                      st.triangle_object);
+            }
+        }
+        series.push_back({sim.time(), name, 0});
+        if (!static_file.empty()) series.push_back({sim.time(), static_file, 1});
+        io::write_pvd_parts(pvd, series);
     };
     // 60 frames per simulated second unless the scene says (a frame every step of a 55k-tet mesh wrote 2.5 GB).
     const int every = scene.output.every >= 0 ? scene.output.every
@@ -394,13 +425,15 @@ void run_simulate(SimulateOptions o)
         throw;
     }
     if (tty) std::fprintf(stderr, "\n");
+    const std::size_t frames = static_cast<std::size_t>(
+        std::count_if(series.begin(), series.end(), [](const io::PvdEntry& e) { return e.part == 0; }));
     if (g_interrupted) {
         write_run_json(o.out, sim, "interrupted",
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         std::fprintf(stderr,
                      "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
                      "series: %s\n",
-                     done, scene.steps, sim.time(), series.size(), series.size() == 1 ? "" : "s", pvd.c_str());
+                     done, scene.steps, sim.time(), frames, frames == 1 ? "" : "s", pvd.c_str());
         std::fflush(stderr);
         std::signal(SIGINT, SIG_DFL);
         std::raise(SIGINT); // the conventional status of a run ended by Ctrl-C (130 from a shell)
@@ -450,7 +483,8 @@ void run_simulate(SimulateOptions o)
     write_run_json(o.out, sim, problems.empty() ? "ok" : "untrusted", wall);
     if (every > 0)
         std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView; run.json says how far to trust them)\n",
-                     series.size(), o.out.c_str());
+                     frames, o.out.c_str());
+    if (render_options) render_run(render::open_series(o.out), *render_options, o.render);
     if (o.strict && !problems.empty())
         throw RunFailure("--strict: the run cannot be trusted (" + std::to_string(problems.size()) + " problem" +
                          (problems.size() == 1 ? "" : "s") + " above)");
@@ -486,7 +520,16 @@ Registrar reg{
          sub.add_option("-o,--out", o->out,
                         "Output folder for frame_NNNNN.vtu and scene.pvd (those of a previous run there are removed)")
              ->capture_default_str();
-         sub.callback([o] { run_simulate(*o); });
+         CLI::Option* render = sub.add_option("--render", o->render,
+                                              "At the end, draw the run to this file (.gif, .mp4 or .png; without a "
+                                              "value OUT/scene.gif); the options of `tethash render` apply")
+                                   ->expected(0, 1);
+         o->render_flags.add(sub, false);
+         sub.callback([o, render] {
+             if (render->count() > 0 && o->render.empty())
+                 o->render = (std::filesystem::path(o->out) / "scene.gif").string();
+             run_simulate(*o);
+         });
      }}};
 
 } // namespace

@@ -13,6 +13,11 @@
 /// (a user field of the same name takes precedence).
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/surface_mesh.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 namespace tethash::io {
 
@@ -23,6 +28,21 @@ TetMesh read_vtu(const std::string& path, ReadNotes* notes = nullptr, const Read
 /// Binary appended raw data (no base64), little-endian, UInt32 header (UInt64 if an array
 /// exceeds 4 GiB).
 void write_vtu(const std::string& path, const TetMesh& mesh, const Fields& fields = {});
+/// What read_vtu_contents reads beyond the tets: the triangle cells and every data array.
+struct VtuContents {
+    TetMesh mesh;                             ///< as read_vtu returns it
+    Triangles triangles;                      ///< the triangle cells (VTK type 5), ids into mesh.positions
+    std::vector<std::int64_t> tet_cells;      ///< the file's cell index of each tet of mesh
+    std::vector<std::int64_t> triangle_cells; ///< the file's cell index of each triangle
+    Fields fields; ///< every point and cell array of 1 or 3 components, as Float64; cell arrays over the file's cells
+};
+/// read_vtu, keeping also the triangles and the data arrays (for pictures of simulation frames and of the static
+/// surfaces written beside them).
+VtuContents read_vtu_contents(const std::string& path, ReadNotes* notes = nullptr, const ReadOptions& options = {});
+/// A triangle surface (VTK type 5 cells) with an Int32 cell array "object" (one id per triangle): the static
+/// obstacles of a simulation, written beside its frames. Binary appended, as write_vtu.
+void write_vtu_surface(const std::string& path, const meshing::SurfaceMesh& surface,
+                       const std::vector<Index>& triangle_object);
 /// True if read_vtu can read zlib-compressed files (tethash was built with zlib).
 bool vtu_zlib_supported();
 

@@ -13,6 +13,7 @@
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/surface_mesh.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
@@ -80,6 +81,12 @@ struct RunHealth {
 };
 
 class SimulationImpl;
+
+/// Triangles of the scene's static parts (Simulation::static_surface).
+struct StaticSurface {
+    meshing::SurfaceMesh surface;
+    std::vector<Index> triangle_object; ///< one per triangle: an obstacle's object id, or −1 for the ground
+};
 
 class Simulation {
   public:
@@ -152,6 +159,12 @@ class Simulation {
     /// A flag that, once non-zero, ends the current step early: the step is rolled back to its start and
     /// step() throws Interrupted. For Ctrl-C (a signal handler sets it); nullptr: none.
     void set_interrupt_flag(const volatile std::sig_atomic_t* flag);
+
+    /// What does not move, as triangles for the output: the collider = "bsp" obstacles' surfaces (object id of each
+    /// triangle: the obstacle's contact object id, after the tet objects) and, when the scene has a ground, a square
+    /// of it (two triangles, object −1) centred under the scene, its side 4 times the scene's box diagonal (at
+    /// least 1 m). Empty when the scene has neither.
+    StaticSurface static_surface() const;
 
     /// Point data (velocity, contact flag, penetration depth) and cell data (object) for a frame,
     /// filtered by scene().output.fields.
