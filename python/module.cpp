@@ -9,8 +9,10 @@
 #include "tethash/ccd.hpp"
 #include "tethash/continuous.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/oracle.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/sim/scene.hpp"
 #include "tethash/sim/simulation.hpp"
@@ -581,6 +583,98 @@ py::dict detect_continuous(const py::object& tets, const py::object& x0, const p
     return d;
 }
 
+/// One edge-face contact as numpy sees it (dtype tethash.EDGE_CONTACT_DTYPE): the C++ EdgeFaceContact, field for
+/// field (inner_end as int32).
+struct PyEdgeContact {
+    std::int32_t edge, face, edge_vertices[2], face_vertices[3], edge_object, face_object;
+    double edge_t, face_bary[3];
+    std::int32_t inner_end;
+    double normal[3];
+};
+
+/// An EdgeFaceResult as a dict: faces (F, 3), edges (E, 2), contacts (EDGE_CONTACT_DTYPE), candidates.
+py::dict edge_result_dict(const tethash::EdgeFaceResult& r)
+{
+    py::array_t<PyEdgeContact> contacts(static_cast<py::ssize_t>(r.contacts.size()));
+    auto* p = static_cast<PyEdgeContact*>(contacts.mutable_data());
+    for (std::size_t i = 0; i < r.contacts.size(); ++i) {
+        const tethash::EdgeFaceContact& c = r.contacts[i];
+        PyEdgeContact& o = p[i];
+        o.edge = c.edge;
+        o.face = c.face;
+        std::copy(std::begin(c.edge_vertices), std::end(c.edge_vertices), o.edge_vertices);
+        std::copy(std::begin(c.face_vertices), std::end(c.face_vertices), o.face_vertices);
+        o.edge_object = c.edge_object;
+        o.face_object = c.face_object;
+        o.edge_t = c.edge_t;
+        std::copy(std::begin(c.face_bary), std::end(c.face_bary), o.face_bary);
+        o.inner_end = c.inner_end;
+        std::copy(std::begin(c.normal), std::end(c.normal), o.normal);
+    }
+    py::dict d;
+    d["faces"] = matrix_array(r.faces);
+    d["edges"] = matrix_array(r.edges);
+    d["contacts"] = contacts;
+    d["candidates"] = r.candidates;
+    return d;
+}
+
+/// tethash.EdgeFaceDetector: edge-face contacts (edge_contacts.hpp) of a fixed topology at changing positions.
+class PyEdgeFaceDetector {
+  public:
+    void set_topology(const py::object& tets, Index num_vertices, const py::object& vertex_object,
+                      const py::object& tet_object, const py::object& objects)
+    {
+        if (num_vertices < 0)
+            throw tethash::Error("EdgeFaceDetector.set_topology: num_vertices must be >= 0, found " +
+                                 std::to_string(num_vertices));
+        const auto t = tets_of(tets);
+        const auto vo = ids_of(vertex_object, "vertex_object", num_vertices);
+        const auto to = ids_of(tet_object, "tet_object", t.rows);
+        const auto opts = objects_of(objects);
+        m_detector.set_topology(t.map(), num_vertices, vo, to, opts);
+        m_num_vertices = num_vertices;
+        m_has_topology = true;
+    }
+
+    py::dict find(const py::object& positions, int threads)
+    {
+        if (!m_has_topology) throw tethash::Error("EdgeFaceDetector.find: call set_topology(tets, num_vertices) first");
+        const auto p = positions_of(positions);
+        if (p.rows != m_num_vertices)
+            throw tethash::Error("EdgeFaceDetector.find: positions has " + std::to_string(p.rows) + " rows, expected " +
+                                 std::to_string(m_num_vertices) + " (the vertex count given to set_topology)");
+        const tethash::EdgeFaceResult* r = nullptr;
+        {
+            py::gil_scoped_release release;
+            r = &m_detector.find(p.map(), threads);
+        }
+        return edge_result_dict(*r);
+    }
+
+  private:
+    tethash::EdgeFaceDetector m_detector;
+    Index m_num_vertices = 0;
+    bool m_has_topology = false;
+};
+
+/// The oracle's edge-face contacts (brute_force_edge_face_contacts): the tests' reference.
+py::dict brute_force_edges(const py::object& positions, const py::object& tets, const py::object& vertex_object,
+                           const py::object& tet_object, const py::object& objects)
+{
+    const auto p = positions_of(positions);
+    const auto t = tets_of(tets);
+    const auto vo = ids_of(vertex_object, "vertex_object", p.rows);
+    const auto to = ids_of(tet_object, "tet_object", t.rows);
+    const auto opts = objects_of(objects);
+    tethash::EdgeFaceResult r;
+    {
+        py::gil_scoped_release release;
+        r = tethash::brute_force_edge_face_contacts(t.map(), p.map(), vo, to, opts);
+    }
+    return edge_result_dict(r);
+}
+
 } // namespace
 
 PYBIND11_MODULE(_tethash, m)
@@ -588,18 +682,22 @@ PYBIND11_MODULE(_tethash, m)
     m.doc() = "tethash: spatial-hash collision detection for deformable tetrahedral meshes";
     PYBIND11_NUMPY_DTYPE(PyContact, vertex, tet, vertex_object, tet_object, bary, depth, direction);
     m.attr("CONTACT_DTYPE") = py::dtype::of<PyContact>();
+    PYBIND11_NUMPY_DTYPE(PyEdgeContact, edge, face, edge_vertices, face_vertices, edge_object, face_object, edge_t,
+                         face_bary, inner_end, normal);
+    m.attr("EDGE_CONTACT_DTYPE") = py::dtype::of<PyEdgeContact>();
 
     static py::exception<tethash::Error> error(m, "Error", PyExc_ValueError);
     static py::exception<tethash::RunFailure> run_failure(m, "RunFailure", PyExc_RuntimeError);
-    py::register_exception_translator([](std::exception_ptr p) {
-        try {
-            if (p) std::rethrow_exception(p);
-        } catch (const tethash::Error& e) {
-            PyErr_SetString(error.ptr(), e.what());
-        } catch (const tethash::RunFailure& e) {
-            PyErr_SetString(run_failure.ptr(), e.what());
-        }
-    });
+    py::register_exception_translator(
+        [](std::exception_ptr p) { // NOLINT(performance-unnecessary-value-param): the translator type pybind11 takes
+            try {
+                if (p) std::rethrow_exception(p);
+            } catch (const tethash::Error& e) {
+                PyErr_SetString(error.ptr(), e.what());
+            } catch (const tethash::RunFailure& e) {
+                PyErr_SetString(run_failure.ptr(), e.what());
+            }
+        });
 
     py::class_<PyDetector>(m, "Detector")
         .def(py::init<const py::kwargs&>())
@@ -609,6 +707,14 @@ PYBIND11_MODULE(_tethash, m)
         .def_property_readonly("stats", &PyDetector::stats)
         .def_property_readonly("positions_address", &PyDetector::address)
         .def_property_readonly("positions_copied", &PyDetector::copied);
+
+    py::class_<PyEdgeFaceDetector>(m, "EdgeFaceDetector")
+        .def(py::init<>())
+        .def("set_topology", &PyEdgeFaceDetector::set_topology, py::arg("tets"), py::arg("num_vertices"),
+             py::arg("vertex_object") = py::none(), py::arg("tet_object") = py::none(), py::arg("objects") = py::none())
+        .def("find", &PyEdgeFaceDetector::find, py::arg("positions"), py::arg("threads") = 1);
+    m.def("_brute_force_edges", &brute_force_edges, py::arg("positions"), py::arg("tets"),
+          py::arg("vertex_object") = py::none(), py::arg("tet_object") = py::none(), py::arg("objects") = py::none());
 
     m.def(
         "_check_positions", [](const py::object& p) { return static_cast<Index>(positions_of(p).rows); },
@@ -620,7 +726,8 @@ PYBIND11_MODULE(_tethash, m)
         "_simulate_file",
         [](const std::string& path, std::optional<int> steps, std::optional<double> dt, std::optional<int> substeps,
            std::optional<std::string> integrator, int record_every) {
-            return simulate_scene(tethash::sim::load_scene(path), steps, dt, substeps, integrator, record_every);
+            return simulate_scene(tethash::sim::load_scene(path), steps, dt, substeps, std::move(integrator),
+                                  record_every);
         },
         py::arg("path"), py::arg("steps"), py::arg("dt"), py::arg("substeps"), py::arg("integrator"),
         py::arg("record_every"));
@@ -629,8 +736,8 @@ PYBIND11_MODULE(_tethash, m)
         [](const std::string& text, const std::string& source, const std::string& base_dir, std::optional<int> steps,
            std::optional<double> dt, std::optional<int> substeps, std::optional<std::string> integrator,
            int record_every) {
-            return simulate_scene(tethash::sim::parse_scene(text, source, base_dir), steps, dt, substeps, integrator,
-                                  record_every);
+            return simulate_scene(tethash::sim::parse_scene(text, source, base_dir), steps, dt, substeps,
+                                  std::move(integrator), record_every);
         },
         py::arg("text"), py::arg("source"), py::arg("base_dir"), py::arg("steps"), py::arg("dt"), py::arg("substeps"),
         py::arg("integrator"), py::arg("record_every"));

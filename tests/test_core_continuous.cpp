@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 using namespace tethash;
@@ -143,4 +144,63 @@ TEST(CoreContinuous, BadInputIsAnError)
     Positions bad = Positions::Zero(5, 3);
     bad(3, 1) = std::numeric_limits<double>::infinity();
     test::expect_error([&] { detect_continuous(tets, Positions::Zero(5, 3), bad); }, {"vertex 3", "end"});
+}
+
+TEST(CoreContinuous, CandidatesAreTheOverlappingPairsTheNarrowPhaseGets)
+{
+    const Scene s = two_blocks({1.6, 0.3, 0.2}, {-1.5, 0.2, -0.1}, 0.05, 3);
+    const ContinuousCandidates c1 = continuous_candidates(s.tets, s.x0, s.x1, 1);
+    const ContinuousCandidates c2 = continuous_candidates(s.tets, s.x0, s.x1, 2);
+    EXPECT_EQ(c1.vertex_face, c2.vertex_face);
+    EXPECT_EQ(c1.edge_edge, c2.edge_edge);
+    // The reference: every pair by a loop, swept boxes of the corners at both ends, pairs sharing a vertex left out.
+    const auto box = [&](std::vector<Index> ids) {
+        Eigen::Array3d lo = s.x0.row(ids[0]).transpose().array(), hi = lo;
+        for (const Index v : ids)
+            for (const Positions* x : {&s.x0, &s.x1}) {
+                lo = lo.min(x->row(v).transpose().array());
+                hi = hi.max(x->row(v).transpose().array());
+            }
+        return std::make_pair(lo, hi);
+    };
+    const auto overlap = [](const auto& a, const auto& b) {
+        return !((a.first > b.second).any() || (b.first > a.second).any());
+    };
+    std::vector<Index> vertices(c1.faces.data(), c1.faces.data() + c1.faces.size());
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    std::vector<std::array<Index, 2>> vf, ee;
+    for (const Index v : vertices)
+        for (Index f = 0; f < c1.faces.rows(); ++f) {
+            const std::vector<Index> face{c1.faces(f, 0), c1.faces(f, 1), c1.faces(f, 2)};
+            if (std::find(face.begin(), face.end(), v) == face.end() && overlap(box({v}), box(face)))
+                vf.push_back({v, f});
+        }
+    for (Index e = 0; e < c1.edges.rows(); ++e)
+        for (Index g = e + 1; g < c1.edges.rows(); ++g) {
+            const Index a0 = c1.edges(e, 0), a1 = c1.edges(e, 1), b0 = c1.edges(g, 0), b1 = c1.edges(g, 1);
+            if (a0 != b0 && a0 != b1 && a1 != b0 && a1 != b1 && overlap(box({a0, a1}), box({b0, b1})))
+                ee.push_back({e, g});
+        }
+    EXPECT_EQ(c1.vertex_face, vf);
+    EXPECT_EQ(c1.edge_edge, ee);
+    ASSERT_GT(vf.size(), 10u);
+    ASSERT_GT(ee.size(), 10u);
+    // As many as continuous detection counts, and every contact of it among them.
+    const ContinuousResult r = detect_continuous(s.tets, s.x0, s.x1);
+    EXPECT_EQ(r.vertex_face_candidates, static_cast<std::int64_t>(vf.size()));
+    EXPECT_EQ(r.edge_edge_candidates, static_cast<std::int64_t>(ee.size()));
+    const ContinuousResult brute = detect_continuous_brute_force(s.tets, s.x0, s.x1);
+    EXPECT_GT(brute.vertex_face_candidates, r.vertex_face_candidates);
+    ASSERT_FALSE(r.contacts.empty());
+    for (const ContinuousContact& c : r.contacts) {
+        const auto& list = c.kind == ContinuousKind::vertex_face ? vf : ee;
+        EXPECT_TRUE(std::binary_search(list.begin(), list.end(), std::array<Index, 2>{c.a, c.b}));
+    }
+    // Brute force counts every pair that shares no vertex.
+    std::int64_t sharing_free = 0;
+    for (const Index v : vertices)
+        for (Index f = 0; f < c1.faces.rows(); ++f)
+            sharing_free += c1.faces(f, 0) != v && c1.faces(f, 1) != v && c1.faces(f, 2) != v;
+    EXPECT_EQ(brute.vertex_face_candidates, sharing_free);
 }

@@ -8,7 +8,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <iterator>
+#include <limits>
+#include <random>
 
 using namespace tethash;
 namespace fs = std::filesystem;
@@ -138,4 +142,65 @@ TEST(IoCcdQueries, SharedBenchmarkQueriesHaveNoFalseNegative)
     EXPECT_EQ(ee.false_negatives, 0);
     EXPECT_LE(vf.false_positives, 2);
     EXPECT_LE(ee.false_positives, 2);
+}
+
+TEST(IoCcdQueries, DoublesWrittenAsExactRationalsReadBackBitForBit)
+{
+    EXPECT_EQ(io::double_to_rational(0.0), "0,1");
+    EXPECT_EQ(io::double_to_rational(-0.0), "0,1");
+    EXPECT_EQ(io::double_to_rational(0.5), "1,2");
+    EXPECT_EQ(io::double_to_rational(-0.75), "-3,4");
+    EXPECT_EQ(io::double_to_rational(3.0), "3,1");
+    EXPECT_EQ(io::double_to_rational(0x1p70), "1180591620717411303424,1");
+    const std::string tiny = io::double_to_rational(std::ldexp(1.0, -1074));
+    EXPECT_EQ(tiny.substr(0, 2), "1,");
+    EXPECT_EQ(tiny.size(), 2 + 324U) << "2^1074 has 324 decimal digits";
+    EXPECT_THROW(io::double_to_rational(std::nan("")), Error);
+    std::mt19937_64 rng(29);
+    std::uniform_real_distribution<double> mantissa(-1, 1);
+    std::uniform_int_distribution<int> exponent(-1074, 1023);
+    for (int i = 0; i < 5000; ++i) {
+        const double x = i < 10 ? std::nextafter(std::numeric_limits<double>::max(), 0.0) / (i + 1)
+                                : std::ldexp(mantissa(rng), exponent(rng));
+        const std::string text = io::double_to_rational(x);
+        const auto comma = text.find(',');
+        ASSERT_NE(comma, std::string::npos);
+        const double back = io::rational_to_double(text.substr(0, comma), text.substr(comma + 1));
+        ASSERT_EQ(std::memcmp(&back, &x, sizeof x) == 0 || (x == 0 && back == 0), true) << text << " for " << x;
+    }
+}
+
+TEST(IoCcdQueries, WrittenQueriesReadBackAndBadPathsLeaveNothing)
+{
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> d(-3, 3);
+    std::vector<io::CcdQuery> queries(20);
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        for (auto& p : queries[q].points)
+            p = Eigen::Vector3d(d(rng), d(rng) * 1e-7, d(rng) * 1e9);
+        queries[q].collides = q % 3 == 0;
+    }
+    const fs::path dir = test::temp_dir() / "ccd_write";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string path = (dir / "q.csv").string();
+    io::write_ccd_queries(path, queries);
+    const auto back = io::read_ccd_queries(path);
+    ASSERT_EQ(back.size(), queries.size());
+    for (std::size_t q = 0; q < queries.size(); ++q) {
+        EXPECT_EQ(back[q].collides, queries[q].collides);
+        EXPECT_EQ(back[q].line, static_cast<std::int64_t>(8 * q + 1));
+        for (std::size_t r = 0; r < 8; ++r)
+            EXPECT_EQ(back[q].points[r], queries[q].points[r]) << "query " << q << " row " << r;
+    }
+    // A missing folder and a folder as the file are bad paths; a coordinate that is not finite is refused before
+    // any file exists; the file that was there stays.
+    EXPECT_THROW(io::write_ccd_queries((dir / "missing" / "q.csv").string(), queries), Error);
+    EXPECT_THROW(io::write_ccd_queries(dir.string(), queries), Error);
+    auto bad = queries;
+    bad[4].points[6].y() = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(io::write_ccd_queries(path, bad), Error);
+    EXPECT_EQ(io::read_ccd_queries(path).size(), queries.size());
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1) << "no temporary left";
+    fs::remove_all(dir);
 }

@@ -14,6 +14,7 @@
 #include "tethash/error.hpp"
 #include "tethash/mesh.hpp"
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -41,7 +42,8 @@ struct ContinuousResult {
     Triangles faces;                         ///< the boundary faces (boundary_faces(tets), in its order)
     Edges edges;                             ///< the boundary edges: the faces' edges, (i < j), sorted
     std::vector<ContinuousContact> contacts; ///< sorted by kind (vertex-face first), a, b
-    std::int64_t vertex_face_candidates = 0; ///< pairs whose swept boxes overlap, handed to the narrow phase
+    /// Pairs whose swept boxes overlap and that share no vertex: those handed to the narrow phase.
+    std::int64_t vertex_face_candidates = 0;
     std::int64_t edge_edge_candidates = 0;
 };
 
@@ -50,6 +52,20 @@ struct ContinuousResult {
 /// 1e50 in magnitude.
 ContinuousResult detect_continuous(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
                                    const ContinuousParams& params = {});
+
+/// The pairs detect_continuous hands the narrow phase for the step x0 → x1: boundary vertex-face and edge-edge pairs
+/// whose swept boxes overlap and that share no vertex (as many as its vertex_face_candidates and
+/// edge_edge_candidates). For studying and replaying the narrow phase's workload (`tethash simulate --ccd-queries`).
+struct ContinuousCandidates {
+    Triangles faces;                               ///< the boundary faces (boundary_faces(tets), in its order)
+    Edges edges;                                   ///< the boundary edges: the faces' edges, (i < j), sorted
+    std::vector<std::array<Index, 2>> vertex_face; ///< (vertex id, face index), sorted
+    std::vector<std::array<Index, 2>> edge_edge;   ///< (lower edge index, higher edge index), sorted
+};
+/// The candidates of the step, the same for every thread count (`threads`: 0 = all). Throws Error as
+/// detect_continuous does.
+ContinuousCandidates continuous_candidates(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
+                                           int threads = 1);
 
 /// The same by brute force over all pairs (no broad phase): the reference of the tests.
 ContinuousResult detect_continuous_brute_force(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,

@@ -39,13 +39,15 @@ def _load_failure(error):
 
 
 try:
-    from ._tethash import CONTACT_DTYPE, Detector, Error, RunFailure, ccd_edge_edge, ccd_vertex_face, detect_continuous
+    from ._tethash import (CONTACT_DTYPE, EDGE_CONTACT_DTYPE, Detector, EdgeFaceDetector, Error, RunFailure,
+                           ccd_edge_edge, ccd_vertex_face, detect_continuous)
     from . import _tethash
 except ImportError as _error:
     raise _load_failure(_error) from _error
 
 __all__ = ["CONTACT_DTYPE", "Detector", "Error", "RunFailure", "detect", "read_mesh", "write_mesh", "simulate",
-           "study", "scene_toml", "default_scene_text", "ccd_vertex_face", "ccd_edge_edge", "detect_continuous"]
+           "study", "scene_toml", "default_scene_text", "ccd_vertex_face", "ccd_edge_edge", "detect_continuous",
+           "EDGE_CONTACT_DTYPE", "EdgeFaceDetector", "detect_edges"]
 
 
 def detect(positions, tets, vertex_object=None, tet_object=None, objects=None, **params):
@@ -58,6 +60,20 @@ def detect(positions, tets, vertex_object=None, tet_object=None, objects=None, *
     det = Detector(**params)
     det.set_topology(tets, _tethash._check_positions(positions), vertex_object, tet_object, objects)
     return det.detect(positions)
+
+
+def detect_edges(positions, tets, vertex_object=None, tet_object=None, objects=None, threads=1):
+    """Edge-face contacts of one configuration: boundary edges crossing a boundary triangle of another object, or of
+    a distant part of their own (docs/ccd.md). A dict: faces (F, 3) and edges (E, 2) int32 (the boundary), contacts
+    (a structured array, EDGE_CONTACT_DTYPE, sorted by (edge, face)) and candidates (the pairs tested).
+
+    Contact fields: edge, face (rows of edges and faces), edge_vertices (2), face_vertices (3, outward order),
+    edge_object, face_object, edge_t (the crossing point is (1 - t) x[e0] + t x[e1]), face_bary (3), inner_end (0
+    or 1: the end of the edge on the triangle's inner side), normal (3: the triangle's unit normal, inner to outer
+    side). objects and threads as for detect; EdgeFaceDetector keeps the topology between calls."""
+    det = EdgeFaceDetector()
+    det.set_topology(tets, _tethash._check_positions(positions), vertex_object, tet_object, objects)
+    return det.find(positions, threads)
 
 
 def read_mesh(path, linearize=False):

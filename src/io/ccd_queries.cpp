@@ -10,8 +10,11 @@
 #include "tethash/io/file.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -216,6 +219,85 @@ std::vector<CcdQuery> parse_ccd_queries(const std::string& path, std::string_vie
                     " of its 8 rows, from line " + std::to_string(current.line) +
                     "): the rows must be a multiple of 8");
     return queries;
+}
+
+std::string double_to_rational(double x)
+{
+    if (!std::isfinite(x)) throw Error("not a finite number: " + std::to_string(x));
+    if (x == 0) return "0,1";
+    // x = mantissa · 2^exponent with an odd integer mantissa below 2^53 (frexp and ldexp are exact).
+    int e = 0;
+    const double f = std::frexp(std::abs(x), &e);
+    auto mantissa = static_cast<std::uint64_t>(std::ldexp(f, 53));
+    int exponent = e - 53;
+    while ((mantissa & 1U) == 0) {
+        mantissa >>= 1U;
+        ++exponent;
+    }
+    // Decimal digits of m · 2^k, base 10^9 limbs (least significant first), doubled up to 29 bits at a time.
+    const auto decimal = [](std::uint64_t m, int k) {
+        constexpr std::uint64_t base = 1000000000;
+        std::vector<std::uint64_t> limbs;
+        for (; m != 0; m /= base)
+            limbs.push_back(m % base);
+        while (k > 0) {
+            const int step = std::min(k, 29);
+            std::uint64_t carry = 0;
+            for (std::uint64_t& l : limbs) {
+                const std::uint64_t v = (l << static_cast<unsigned>(step)) + carry;
+                l = v % base;
+                carry = v / base;
+            }
+            for (; carry != 0; carry /= base)
+                limbs.push_back(carry % base);
+            k -= step;
+        }
+        if (limbs.empty()) return std::string("0");
+        std::string text = std::to_string(limbs.back());
+        char digits[16];
+        for (std::size_t i = limbs.size() - 1; i-- > 0;) {
+            std::snprintf(digits, sizeof digits, "%09llu", static_cast<unsigned long long>(limbs[i]));
+            text += digits;
+        }
+        return text;
+    };
+    const std::string sign = x < 0 ? "-" : "";
+    if (exponent >= 0) return sign + decimal(mantissa, exponent) + ",1";
+    return sign + decimal(mantissa, 0) + "," + decimal(1, -exponent);
+}
+
+void write_ccd_queries(const std::string& path, const std::vector<CcdQuery>& queries)
+{
+    // The text of every coordinate first: a value that is not finite is bad input, refused before any file exists.
+    for (const CcdQuery& q : queries)
+        for (std::size_t r = 0; r < q.points.size(); ++r)
+            for (int k = 0; k < 3; ++k)
+                if (!std::isfinite(q.points[r][k]))
+                    throw Error(path + ": query " + std::to_string(&q - queries.data()) + ", row " + std::to_string(r) +
+                                ": coordinate " + std::to_string(k) + " is not finite");
+    write_atomically(path, [&](const std::string& tmp) {
+        std::FILE* f = std::fopen(tmp.c_str(), "wb");
+        if (!f) throw WriteError(path + ": cannot create file: " + std::strerror(errno));
+        errno = 0;
+        bool wrote = true;
+        std::string rows;
+        for (const CcdQuery& q : queries) {
+            rows.clear();
+            for (const Eigen::Vector3d& p : q.points) {
+                for (int k = 0; k < 3; ++k)
+                    rows += double_to_rational(p[k]) + ",";
+                rows += q.collides ? "1\n" : "0\n";
+            }
+            if (std::fwrite(rows.data(), 1, rows.size(), f) != rows.size()) {
+                wrote = false;
+                break;
+            }
+        }
+        const bool flushed = std::fflush(f) == 0;
+        const int err = errno;
+        const bool closed = std::fclose(f) == 0;
+        if (!wrote || !flushed || !closed) throw WriteError(path + ": write failed: " + std::strerror(err ? err : EIO));
+    });
 }
 
 std::vector<CcdQuery> read_ccd_queries(const std::string& path)

@@ -1,6 +1,7 @@
 // tethash simulate: runs a scene (TOML, or the built-in default) and writes VTU frames + a .pvd series.
 #include "command.hpp"
 #include "render_options.hpp"
+#include "simulate_ccd.hpp"
 
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
@@ -67,6 +68,7 @@ struct SimulateOptions {
     std::string threads; ///< "" = the scene's
     std::string out = "out";
     bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
+    CcdQueryOptions ccd; ///< --ccd-queries: the steps' continuous queries in the CCD benchmark's format
     // The one-line path: a mesh dropped on the ground (a scene written for it).
     std::string mesh;
     double scale = 1;
@@ -278,6 +280,7 @@ void run_simulate(SimulateOptions o)
         if (scene.output.every == 0)
             throw Error("--render: the scene writes no frames ([output] every = 0): nothing to draw");
     }
+    CcdQueryRecorder ccd_queries(o.ccd); // its paths checked before the run
     sim::Simulation sim(scene);
     sim.set_interrupt_flag(&g_interrupted);
     for (const std::string& w : sim.warnings())
@@ -366,15 +369,19 @@ void run_simulate(SimulateOptions o)
         ~Restore() { std::signal(SIGINT, h); }
     } restore{old_handler};
     int done = 0;
+    Positions step_start;
     try {
         for (int s = 0; s < scene.steps; ++s) {
             if (g_interrupted) break;
+            const bool record = ccd_queries.wants(s + 1);
+            if (record) step_start = sim.positions();
             try {
                 sim.step();
             } catch (const sim::Interrupted&) {
                 break; // rolled back to the last complete step
             }
             done = s + 1;
+            if (record) ccd_queries.record(s + 1, sim.mesh().tets, step_start, sim.positions());
             const sim::StepStats& st = sim.last_stats();
             ms_detect += st.ms_detect;
             ms_depth += st.ms_depth;
@@ -422,6 +429,7 @@ void run_simulate(SimulateOptions o)
         if (tty) std::fprintf(stderr, "\n");
         write_run_json(o.out, sim, "failed",
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        ccd_queries.write(); // the queries of the steps completed
         throw;
     }
     if (tty) std::fprintf(stderr, "\n");
@@ -430,6 +438,7 @@ void run_simulate(SimulateOptions o)
     if (g_interrupted) {
         write_run_json(o.out, sim, "interrupted",
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        ccd_queries.write();
         std::fprintf(stderr,
                      "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
                      "series: %s\n",
@@ -481,6 +490,7 @@ void run_simulate(SimulateOptions o)
     for (const std::string& p : problems)
         std::fprintf(stderr, "tethash: warning: %s\n", p.c_str());
     write_run_json(o.out, sim, problems.empty() ? "ok" : "untrusted", wall);
+    ccd_queries.write();
     if (every > 0)
         std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView; run.json says how far to trust them)\n",
                      frames, o.out.c_str());
@@ -517,6 +527,17 @@ Registrar reg{
          sub.add_flag("--strict", o->strict,
                       "Exit 1 when the run cannot be trusted: energy gained, volume lost, iterations unconverged, "
                       "steps refined or tets inverted at the end (each is a warning otherwise)");
+         sub.add_option("--ccd-queries", o->ccd.dir,
+                        "Write the continuous queries of the steps (boundary vertex-face and edge-edge pairs whose "
+                        "swept boxes overlap, at the step's start and end) to DIR/vertex_face.csv and "
+                        "DIR/edge_edge.csv in the CCD benchmark's format (`tethash ccd` replays them); ground truth: "
+                        "the narrow phase's answer");
+         sub.add_option("--ccd-steps", o->ccd.steps,
+                        "With --ccd-queries: only step K, or steps FIRST:LAST (1-based; step K ends at frame K)");
+         sub.add_option("--ccd-max-queries", o->ccd.max_queries,
+                        "With --ccd-queries: at most this many queries per file, whole steps (later steps left out, "
+                        "with a note)")
+             ->capture_default_str();
          sub.add_option("-o,--out", o->out,
                         "Output folder for frame_NNNNN.vtu and scene.pvd (those of a previous run there are removed)")
              ->capture_default_str();

@@ -35,4 +35,14 @@ std::vector<CcdQuery> parse_ccd_queries(const std::string& path, std::string_vie
 /// whose magnitude is 2^1024 or more after rounding.
 double rational_to_double(std::string_view num, std::string_view den);
 
+/// The exact rational of a finite double as the text "num,den": num a signed decimal integer, den a power of two (1
+/// for an integer), the fraction reduced; rational_to_double reads it back bit for bit (0 and −0: "0,1"). Throws
+/// Error on a value that is not finite.
+std::string double_to_rational(double x);
+
+/// Writes `queries` in the format above (8 rows each, ground truth `collides`) to `path`, atomically (file.hpp:
+/// nothing half-written is left). Throws Error when `path` cannot name a file (a folder, a missing folder) or a
+/// coordinate is not finite, WriteError when the file system refuses it.
+void write_ccd_queries(const std::string& path, const std::vector<CcdQuery>& queries);
+
 } // namespace tethash::io

@@ -86,12 +86,22 @@ std::array<Index, 2> edge_of(const Edges& edges, Index e)
     return {edges(e, 0), edges(e, 1)};
 }
 
-/// The narrow phase of one pair; appends a contact when they may meet.
+/// Pairs sharing a vertex are never queried (they meet at it).
+bool shares_vertex(const Triangles& faces, Index v, Index f)
+{
+    return faces(f, 0) == v || faces(f, 1) == v || faces(f, 2) == v;
+}
+bool shares_vertex(const Edges& edges, Index e, Index g)
+{
+    return edges(e, 0) == edges(g, 0) || edges(e, 0) == edges(g, 1) || edges(e, 1) == edges(g, 0) ||
+           edges(e, 1) == edges(g, 1);
+}
+
+/// The narrow phase of one pair (sharing no vertex); appends a contact when they may meet.
 void vertex_face_pair(const PositionsRef& x0, const PositionsRef& x1, const Triangles& faces, Index v, Index f,
                       const CcdParams& query, std::vector<ContinuousContact>& out)
 {
     const auto c = face_of(faces, f);
-    if (c[0] == v || c[1] == v || c[2] == v) return;
     const CcdResult r = vertex_face_ccd(x0.row(v).transpose(), x0.row(c[0]).transpose(), x0.row(c[1]).transpose(),
                                         x0.row(c[2]).transpose(), x1.row(v).transpose(), x1.row(c[0]).transpose(),
                                         x1.row(c[1]).transpose(), x1.row(c[2]).transpose(), query);
@@ -102,7 +112,6 @@ void edge_edge_pair(const PositionsRef& x0, const PositionsRef& x1, const Edges&
                     const CcdParams& query, std::vector<ContinuousContact>& out)
 {
     const auto a = edge_of(edges, e), b = edge_of(edges, g);
-    if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
     const CcdResult r = edge_edge_ccd(x0.row(a[0]).transpose(), x0.row(a[1]).transpose(), x0.row(b[0]).transpose(),
                                       x0.row(b[1]).transpose(), x1.row(a[0]).transpose(), x1.row(a[1]).transpose(),
                                       x1.row(b[0]).transpose(), x1.row(b[1]).transpose(), query);
@@ -132,6 +141,63 @@ void build_tree(detail::TriangleBvh& tree, const std::vector<Box>& boxes)
         4);
 }
 
+/// The threads a parallel loop asked for `threads` (0: all) runs on.
+int thread_slots(int threads)
+{
+#ifdef TETHASH_HAVE_OPENMP
+    if (threads <= 0) threads = omp_get_max_threads();
+#endif
+    return std::max(threads, 1);
+}
+
+/// The broad phase: calls vf(rank, v, f) for every boundary vertex v and face f, and ee(rank, e, g) for every pair of
+/// boundary edges e < g, whose swept boxes overlap and that share no vertex, on `threads` threads (rank: the
+/// calling thread's, in [0, threads)). Returns the thread count used.
+template <typename VertexFace, typename EdgeEdge>
+int for_each_candidate(const Boundary& bd, const PositionsRef& x0, const PositionsRef& x1, int threads,
+                       const VertexFace& vf, const EdgeEdge& ee)
+{
+    std::vector<Box> face_boxes(static_cast<std::size_t>(bd.faces.rows())),
+        edge_boxes(static_cast<std::size_t>(bd.edges.rows()));
+    for (std::size_t f = 0; f < face_boxes.size(); ++f)
+        face_boxes[f] = swept_box<3>(x0, x1, face_of(bd.faces, static_cast<Index>(f)));
+    for (std::size_t e = 0; e < edge_boxes.size(); ++e)
+        edge_boxes[e] = swept_box<2>(x0, x1, edge_of(bd.edges, static_cast<Index>(e)));
+    detail::TriangleBvh face_tree, edge_tree;
+    build_tree(face_tree, face_boxes);
+    build_tree(edge_tree, edge_boxes);
+
+    threads = thread_slots(threads);
+    const std::int64_t nv = static_cast<std::int64_t>(bd.vertices.size()), ne = bd.edges.rows();
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel num_threads(threads) if (threads > 1)
+#endif
+    {
+        const int rank = detail::team_rank(), size = detail::team_size();
+        std::int64_t begin = 0, end = 0;
+        detail::team_split(nv, rank, size, begin, end);
+        for (std::int64_t i = begin; i < end; ++i) {
+            const Index v = bd.vertices[static_cast<std::size_t>(i)];
+            const Box vb = swept_box<1>(x0, x1, {v});
+            face_tree.for_box(vb.lo, vb.hi, [&](Index f) {
+                if (!overlap(vb, face_boxes[static_cast<std::size_t>(f)]) || shares_vertex(bd.faces, v, f)) return;
+                vf(rank, v, f);
+            });
+        }
+        detail::team_split(ne, rank, size, begin, end);
+        for (std::int64_t e = begin; e < end; ++e) {
+            const Box& eb = edge_boxes[static_cast<std::size_t>(e)];
+            edge_tree.for_box(eb.lo, eb.hi, [&](Index g) {
+                if (g <= e || !overlap(eb, edge_boxes[static_cast<std::size_t>(g)]) ||
+                    shares_vertex(bd.edges, static_cast<Index>(e), g))
+                    return;
+                ee(rank, static_cast<Index>(e), g);
+            });
+        }
+    }
+    return threads;
+}
+
 } // namespace
 
 ContinuousResult detect_continuous(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
@@ -143,52 +209,19 @@ ContinuousResult detect_continuous(const TetsRef& tets, const PositionsRef& x0, 
         throw Error("detect_continuous: the tolerance must be positive and finite and max_iterations at least 1");
     Boundary bd = boundary_of(tets);
     ContinuousResult result;
-    std::vector<Box> face_boxes(static_cast<std::size_t>(bd.faces.rows())),
-        edge_boxes(static_cast<std::size_t>(bd.edges.rows()));
-    for (std::size_t f = 0; f < face_boxes.size(); ++f)
-        face_boxes[f] = swept_box<3>(x0, x1, face_of(bd.faces, static_cast<Index>(f)));
-    for (std::size_t e = 0; e < edge_boxes.size(); ++e)
-        edge_boxes[e] = swept_box<2>(x0, x1, edge_of(bd.edges, static_cast<Index>(e)));
-    detail::TriangleBvh face_tree, edge_tree;
-    build_tree(face_tree, face_boxes);
-    build_tree(edge_tree, edge_boxes);
-
-    int threads = params.threads;
-#ifdef TETHASH_HAVE_OPENMP
-    if (threads <= 0) threads = omp_get_max_threads();
-#endif
-    threads = std::max(threads, 1);
-    const std::int64_t nv = static_cast<std::int64_t>(bd.vertices.size()), ne = bd.edges.rows();
-    std::vector<std::vector<ContinuousContact>> found(static_cast<std::size_t>(threads));
-    std::vector<std::int64_t> vf_candidates(static_cast<std::size_t>(threads)),
-        ee_candidates(static_cast<std::size_t>(threads));
-#ifdef TETHASH_HAVE_OPENMP
-#pragma omp parallel num_threads(threads) if (threads > 1)
-#endif
-    {
-        const int rank = detail::team_rank(), size = detail::team_size();
-        auto& out = found[static_cast<std::size_t>(rank)];
-        std::int64_t begin = 0, end = 0;
-        detail::team_split(nv, rank, size, begin, end);
-        for (std::int64_t i = begin; i < end; ++i) {
-            const Index v = bd.vertices[static_cast<std::size_t>(i)];
-            const Box vb = swept_box<1>(x0, x1, {v});
-            face_tree.for_box(vb.lo, vb.hi, [&](Index f) {
-                if (!overlap(vb, face_boxes[static_cast<std::size_t>(f)])) return;
-                ++vf_candidates[static_cast<std::size_t>(rank)];
-                vertex_face_pair(x0, x1, bd.faces, v, f, params.query, out);
-            });
-        }
-        detail::team_split(ne, rank, size, begin, end);
-        for (std::int64_t e = begin; e < end; ++e) {
-            const Box& eb = edge_boxes[static_cast<std::size_t>(e)];
-            edge_tree.for_box(eb.lo, eb.hi, [&](Index g) {
-                if (g <= e || !overlap(eb, edge_boxes[static_cast<std::size_t>(g)])) return;
-                ++ee_candidates[static_cast<std::size_t>(rank)];
-                edge_edge_pair(x0, x1, bd.edges, static_cast<Index>(e), g, params.query, out);
-            });
-        }
-    }
+    const auto slots = static_cast<std::size_t>(thread_slots(params.threads));
+    std::vector<std::vector<ContinuousContact>> found(slots);
+    std::vector<std::int64_t> vf_candidates(slots), ee_candidates(slots);
+    const int threads = for_each_candidate(
+        bd, x0, x1, params.threads,
+        [&](int rank, Index v, Index f) {
+            ++vf_candidates[static_cast<std::size_t>(rank)];
+            vertex_face_pair(x0, x1, bd.faces, v, f, params.query, found[static_cast<std::size_t>(rank)]);
+        },
+        [&](int rank, Index e, Index g) {
+            ++ee_candidates[static_cast<std::size_t>(rank)];
+            edge_edge_pair(x0, x1, bd.edges, e, g, params.query, found[static_cast<std::size_t>(rank)]);
+        });
     for (int r = 0; r < threads; ++r) {
         const auto& part = found[static_cast<std::size_t>(r)];
         result.contacts.insert(result.contacts.end(), part.begin(), part.end());
@@ -196,6 +229,35 @@ ContinuousResult detect_continuous(const TetsRef& tets, const PositionsRef& x0, 
         result.edge_edge_candidates += ee_candidates[static_cast<std::size_t>(r)];
     }
     sort_contacts(result.contacts);
+    result.faces = std::move(bd.faces);
+    result.edges = std::move(bd.edges);
+    return result;
+}
+
+ContinuousCandidates continuous_candidates(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
+                                           int threads)
+{
+    check_input(tets, x0, x1);
+    Boundary bd = boundary_of(tets);
+    const auto slots = static_cast<std::size_t>(thread_slots(threads));
+    std::vector<std::vector<std::array<Index, 2>>> vf(slots), ee(slots);
+    const int used = for_each_candidate(
+        bd, x0, x1, threads,
+        [&](int rank, Index v, Index f) {
+            vf[static_cast<std::size_t>(rank)].push_back({v, f});
+        },
+        [&](int rank, Index e, Index g) {
+            ee[static_cast<std::size_t>(rank)].push_back({e, g});
+        });
+    ContinuousCandidates result;
+    for (int r = 0; r < used; ++r) {
+        result.vertex_face.insert(result.vertex_face.end(), vf[static_cast<std::size_t>(r)].begin(),
+                                  vf[static_cast<std::size_t>(r)].end());
+        result.edge_edge.insert(result.edge_edge.end(), ee[static_cast<std::size_t>(r)].begin(),
+                                ee[static_cast<std::size_t>(r)].end());
+    }
+    std::sort(result.vertex_face.begin(), result.vertex_face.end());
+    std::sort(result.edge_edge.begin(), result.edge_edge.end());
     result.faces = std::move(bd.faces);
     result.edges = std::move(bd.edges);
     return result;
@@ -209,11 +271,13 @@ ContinuousResult detect_continuous_brute_force(const TetsRef& tets, const Positi
     ContinuousResult result;
     for (const Index v : bd.vertices)
         for (Index f = 0; f < bd.faces.rows(); ++f) {
+            if (shares_vertex(bd.faces, v, f)) continue;
             ++result.vertex_face_candidates;
             vertex_face_pair(x0, x1, bd.faces, v, f, query, result.contacts);
         }
     for (Index e = 0; e < bd.edges.rows(); ++e)
         for (Index g = e + 1; g < bd.edges.rows(); ++g) {
+            if (shares_vertex(bd.edges, e, g)) continue;
             ++result.edge_edge_candidates;
             edge_edge_pair(x0, x1, bd.edges, e, g, query, result.contacts);
         }
