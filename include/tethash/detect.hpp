@@ -150,10 +150,8 @@ std::int64_t next_power_of_two(std::int64_t n);
 /// The default table size for `vertices` hashed vertices: for the column hash the smallest power of two
 /// ≥ 2·vertices (so 2V..4V buckets; bucket ranges are masks), for Teschner's hash the smallest prime ≥ 2·vertices
 /// (the xor-product hash needs an odd modulus). At least 1.
-/// Measured (tethash_bench --table-factor, scenario 5: 19,600 vertices, CPU ms at one thread, ±5 %):
-/// 16,384 buckets (0.84 V) 6.3–7.3, 32,768 (1.7 V) 6.0, 65,536 (3.3 V, the default) 5.7, 131,072 (6.7 V) 5.9:
-/// below 2V the hash collisions scanned cost more than they save in table memory, beyond 4V the bigger offset
-/// array no longer stays in cache.
+/// Below 2V the hash collisions scanned cost more than they save in table memory, beyond 4V the bigger offset
+/// array no longer stays in cache (docs/detection.md, "Parameters and defaults", has the figures).
 std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices);
 /// Smallest prime ≥ n (n ≥ 2).
 std::int64_t next_prime(std::int64_t n);

@@ -60,12 +60,11 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
             lo = lo.cwiseMin(x.row(i).transpose());
             hi = hi.cwiseMax(x.row(i).transpose());
         }
-        // A sheet thinner than half a cell (the mat: one tet layer, 8 mm over 1 m) that its weight folds gets no
-        // lattice: the cells span its folds, and the start state's matrix points nowhere useful once it crumples
-        // (its corrections slowed the sweeps: mean height 0.11-0.18 m at 0.5 s where the converged step is at
-        // 0.044). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
-        // large: 1,500 for the mat of young 1e5 at 1 m. A stiff sheet keeps its lattice: the mat of young 1e9 at 1 m
-        // (0.15) ended its drop at 124 times its start energy with the sweeps alone, at 0.99 with the lattice.
+        // A sheet thinner than half a cell (one tet layer) that its weight folds gets no lattice: the cells span its
+        // folds, and the start state's matrix points nowhere useful once it crumples (its corrections slowed the
+        // sweeps). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
+        // large. A stiff sheet keeps its lattice: without it, the sweeps alone let its drop gain energy many times
+        // over (docs/simulator.md, "Figures behind the code's constants").
         const Eigen::Vector3d extent3 = hi - lo;
         if (extent3.minCoeff() < 0.5 * std::max(2.0 * model.object_mean_edge[o], extent3.maxCoeff() / 6.0)) {
             const double stiffness = model.object_frequency_sq[o] * model.object_mean_edge[o] *
@@ -78,8 +77,8 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
         const double extent = (hi - lo).maxCoeff();
         double cell = std::max(2.0 * model.object_mean_edge[o], extent / cells_per_extent);
         // At most a quarter as many nodes as the object has vertices (125 for any object), and max_nodes_per_object:
-        // the factorisation grows about as the square of the nodes (the hand at 5 cm with cells of two mean edges:
-        // 300 ms a substep).
+        // the factorisation grows about as the square of the nodes (hundreds of milliseconds a substep on a real
+        // mesh with cells of two mean edges; docs/simulator.md).
         const size_t cap = std::min<size_t>(max_nodes_per_object, std::max<size_t>(125, vs.size() / 4));
         Eigen::Array3i dims;
         std::vector<std::int32_t> id;

@@ -200,8 +200,9 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     // Each object has a wave speed c = sqrt(young / density) and a frequency ω = c / L̄ at its mean edge L̄
     // (object_frequency_sq); every free vertex gets at least the mass that keeps its Gershgorin bound of
     // stiffness / mass at (2 / h_m)², h_m = material_courant / ω, so no vertex's explicit limit falls below
-    // h_m whatever the tets' shapes. The mass the floor adds (0.13 % of the hand, 7 % of its vertices) is taken
-    // back from the vertices above the floor, so each object keeps density × volume.
+    // h_m whatever the tets' shapes. The mass the floor adds (a small fraction of a real mesh's, on its slivers'
+    // vertices; docs/simulator.md) is taken back from the vertices above the floor, so each object keeps
+    // density × volume.
     m.object_frequency_sq.assign(static_cast<size_t>(objects), 0.0);
     for (Index o = 0; o < objects; ++o) {
         const double lbar = m.object_mean_edge[static_cast<size_t>(o)];

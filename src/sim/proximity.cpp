@@ -96,16 +96,13 @@ using Vec3 = Eigen::Vector3d;
 
 /// A vertex's reach is this many times its travel in the substep ...
 constexpr double radius_travel = 1.5;
-/// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On the mat (a one-layer sheet
-/// crumpling, every vertex moving) 0.5 cost twice as much as 0.25 per step at 1/240 (87 against 38 ms of
-/// proximity; 724 against 248 at 1/60) for about as many far self-penetrations at the worst frame (41 and 39 of
-/// 20,000 vertices); 1.5 cost twice as much again (docs/simulator.md).
+/// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On a crumpling sheet (every
+/// vertex moving) twice this cap cost twice as much per step for about as many far self-penetrations
+/// (docs/simulator.md, "Figures behind the code's constants").
 constexpr double radius_edges = 0.25;
-/// The grid's cell, in mean edges. Each face is entered in every cell its grown box meets (about 35 at one mean
-/// edge on the hand); at two, a face meets fewer cells and a query reads more faces per cell, and the stage cost
-/// less on every shared-mesh drop measured at 1/240 (alternating runs: the hand 3.15 → 2.96 ms a step, octocat
-/// 3.7 → 3.0, the two armadillos 1.72 → 1.40, quintupleTorus 6.8 → 4.8, the mat 30 → 20); at three the hand's
-/// went up again (3.5).
+/// The grid's cell, in mean edges. Each face is entered in every cell its grown box meets (tens at one mean edge);
+/// at two, a face meets fewer cells and a query reads more faces per cell, and the stage cost less on every
+/// shared-mesh drop measured; at three it cost more again (docs/simulator.md, "Open").
 constexpr double cell_edges = 2.0;
 /// Two objects thrown at each other: their whole surfaces close at once, so the cap is wider (it costs only while
 /// they approach fast).
@@ -198,7 +195,7 @@ void Proximity::setup(const TetMesh& mesh, const Positions& rest, const Model& m
     for (Index i = 0; i < mesh.num_vertices(); ++i)
         if (is_boundary[static_cast<size_t>(i)]) m_vertices.push_back(i);
     // Vertices and faces in Morton order of their rest positions: consecutive queries read the same cells and
-    // consecutive faces write to nearby ones (2.6 MB of cells on the hand: out of the cache in index order).
+    // consecutive faces write to nearby ones (a real mesh's cells take megabytes: out of the cache in index order).
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (Index i : m_vertices) {
         lo = lo.cwiseMin(rest.row(i).transpose());

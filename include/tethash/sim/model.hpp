@@ -134,8 +134,8 @@ struct Model {
     /// scale_k · K + scale_c · C at fixed positions, with every per-element quantity (spring blocks, volume
     /// gradients, ground coefficients) evaluated once, so that repeated products (CG iterations) cost no
     /// square roots or cross products. Same matrix as apply_matrix / add_matrix_diagonal at those positions.
-    /// Products are gathered per vertex over its springs and tets (no write conflicts; serial: on the shared
-    /// 2-core machine OpenMP regions per CG iteration measured 5-8× slower than one thread).
+    /// Products are gathered per vertex over its springs and tets (no write conflicts; serial: an OpenMP region per
+    /// CG iteration costs more than the products it shares out; docs/simulator.md has the figure).
     struct Linearised {
         std::vector<Eigen::Matrix3d> spring_block;     ///< per spring
         std::vector<Eigen::Matrix<double, 4, 3>> grad; ///< per volume term: ∇V scaled by sqrt(scale_k k_V / V0)
