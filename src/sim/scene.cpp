@@ -3,7 +3,7 @@
 #include "core/enum_names.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/surface.hpp"
+#include "tethash/io/mesh_io.hpp"
 
 #include <toml++/toml.h>
 
@@ -394,7 +394,8 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object needs 'mesh' or 'generate'");
     if (!o.mesh.empty() && o.generate)
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object has either 'mesh' or 'generate', not both");
-    if (o.collider == Collider::bsp && (!o.is_static || o.mesh.empty() || !io::is_surface_path(o.mesh)))
+    if (o.collider == Collider::bsp &&
+        (!o.is_static || o.mesh.empty() || io::classify_path(o.mesh) != io::PathKind::surface))
         r.fail(t.get("collider"), pre + "collider",
                "collider = \"bsp\" needs a static object (static = true) whose mesh is a closed surface file");
     return o;

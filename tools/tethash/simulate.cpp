@@ -6,7 +6,6 @@
 #include "tethash/io/file.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/pvd.hpp"
-#include "tethash/io/surface.hpp"
 #include "tethash/io/vtu.hpp"
 #include "tethash/sim/simulation.hpp"
 #include "tethash/study/json.hpp"
@@ -76,7 +75,7 @@ struct SimulateOptions {
 /// A file name whose extension is a mesh's (tet mesh or surface), not a scene's.
 bool looks_like_a_mesh(const std::string& path)
 {
-    return io::is_tet_mesh_path(path) || io::is_surface_path(path);
+    return io::classify_path(path) != io::PathKind::unknown;
 }
 
 /// The scene `--mesh FILE` runs: the mesh scaled by `scale`, its up axis `up`, centred over the origin with its
