@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -77,6 +78,15 @@ void Baseline2003::run(const TetMesh& m, double l, std::vector<std::pair<Index, 
                     }
                 }
     }
+}
+
+bool same_pairs(std::vector<std::pair<Index, Index>> pairs, const std::vector<Contact>& contacts)
+{
+    if (pairs.size() != contacts.size()) return false;
+    std::sort(pairs.begin(), pairs.end());
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+        if (pairs[i].first != contacts[i].vertex || pairs[i].second != contacts[i].tet) return false;
+    return true;
 }
 
 } // namespace tethash::bench

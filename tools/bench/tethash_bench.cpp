@@ -79,6 +79,7 @@ struct Measured {
     double cpu_ms = 0;         ///< CPU time of the calling thread (meaningful at 1 thread)
     double process_cpu_ms = 0; ///< CPU time of all threads (includes OpenMP spin-waiting)
     DetectStats stats;
+    std::vector<Contact> contacts; ///< of the warm-up call (the oracle's, as the tests hold)
 };
 
 Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
@@ -86,7 +87,7 @@ Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
     Detector det(p);
     det.set_topology(m);
     DetectStats st;
-    det.detect(m.positions); // warm-up (auto cell size, buffers)
+    std::vector<Contact> contacts = det.detect(m.positions); // warm-up (auto cell size, buffers)
     std::vector<double> ms, cpu, pcpu, s1, s2, s3, s4;
     for (int r = 0; r < repeat; ++r) {
         const double c0 = thread_cpu_ms(), p0 = process_cpu_ms();
@@ -108,13 +109,13 @@ Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
     st.ms_tets = median(s2);
     st.ms_inside = median(s3);
     st.ms_sort = median(s4);
-    return {median(ms), median(cpu), median(pcpu), st};
+    return {median(ms), median(cpu), median(pcpu), st, std::move(contacts)};
 }
 
-double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& contacts, double& cpu_ms)
+double measure_baseline(const TetMesh& m, double l, int repeat, std::vector<std::pair<Index, Index>>& out,
+                        double& cpu_ms)
 {
     bench::Baseline2003 b;
-    std::vector<std::pair<Index, Index>> out;
     b.run(m, l, out);
     std::vector<double> ms, cpu;
     for (int r = 0; r < repeat; ++r) {
@@ -124,7 +125,6 @@ double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& con
         ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         cpu.push_back(thread_cpu_ms() - c0);
     }
-    contacts = out.size();
     cpu_ms = median(cpu);
     return median(ms);
 }
@@ -182,11 +182,13 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
     if (all.stats.contacts != one.stats.contacts) std::printf("  ERROR: contact counts differ between thread counts\n");
     double baseline_cpu = 0;
     if (baseline) {
-        std::size_t bc = 0;
-        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), bc, baseline_cpu);
+        std::vector<std::pair<Index, Index>> pairs;
+        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), pairs, baseline_cpu);
         std::printf("  baseline 2003  %8.3f ms (1 thread, cpu %.3f ms, %zu contacts)   ratio: %.1fx at 1 thread "
-                    "(cpu %.1fx), %.1fx at %d threads\n",
-                    bms, baseline_cpu, bc, bms / one.ms, baseline_cpu / one.cpu_ms, bms / all.ms, all.stats.threads);
+                    "(cpu %.1fx), %.1fx at %d threads%s\n",
+                    bms, baseline_cpu, pairs.size(), bms / one.ms, baseline_cpu / one.cpu_ms, bms / all.ms,
+                    all.stats.threads,
+                    bench::same_pairs(pairs, one.contacts) ? "" : "  ERROR: contacts differ from the hash");
     }
     // The other broad phases at 1 thread, same scene and parameters (DetectStats::candidates: the pairs handed to
     // the exact test; nodes: cells, nodes or levels of the structure).
