@@ -66,6 +66,28 @@ void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, s
 
 } // namespace
 
+namespace {
+
+/// Per vertex: friction_smoothing × the largest side of its object's rest bounding box.
+std::vector<double> friction_speeds(const Positions& rest, const std::vector<Index>& vertex_object, size_t objects)
+{
+    std::vector<Vec3> lo(objects, Vec3::Constant(std::numeric_limits<double>::infinity()));
+    std::vector<Vec3> hi(objects, Vec3::Constant(-std::numeric_limits<double>::infinity()));
+    for (Index i = 0; i < rest.rows(); ++i) {
+        const size_t o = static_cast<size_t>(vertex_object[static_cast<size_t>(i)]);
+        lo[o] = lo[o].cwiseMin(row(rest, i));
+        hi[o] = hi[o].cwiseMax(row(rest, i));
+    }
+    std::vector<double> speed(static_cast<size_t>(rest.rows()));
+    for (Index i = 0; i < rest.rows(); ++i) {
+        const size_t o = static_cast<size_t>(vertex_object[static_cast<size_t>(i)]);
+        speed[static_cast<size_t>(i)] = friction_smoothing * (hi[o] - lo[o]).maxCoeff();
+    }
+    return speed;
+}
+
+} // namespace
+
 Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
 {
     Model m;
@@ -242,6 +264,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     for (Index i = 0; i < n; ++i)
         if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
             m.fixed[static_cast<size_t>(i)] = 1; // unreferenced vertex: nothing moves it
+    m.friction_speed = friction_speeds(rest, m.vertex_object, static_cast<size_t>(objects));
     return m;
 }
 
@@ -287,8 +310,8 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
             if (ground.friction > 0) {
                 const Vec3 vt = vi - vn * nrm;
                 const double speed = vt.norm();
-                double ft = ground.friction * fn; // Coulomb, smoothed below 1 mm/s of sliding
-                ft *= speed / std::max(speed, 1e-3);
+                double ft = ground.friction * fn; // Coulomb, smoothed below the object's friction_speed
+                ft *= speed / std::max(speed, friction_speed[static_cast<size_t>(i)]);
                 if (opt.h > 0) ft = std::min(ft, mass[static_cast<size_t>(i)] * speed / opt.h);
                 if (speed > 0) force -= ft * vt / speed;
             }

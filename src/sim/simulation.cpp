@@ -8,11 +8,12 @@
 #include "objects.hpp"
 #include "obstacles.hpp"
 
+#include "core/timing.hpp"
+
 #include "tethash/error.hpp"
 #include "tethash/sim/quality.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -20,12 +21,8 @@ namespace tethash::sim {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using tethash::detail::Clock;
+using tethash::detail::ms_since;
 
 /// Explicit stability limit of the model with, per vertex, the stiffer of its stiffest possible contact and the
 /// ground (with their damping). A contact's effective mass is at most the vertex's own.
