@@ -9,6 +9,7 @@
 #include "tethash/ccd.hpp"
 #include "tethash/continuous.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/penetration.hpp"

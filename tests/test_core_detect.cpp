@@ -5,6 +5,7 @@
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/oracle.hpp"
 

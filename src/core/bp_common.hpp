@@ -3,6 +3,7 @@
 // for points and box corners alike, per-vertex static flags, the vertices sorted by x, the parallel loops over
 // vertices and tets that feed the threads' sinks, a timer.
 #include "broad_phase.hpp"
+#include "table_size.hpp"
 #include "team.hpp"
 #include "timing.hpp"
 

@@ -2,6 +2,8 @@
 
 #include "core/timing.hpp"
 
+#include "tethash/detect_grammar.hpp"
+
 #include <algorithm>
 #include <cmath>
 

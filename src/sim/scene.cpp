@@ -1,3 +1,4 @@
+#include "tethash/detect_grammar.hpp"
 #include "tethash/sim/scene.hpp"
 
 #include "core/enum_names.hpp"
@@ -486,7 +487,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                               "looseness", "levels"});
                 for (auto&& [dk, dv] : t) {
                     const std::string d(dk.str()), full = "detector." + d;
-                    // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
+                    // Numbers are lengths or counts; strings go through the detector's own grammar (detect_grammar.hpp), so
                     // a value means here what it means on the command line.
                     const toml::node& node = dv; // (a structured binding cannot be captured before C++20's P1091)
                     const auto grammar = [&r, &node, &full](auto&& parse) {
@@ -540,7 +541,7 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                     } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
                         length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin,
                                &Reader::non_negative, parse_skin);
-                    } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
+                    } else if (d == "method") { // the broad phase (detect_grammar.hpp: parse_method)
                         grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
                     } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
                         PartitionParams& q = s.detect.partition;

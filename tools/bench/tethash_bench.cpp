@@ -14,6 +14,7 @@
 //   object
 //                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"

@@ -5,6 +5,7 @@
 
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/cells.hpp"

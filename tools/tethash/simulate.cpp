@@ -2,6 +2,7 @@
 #include "command.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
 #include "tethash/io/mesh_io.hpp"
