@@ -25,12 +25,33 @@ constexpr auto is_space = detail::is_xml_space;
 
 // ---- .vtu reader ---------------------------------------------------------------------------
 
+/// What the pieces of a file hold, gathered piece by piece.
+struct Pieces {
+    std::vector<double> coords;
+    std::vector<std::int64_t> tet_cells; ///< the cells that are tets, numbered over all pieces
+    std::vector<Index> tet_ids;          ///< their four point ids each, numbered over all pieces
+    std::map<std::int64_t, std::int64_t> skipped;
+    std::map<std::string, NamedArray> point_arrays, cell_arrays;
+    std::int64_t total_points = 0, total_cells = 0;
+};
+
 class VtuReader : FileReaderBase {
   public:
     using FileReaderBase::FileReaderBase;
     TetMesh read();
 
   private:
+    /// The <VTKFile> element's attributes (type, version, byte order, header type, compressor) and the appended
+    /// data's encoding; returns the <UnstructuredGrid>.
+    const XmlElement& read_header();
+    /// One <Piece>: its points, its cells and its label arrays appended to `out`.
+    void read_piece(const XmlElement& piece, Pieces& out);
+    void read_points(const XmlElement& piece, std::size_t np, Pieces& out);
+    void read_cells(const XmlElement& cells, std::int64_t np, std::size_t nc, Pieces& out);
+    /// The point (or cell) arrays of a piece that may hold object ids or labels.
+    void gather_arrays(const XmlElement& piece, const char* section, bool cell, std::size_t count,
+                       std::map<std::string, NamedArray>& into);
+
     std::string attr(const XmlElement& el, const char* key, bool required = true) const
     {
         const std::string* v = el.attr(key);
@@ -337,10 +358,8 @@ std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected,
     return out;
 }
 
-TetMesh VtuReader::read()
+const XmlElement& VtuReader::read_header()
 {
-    m_data = read_file(m_path);
-    m_doc = detail::parse_xml(m_path, m_data);
     const XmlElement& root = m_doc.root;
     if (root.name != "VTKFile") fail(at_line(root.line), "expected <VTKFile>, found <" + root.name + ">");
     const std::string type = attr(root, "type");
@@ -380,135 +399,139 @@ TetMesh VtuReader::read()
     }
     const XmlElement* grid = root.child("UnstructuredGrid");
     if (!grid) fail(at_line(root.line), "expected <UnstructuredGrid> in <VTKFile>, found none");
+    return *grid;
+}
 
-    std::vector<double> coords;
-    std::vector<std::int64_t> tet_cells;
-    std::vector<Index> tet_ids;
-    std::map<std::int64_t, std::int64_t> skipped;
-    std::map<std::string, NamedArray> point_arrays, cell_arrays;
-    std::int64_t total_points = 0, total_cells = 0;
+void VtuReader::read_points(const XmlElement& piece, std::size_t npz, Pieces& out)
+{
+    const XmlElement* points = piece.child("Points");
+    if (!points) fail(at_line(piece.line), "expected <Points> in <Piece>, found none");
+    const XmlElement* pda = points->child("DataArray");
+    if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
+    const std::string comps = attr(*pda, "NumberOfComponents", false);
+    if (comps != "3")
+        fail(at_line(pda->line),
+             "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
+    const std::vector<double> pc =
+        read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(npz) + " × 3 values)");
+    for (std::size_t i = 0; i < npz; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(pc[3 * i + k]))
+                fail(at_value(*pda, 3 * i + k), "point " +
+                                                    std::to_string(out.total_points + static_cast<std::int64_t>(i)) +
+                                                    " has a non-finite coordinate");
+    out.coords.insert(out.coords.end(), pc.begin(), pc.end());
+}
 
-    for (const XmlElement& piece : grid->children) {
-        if (piece.name != "Piece") continue;
-        const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
-        const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
-        if (nc > (std::int64_t(1) << 40))
-            fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
-        if (np > 2147483647 - total_points)
-            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points) + " + " +
-                                          std::to_string(np) + ", at most 2147483647)");
-        const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
-
-        // Points
-        const XmlElement* points = piece.child("Points");
-        if (!points) fail(at_line(piece.line), "expected <Points> in <Piece>, found none");
-        const XmlElement* pda = points->child("DataArray");
-        if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
-        const std::string comps = attr(*pda, "NumberOfComponents", false);
-        if (comps != "3")
-            fail(at_line(pda->line),
-                 "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
-        const std::vector<double> pc =
-            read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
-        for (std::size_t i = 0; i < npz; ++i)
-            for (int k = 0; k < 3; ++k)
-                if (!std::isfinite(pc[3 * i + k]))
-                    fail(at_value(*pda, 3 * i + k), "point " +
-                                                        std::to_string(total_points + static_cast<std::int64_t>(i)) +
-                                                        " has a non-finite coordinate");
-        coords.insert(coords.end(), pc.begin(), pc.end());
-
-        // Cells
-        const XmlElement* cells = piece.child("Cells");
-        if (!cells && nc > 0) fail(at_line(piece.line), "expected <Cells> in <Piece>, found none");
-        if (cells) {
-            const auto find = [&](const char* name) -> const XmlElement& {
-                for (const auto& c : cells->children)
-                    if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
-                fail(at_line(cells->line),
-                     "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
-            };
-            const XmlElement& oda = find("offsets");
-            const XmlElement& cda = find("connectivity");
-            const XmlElement& tda = find("types");
-            const auto offsets =
-                read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
-            const auto types =
-                read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
-            std::int64_t prev = 0;
-            for (std::size_t c = 0; c < ncz; ++c) {
-                if (offsets[c] < prev)
-                    fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
-                                               ", expected at least " + std::to_string(prev) +
-                                               " (offsets must not decrease)");
-                prev = offsets[c];
-            }
-            const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
-            if (conn_size > (std::int64_t(1) << 40))
-                fail(at_value(oda, ncz - 1), "last offset " + std::to_string(conn_size) + " is implausibly large");
-            const auto conn = read_array<std::int64_t>(cda, static_cast<std::size_t>(conn_size),
-                                                       "DataArray 'connectivity' (" + std::to_string(conn_size) +
-                                                           " values, the last offset)");
-            for (std::size_t c = 0; c < ncz; ++c) {
-                const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
-                if (types[c] != 10 && !quadratic) {
-                    ++skipped[types[c]];
-                    continue;
-                }
-                const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
-                if (offsets[c] - first != (quadratic ? 10 : 4))
-                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type " +
-                                               (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") + " but " +
-                                               std::to_string(offsets[c] - first) + " points, expected " +
-                                               (quadratic ? "10" : "4"));
-                for (int k = 0; k < 4; ++k) {
-                    const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
-                    if (v < 0 || v >= np)
-                        fail(at_value(cda, static_cast<std::size_t>(first + k)),
-                             "tet " + std::to_string(tet_cells.size()) + " (cell " + std::to_string(c) +
-                                 ") refers to point " + std::to_string(v) + ", but the piece has only " +
-                                 std::to_string(np) + " points (0-based ids)");
-                    tet_ids.push_back(static_cast<Index>(v + total_points));
-                }
-                tet_cells.push_back(total_cells + static_cast<std::int64_t>(c));
-            }
-        }
-
-        // Point and cell arrays that may hold object ids or labels.
-        const auto gather = [&](const char* section, bool cell, std::size_t count,
-                                std::map<std::string, NamedArray>& into) {
-            const XmlElement* s = piece.child(section);
-            if (!s) return;
-            for (const auto& da : s->children) {
-                if (da.name != "DataArray" || !da.attr("Name")) continue;
-                const std::string& name = *da.attr("Name");
-                const std::string* nc_attr = da.attr("NumberOfComponents");
-                if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
-                auto values = read_array<double>(da, count, "DataArray '" + name + "'");
-                NamedArray& a = into[name];
-                if (a.name.empty()) a = {name, {}, at_line(da.line)};
-                // Pieces missing the array leave it short; apply_label_arrays then ignores it.
-                a.values.insert(a.values.end(), values.begin(), values.end());
-            }
-        };
-        gather("PointData", false, npz, point_arrays);
-        gather("CellData", true, ncz, cell_arrays);
-        total_points += np;
-        total_cells += nc;
+void VtuReader::read_cells(const XmlElement& cells, std::int64_t np, std::size_t ncz, Pieces& out)
+{
+    const auto nc = static_cast<std::int64_t>(ncz);
+    const auto find = [&](const char* name) -> const XmlElement& {
+        for (const auto& c : cells.children)
+            if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
+        fail(at_line(cells.line), "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
+    };
+    const XmlElement& oda = find("offsets");
+    const XmlElement& cda = find("connectivity");
+    const XmlElement& tda = find("types");
+    const auto offsets = read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
+    const auto types = read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
+    std::int64_t prev = 0;
+    for (std::size_t c = 0; c < ncz; ++c) {
+        if (offsets[c] < prev)
+            fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
+                                       ", expected at least " + std::to_string(prev) + " (offsets must not decrease)");
+        prev = offsets[c];
     }
+    const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
+    if (conn_size > (std::int64_t(1) << 40))
+        fail(at_value(oda, ncz - 1), "last offset " + std::to_string(conn_size) + " is implausibly large");
+    const auto conn = read_array<std::int64_t>(cda, static_cast<std::size_t>(conn_size),
+                                               "DataArray 'connectivity' (" + std::to_string(conn_size) +
+                                                   " values, the last offset)");
+    for (std::size_t c = 0; c < ncz; ++c) {
+        const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+        if (types[c] != 10 && !quadratic) {
+            ++out.skipped[types[c]];
+            continue;
+        }
+        const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
+        if (offsets[c] - first != (quadratic ? 10 : 4))
+            fail(at_value(tda, c),
+                 "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
+                     " but " + std::to_string(offsets[c] - first) + " points, expected " + (quadratic ? "10" : "4"));
+        for (int k = 0; k < 4; ++k) {
+            const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
+            if (v < 0 || v >= np)
+                fail(at_value(cda, static_cast<std::size_t>(first + k)),
+                     "tet " + std::to_string(out.tet_cells.size()) + " (cell " + std::to_string(c) +
+                         ") refers to point " + std::to_string(v) + ", but the piece has only " + std::to_string(np) +
+                         " points (0-based ids)");
+            out.tet_ids.push_back(static_cast<Index>(v + out.total_points));
+        }
+        out.tet_cells.push_back(out.total_cells + static_cast<std::int64_t>(c));
+    }
+}
+
+void VtuReader::gather_arrays(const XmlElement& piece, const char* section, bool cell, std::size_t count,
+                              std::map<std::string, NamedArray>& into)
+{
+    const XmlElement* s = piece.child(section);
+    if (!s) return;
+    for (const auto& da : s->children) {
+        if (da.name != "DataArray" || !da.attr("Name")) continue;
+        const std::string& name = *da.attr("Name");
+        const std::string* nc_attr = da.attr("NumberOfComponents");
+        if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
+        auto values = read_array<double>(da, count, "DataArray '" + name + "'");
+        NamedArray& a = into[name];
+        if (a.name.empty()) a = {name, {}, at_line(da.line)};
+        // Pieces missing the array leave it short; apply_label_arrays then ignores it.
+        a.values.insert(a.values.end(), values.begin(), values.end());
+    }
+}
+
+void VtuReader::read_piece(const XmlElement& piece, Pieces& out)
+{
+    const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
+    const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
+    if (nc > (std::int64_t(1) << 40))
+        fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
+    if (np > 2147483647 - out.total_points)
+        fail(at_line(piece.line), "too many points for tethash (" + std::to_string(out.total_points) + " + " +
+                                      std::to_string(np) + ", at most 2147483647)");
+    const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
+    read_points(piece, npz, out);
+    const XmlElement* cells = piece.child("Cells");
+    if (!cells && nc > 0) fail(at_line(piece.line), "expected <Cells> in <Piece>, found none");
+    if (cells) read_cells(*cells, np, ncz, out);
+    gather_arrays(piece, "PointData", false, npz, out.point_arrays);
+    gather_arrays(piece, "CellData", true, ncz, out.cell_arrays);
+    out.total_points += np;
+    out.total_cells += nc;
+}
+
+TetMesh VtuReader::read()
+{
+    m_data = read_file(m_path);
+    m_doc = detail::parse_xml(m_path, m_data);
+    const XmlElement& grid = read_header();
+    Pieces p;
+    for (const XmlElement& piece : grid.children)
+        if (piece.name == "Piece") read_piece(piece, p);
 
     TetMesh mesh;
-    mesh.positions.resize(total_points, 3);
-    std::copy(coords.begin(), coords.end(), mesh.positions.data());
-    mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
-    std::copy(tet_ids.begin(), tet_ids.end(), mesh.tets.data());
-    note_skipped_cells(skipped);
+    mesh.positions.resize(p.total_points, 3);
+    std::copy(p.coords.begin(), p.coords.end(), mesh.positions.data());
+    mesh.tets.resize(static_cast<Eigen::Index>(p.tet_cells.size()), 4);
+    std::copy(p.tet_ids.begin(), p.tet_ids.end(), mesh.tets.data());
+    note_skipped_cells(p.skipped);
     std::vector<NamedArray> pa, ca;
-    for (auto& [k, a] : point_arrays)
+    for (auto& [k, a] : p.point_arrays)
         pa.push_back(std::move(a));
-    for (auto& [k, a] : cell_arrays)
+    for (auto& [k, a] : p.cell_arrays)
         ca.push_back(std::move(a));
-    apply_label_arrays(mesh, pa, ca, tet_cells, static_cast<std::size_t>(total_cells), m_notes);
+    apply_label_arrays(mesh, pa, ca, p.tet_cells, static_cast<std::size_t>(p.total_cells), m_notes);
     return mesh;
 }
 
