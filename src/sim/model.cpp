@@ -86,6 +86,72 @@ std::vector<double> friction_speeds(const Positions& rest, const std::vector<Ind
     return speed;
 }
 
+/// Per spring: the rest volume of the tets around its edge (per vertex a sorted list of (other end, edge), then
+/// every tet's six edges).
+std::vector<double> edge_volumes(const Edges& edges, const Tets& tets, const std::vector<double>& rest_volume, Index n)
+{
+    const Index ne = static_cast<Index>(edges.rows());
+    std::vector<double> edge_volume(static_cast<size_t>(ne), 0.0);
+    std::vector<Index> start(static_cast<size_t>(n + 1), 0);
+    for (Index e = 0; e < ne; ++e)
+        ++start[static_cast<size_t>(edges(e, 0) + 1)];
+    for (Index i = 0; i < n; ++i)
+        start[static_cast<size_t>(i + 1)] += start[static_cast<size_t>(i)];
+    std::vector<Index> other(static_cast<size_t>(ne)), id(static_cast<size_t>(ne));
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (Index e = 0; e < ne; ++e) {
+        const size_t k = static_cast<size_t>(fill[static_cast<size_t>(edges(e, 0))]++);
+        other[k] = edges(e, 1);
+        id[k] = e;
+    }
+    auto find_edge = [&](Index a, Index b) {
+        if (a > b) std::swap(a, b);
+        for (Index k = start[static_cast<size_t>(a)]; k < start[static_cast<size_t>(a + 1)]; ++k)
+            if (other[static_cast<size_t>(k)] == b) return id[static_cast<size_t>(k)];
+        return Index{-1};
+    };
+    for (Index q = 0; q < tets.rows(); ++q)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const Index e = find_edge(tets(q, a), tets(q, b));
+                if (e >= 0) edge_volume[static_cast<size_t>(e)] += rest_volume[static_cast<size_t>(q)];
+            }
+    return edge_volume;
+}
+
+/// The mass floor of Model::build (free vertices with edges): at least the mass that keeps each vertex's Gershgorin
+/// bound of stiffness / mass at (2 / h_m)², the mass added taken back from the vertices above the floor.
+void floor_masses(Model& m, const Positions& rest, const std::vector<double>& vertex_edge_count, size_t objects)
+{
+    const Index n = m.num_vertices();
+    std::vector<double> ksum, csum;
+    gershgorin(m, rest, ksum, csum);
+    std::vector<double> total(static_cast<size_t>(objects), 0.0), floored(static_cast<size_t>(objects), 0.0);
+    std::vector<double> above(static_cast<size_t>(objects), 0.0);
+    std::vector<char> at_floor(static_cast<size_t>(n), 0);
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const size_t o = static_cast<size_t>(m.vertex_object[u]);
+        if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
+        total[o] += m.mass[u];
+        const double floor = ksum[u] * material_courant * material_courant / (4 * m.object_frequency_sq[o]);
+        if (floor > m.mass[u]) {
+            m.mass[u] = floor;
+            at_floor[u] = 1;
+            floored[o] += floor;
+        } else {
+            above[o] += m.mass[u];
+        }
+    }
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const size_t o = static_cast<size_t>(m.vertex_object[u]);
+        if (m.fixed[u] || !(vertex_edge_count[u] > 0) || at_floor[u]) continue;
+        // Floors holding more than 90 % of an object's mass (none on the shared meshes) add mass instead.
+        if (above[o] > 0 && total[o] - floored[o] > 0.1 * total[o]) m.mass[u] *= (total[o] - floored[o]) / above[o];
+    }
+}
+
 } // namespace
 
 Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
@@ -162,35 +228,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         dyn_tets.row(static_cast<Index>(q)) = m.volumes.tets.row(static_cast<Index>(q));
     m.springs.edges = unique_edges(dyn_tets);
     const Index ne = static_cast<Index>(m.springs.edges.rows());
-    // Volume around each edge: per vertex a sorted list of (other end, edge), then every tet's six edges.
-    std::vector<double> edge_volume(static_cast<size_t>(ne), 0.0);
-    {
-        std::vector<Index> start(static_cast<size_t>(n + 1), 0);
-        for (Index e = 0; e < ne; ++e)
-            ++start[static_cast<size_t>(m.springs.edges(e, 0) + 1)];
-        for (Index i = 0; i < n; ++i)
-            start[static_cast<size_t>(i + 1)] += start[static_cast<size_t>(i)];
-        std::vector<Index> other(static_cast<size_t>(ne)), id(static_cast<size_t>(ne));
-        std::vector<Index> fill(start.begin(), start.end() - 1);
-        for (Index e = 0; e < ne; ++e) {
-            const size_t k = static_cast<size_t>(fill[static_cast<size_t>(m.springs.edges(e, 0))]++);
-            other[k] = m.springs.edges(e, 1);
-            id[k] = e;
-        }
-        auto find_edge = [&](Index a, Index b) {
-            if (a > b) std::swap(a, b);
-            for (Index k = start[static_cast<size_t>(a)]; k < start[static_cast<size_t>(a + 1)]; ++k)
-                if (other[static_cast<size_t>(k)] == b) return id[static_cast<size_t>(k)];
-            return Index{-1};
-        };
-        for (size_t q = 0; q < dyn.size(); ++q)
-            for (int a = 0; a < 4; ++a)
-                for (int b = a + 1; b < 4; ++b) {
-                    const Index e =
-                        find_edge(m.volumes.tets(static_cast<Index>(q), a), m.volumes.tets(static_cast<Index>(q), b));
-                    if (e >= 0) edge_volume[static_cast<size_t>(e)] += m.volumes.rest[q];
-                }
-    }
+    const std::vector<double> edge_volume = edge_volumes(m.springs.edges, m.volumes.tets, m.volumes.rest, n);
     m.springs.rest.resize(static_cast<size_t>(ne));
     m.springs.k.resize(static_cast<size_t>(ne));
     m.springs.c.resize(static_cast<size_t>(ne));
@@ -233,34 +271,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         const double young = mat.stiffness > 0 ? mat.stiffness / lbar : mat.young;
         m.object_frequency_sq[static_cast<size_t>(o)] = young / (mat.density * lbar * lbar);
     }
-    {
-        std::vector<double> ksum, csum;
-        gershgorin(m, rest, ksum, csum);
-        std::vector<double> total(static_cast<size_t>(objects), 0.0), floored(static_cast<size_t>(objects), 0.0);
-        std::vector<double> above(static_cast<size_t>(objects), 0.0);
-        std::vector<char> at_floor(static_cast<size_t>(n), 0);
-        for (Index i = 0; i < n; ++i) {
-            const size_t u = static_cast<size_t>(i);
-            const size_t o = static_cast<size_t>(m.vertex_object[u]);
-            if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
-            total[o] += m.mass[u];
-            const double floor = ksum[u] * material_courant * material_courant / (4 * m.object_frequency_sq[o]);
-            if (floor > m.mass[u]) {
-                m.mass[u] = floor;
-                at_floor[u] = 1;
-                floored[o] += floor;
-            } else {
-                above[o] += m.mass[u];
-            }
-        }
-        for (Index i = 0; i < n; ++i) {
-            const size_t u = static_cast<size_t>(i);
-            const size_t o = static_cast<size_t>(m.vertex_object[u]);
-            if (m.fixed[u] || !(vertex_edge_count[u] > 0) || at_floor[u]) continue;
-            // Floors holding more than 90 % of an object's mass (none on the shared meshes) add mass instead.
-            if (above[o] > 0 && total[o] - floored[o] > 0.1 * total[o]) m.mass[u] *= (total[o] - floored[o]) / above[o];
-        }
-    }
+    floor_masses(m, rest, vertex_edge_count, static_cast<size_t>(objects));
     for (Index i = 0; i < n; ++i)
         if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
             m.fixed[static_cast<size_t>(i)] = 1; // unreferenced vertex: nothing moves it
