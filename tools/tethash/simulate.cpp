@@ -207,12 +207,10 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
     io::write_text_file((std::filesystem::path(dir) / "run.json").string(), j.str() + "\n");
 }
 
-void run_simulate(SimulateOptions o)
+/// The scene the options name (a scene file, --mesh FILE or the default scene) with the options' overrides
+/// (--steps, --dt, --substeps, --integrator, --threads). `mesh_scene`: the text of the --mesh scene (empty without).
+sim::Scene scene_of(SimulateOptions& o, std::string& mesh_scene)
 {
-    if (o.template_scene) {
-        std::fputs(template_text(), stdout);
-        return;
-    }
     if (!o.scene.empty() && !o.mesh.empty())
         throw Error("give a scene file or --mesh FILE, not both (found '" + o.scene + "' and --mesh '" + o.mesh + "')");
     if (!o.scene.empty() && looks_like_a_mesh(o.scene)) {
@@ -225,7 +223,6 @@ void run_simulate(SimulateOptions o)
     }
     if (o.mesh.empty() && (o.scale != 1 || o.up != "z" || o.young != 1e5 || o.density != 1000))
         throw Error("--scale, --up, --young and --density go with --mesh FILE (a scene file says them itself)");
-    std::string mesh_scene;
     if (!o.mesh.empty()) mesh_scene = mesh_scene_text(o);
     sim::Scene scene = !mesh_scene.empty() ? sim::parse_scene(mesh_scene, "--mesh " + o.mesh)
                        : o.scene.empty()   ? sim::default_scene()
@@ -256,15 +253,12 @@ void run_simulate(SimulateOptions o)
         scene.detect.threads = parse_threads(o.threads);
     else
         check_threads(scene.detect.threads, scene.source + ": [detector] threads");
-    // Detector threads: the scene's (1 unless [detector] threads says otherwise), --threads overrides; 0 = all.
-    const int all = set_threads(scene.detect.threads);
-    const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
+    return scene;
+}
 
-    sim::Simulation sim(scene);
-    sim.set_interrupt_flag(&g_interrupted);
-    for (const std::string& w : sim.warnings())
-        std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
-
+/// The output folder, made if missing and emptied of a previous run's frames; the --mesh scene written into it.
+void prepare_output(const SimulateOptions& o, const std::string& mesh_scene)
+{
     std::error_code ec;
     std::filesystem::create_directories(o.out, ec);
     if (ec) {
@@ -284,6 +278,149 @@ void run_simulate(SimulateOptions o)
         io::write_text_file(path, mesh_scene);
         std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n", path.c_str());
     }
+}
+
+void print_setup(const sim::Scene& scene, const sim::Simulation& sim, int threads)
+{
+    std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
+    std::fprintf(
+        stdout,
+        "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %d threads\n",
+        static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
+        static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
+        scene.steps, threads);
+    std::string sizes;
+    const std::vector<double> size = sim.object_sizes();
+    for (size_t k = 0; k < size.size(); ++k)
+        sizes +=
+            fmt::format("{}{} {:.4g} m", k ? ", " : "",
+                        scene.objects[k].name.empty() ? fmt::format("object {}", k) : scene.objects[k].name, size[k]);
+    std::fprintf(stdout, "object sizes (longest extent): %s\n", sizes.c_str());
+    if (scene.integrator == sim::Integrator::symplectic_euler)
+        std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
+    std::fflush(stdout);
+}
+
+/// The steps' figures summed over the run.
+struct RunTotals {
+    double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, max_depth = 0,
+           depth_sum = 0;
+    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0;
+
+    void add(const sim::StepStats& st, int scene_substeps)
+    {
+        ms_detect += st.ms_detect;
+        ms_depth += st.ms_depth;
+        ms_proximity += st.ms_proximity;
+        ms_response += st.ms_response;
+        ignored += st.ignored_local;
+        ms_integrate += st.ms_integrate;
+        contacts += st.contacts;
+        iterations += st.solver_iterations;
+        if (st.substeps > scene_substeps) {
+            ++refined;
+            refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
+        }
+        max_depth = std::max(max_depth, st.max_depth);
+        depth_sum += st.mean_depth * static_cast<double>(st.contacts);
+    }
+};
+
+/// The progress line after step s (0-based): a bar redrawn on a terminal, a line every tenth of the run otherwise.
+struct Progress {
+    bool tty = stderr_is_terminal();
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last_print = start;
+
+    void after_step(const sim::Simulation& sim, int s, int steps)
+    {
+        const sim::StepStats& st = sim.last_stats();
+        const auto now = std::chrono::steady_clock::now();
+        const double secs = std::chrono::duration<double>(now - start).count();
+        const double rate = secs > 0 ? (s + 1) / secs : 0.0;
+        const double eta = rate > 0 ? (steps - s - 1) / rate : 0.0;
+        const std::string times = fmt::format("  {:.1f} s elapsed, {:.1f} s left", secs, eta);
+        // What the run should not hide, as it happens: energy gained, substeps unconverged, steps refined.
+        std::string note;
+        const sim::RunHealth& hl = sim.health();
+        if (hl.energy_growth > sim::RunHealth::energy_slack)
+            note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
+        if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
+        if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
+        if (tty) {
+            if (std::chrono::duration<double>(now - last_print).count() > 0.1 || s + 1 == steps) {
+                const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, steps));
+                std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s   ",
+                             std::string(static_cast<size_t>(filled), '#').c_str(),
+                             std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, steps, rate,
+                             times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
+                last_print = now;
+            }
+        } else if ((s + 1) % std::max(1, steps / 10) == 0 || s + 1 == steps) {
+            std::fprintf(stderr, "step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s\n", s + 1, steps, rate,
+                         times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
+        }
+    }
+    double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); }
+};
+
+/// The run's summary: time per stage, contacts, solver, refined steps, depths, energies and health.
+void print_summary(const sim::Scene& scene, const sim::Simulation& sim, const RunTotals& t, double wall,
+                   const sim::Energy& e0)
+{
+    const int n = std::max(1, scene.steps);
+    const sim::Energy e1 = sim.energy();
+    // The stages add up to the step's wall time: what they leave is the health checks, the frames written and
+    // the progress lines.
+    const double ms_step = 1e3 * wall / n;
+    const double ms_stages = (t.ms_detect + t.ms_depth + t.ms_proximity + t.ms_response + t.ms_integrate) / n;
+    std::fprintf(stdout,
+                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, proximity %.3f, response %.3f, "
+                 "integration %.3f, checks and output %.3f)\n",
+                 scene.steps, wall, ms_step, t.ms_detect / n, t.ms_depth / n, t.ms_proximity / n, t.ms_response / n,
+                 t.ms_integrate / n, std::max(0.0, ms_step - ms_stages));
+    std::fprintf(stdout, "contacts per step: %.1f (plus %.1f local self-contacts left to the elastic terms)\n",
+                 static_cast<double>(t.contacts) / n, static_cast<double>(t.ignored) / n);
+    if (t.iterations)
+        std::fprintf(stdout, "solver: %.1f %s per step\n", static_cast<double>(t.iterations) / n,
+                     scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
+    if (t.refined)
+        std::fprintf(stdout,
+                     "refined steps: %lld of %d taken in up to %lld substeps (tets inverted or a blow-up at "
+                     "%d; max_substeps bounds it)\n",
+                     static_cast<long long>(t.refined), n, static_cast<long long>(t.refined_substeps), scene.substeps);
+    std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", t.max_depth,
+                 t.contacts ? t.depth_sum / static_cast<double>(t.contacts) : 0.0);
+    std::fprintf(stdout,
+                 "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
+                 "contact %.4g)\n",
+                 e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
+    const sim::RunHealth& health = sim.health();
+    std::fprintf(stdout,
+                 "health: energy end/start %.4g (most gained %.3g %% of what the scene had to spend), volume end/start "
+                 "%.4f (least %.4f), %lld unconverged of %lld substeps, %lld refined steps, %lld tets inverted\n",
+                 health.energy_start != 0 ? health.energy_end / health.energy_start : 1.0,
+                 100 * std::max(0.0, health.energy_growth), health.volume_end, health.volume_ratio,
+                 static_cast<long long>(health.unconverged_substeps), static_cast<long long>(health.substeps),
+                 static_cast<long long>(health.refined_steps), static_cast<long long>(health.inverted_end));
+}
+
+void run_simulate(SimulateOptions o)
+{
+    if (o.template_scene) {
+        std::fputs(template_text(), stdout);
+        return;
+    }
+    std::string mesh_scene;
+    const sim::Scene scene = scene_of(o, mesh_scene);
+    // Detector threads: the scene's (1 unless [detector] threads says otherwise), --threads overrides; 0 = all.
+    const int all = set_threads(scene.detect.threads);
+    const int threads = scene.detect.threads > 0 ? scene.detect.threads : all;
+
+    sim::Simulation sim(scene);
+    sim.set_interrupt_flag(&g_interrupted);
+    for (const std::string& w : sim.warnings())
+        std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
+    prepare_output(o, mesh_scene);
     std::vector<std::pair<double, std::string>> series;
     const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
     auto write_frame = [&]() {
@@ -298,33 +435,9 @@ void run_simulate(SimulateOptions o)
     if (every > 0) write_frame();
 
     const sim::Energy e0 = sim.energy();
-    std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
-    std::fprintf(
-        stdout,
-        "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %d threads\n",
-        static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
-        static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
-        scene.steps, threads);
-    {
-        std::string sizes;
-        const std::vector<double> size = sim.object_sizes();
-        for (size_t k = 0; k < size.size(); ++k)
-            sizes += fmt::format("{}{} {:.4g} m", k ? ", " : "",
-                                 scene.objects[k].name.empty() ? fmt::format("object {}", k) : scene.objects[k].name,
-                                 size[k]);
-        std::fprintf(stdout, "object sizes (longest extent): %s\n", sizes.c_str());
-    }
-    if (scene.integrator == sim::Integrator::symplectic_euler)
-        std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
-    std::fflush(stdout);
-
-    const bool tty = stderr_is_terminal();
-    double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, max_depth = 0,
-           depth_sum = 0;
-    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0;
-    const auto start = std::chrono::steady_clock::now();
-    auto last_print = start;
-    const int plain_every = std::max(1, scene.steps / 10);
+    print_setup(scene, sim, threads);
+    RunTotals totals;
+    Progress progress;
     // Ctrl-C ends the run after the current step with a note of where it stopped; the frames written so far and
     // scene.pvd stay a valid series.
     g_interrupted = 0;
@@ -344,58 +457,18 @@ void run_simulate(SimulateOptions o)
                 break; // rolled back to the last complete step
             }
             done = s + 1;
-            const sim::StepStats& st = sim.last_stats();
-            ms_detect += st.ms_detect;
-            ms_depth += st.ms_depth;
-            ms_proximity += st.ms_proximity;
-            ms_response += st.ms_response;
-            ignored += st.ignored_local;
-            ms_integrate += st.ms_integrate;
-            contacts += st.contacts;
-            iterations += st.solver_iterations;
-            if (st.substeps > scene.substeps) {
-                ++refined;
-                refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
-            }
-            max_depth = std::max(max_depth, st.max_depth);
-            depth_sum += st.mean_depth * static_cast<double>(st.contacts);
+            totals.add(sim.last_stats(), scene.substeps);
             if (every > 0 && sim.step_index() % every == 0) write_frame();
-            const auto now = std::chrono::steady_clock::now();
-            const double secs = std::chrono::duration<double>(now - start).count();
-            const double rate = secs > 0 ? (s + 1) / secs : 0.0;
-            const double eta = rate > 0 ? (scene.steps - s - 1) / rate : 0.0;
-            const std::string times = fmt::format("  {:.1f} s elapsed, {:.1f} s left", secs, eta);
-            // What the run should not hide, as it happens: energy gained, substeps unconverged, steps refined.
-            std::string note;
-            const sim::RunHealth& hl = sim.health();
-            if (hl.energy_growth > sim::RunHealth::energy_slack)
-                note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
-            if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
-            if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
-            if (tty) {
-                if (std::chrono::duration<double>(now - last_print).count() > 0.1 || s + 1 == scene.steps) {
-                    const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, scene.steps));
-                    std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s   ",
-                                 std::string(static_cast<size_t>(filled), '#').c_str(),
-                                 std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps,
-                                 rate, times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
-                    last_print = now;
-                }
-            } else if ((s + 1) % plain_every == 0 || s + 1 == scene.steps) {
-                std::fprintf(stderr, "step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s\n", s + 1, scene.steps,
-                             rate, times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
-            }
+            progress.after_step(sim, s, scene.steps);
         }
     } catch (const RunFailure&) {
-        if (tty) std::fprintf(stderr, "\n");
-        write_run_json(o.out, sim, "failed",
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        if (progress.tty) std::fprintf(stderr, "\n");
+        write_run_json(o.out, sim, "failed", progress.seconds());
         throw;
     }
-    if (tty) std::fprintf(stderr, "\n");
+    if (progress.tty) std::fprintf(stderr, "\n");
     if (g_interrupted) {
-        write_run_json(o.out, sim, "interrupted",
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        write_run_json(o.out, sim, "interrupted", progress.seconds());
         std::fprintf(stderr,
                      "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
                      "series: %s\n",
@@ -404,43 +477,9 @@ void run_simulate(SimulateOptions o)
         std::signal(SIGINT, SIG_DFL);
         std::raise(SIGINT); // the conventional status of a run ended by Ctrl-C (130 from a shell)
     }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const int n = std::max(1, scene.steps);
-    const sim::Energy e1 = sim.energy();
-    // The stages add up to the step's wall time: what they leave is the health checks, the frames written and
-    // the progress lines.
-    const double ms_step = 1e3 * wall / n;
-    const double ms_stages = (ms_detect + ms_depth + ms_proximity + ms_response + ms_integrate) / n;
-    std::fprintf(stdout,
-                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, proximity %.3f, response %.3f, "
-                 "integration %.3f, checks and output %.3f)\n",
-                 scene.steps, wall, ms_step, ms_detect / n, ms_depth / n, ms_proximity / n, ms_response / n,
-                 ms_integrate / n, std::max(0.0, ms_step - ms_stages));
-    std::fprintf(stdout, "contacts per step: %.1f (plus %.1f local self-contacts left to the elastic terms)\n",
-                 static_cast<double>(contacts) / n, static_cast<double>(ignored) / n);
-    if (iterations)
-        std::fprintf(stdout, "solver: %.1f %s per step\n", static_cast<double>(iterations) / n,
-                     scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
-    if (refined)
-        std::fprintf(stdout,
-                     "refined steps: %lld of %d taken in up to %lld substeps (tets inverted or a blow-up at "
-                     "%d; max_substeps bounds it)\n",
-                     static_cast<long long>(refined), n, static_cast<long long>(refined_substeps), scene.substeps);
-    std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
-                 contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
-    std::fprintf(stdout,
-                 "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
-                 "contact %.4g)\n",
-                 e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
-    const sim::RunHealth& health = sim.health();
-    std::fprintf(stdout,
-                 "health: energy end/start %.4g (most gained %.3g %% of what the scene had to spend), volume end/start "
-                 "%.4f (least %.4f), %lld unconverged of %lld substeps, %lld refined steps, %lld tets inverted\n",
-                 health.energy_start != 0 ? health.energy_end / health.energy_start : 1.0,
-                 100 * std::max(0.0, health.energy_growth), health.volume_end, health.volume_ratio,
-                 static_cast<long long>(health.unconverged_substeps), static_cast<long long>(health.substeps),
-                 static_cast<long long>(health.refined_steps), static_cast<long long>(health.inverted_end));
-    const std::vector<std::string> problems = health.problems();
+    const double wall = progress.seconds();
+    print_summary(scene, sim, totals, wall, e0);
+    const std::vector<std::string> problems = sim.health().problems();
     for (const std::string& p : problems)
         std::fprintf(stderr, "tethash: warning: %s\n", p.c_str());
     write_run_json(o.out, sim, problems.empty() ? "ok" : "untrusted", wall);
