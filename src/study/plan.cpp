@@ -6,7 +6,7 @@
 #include "report.hpp"
 #include "value_list.hpp"
 
-#include "core/table_size.hpp"
+#include "core/hash/table_size.hpp"
 
 #include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"

@@ -5,8 +5,8 @@
 
 #include "core/timing.hpp"
 
+#include "core/broad_phase/split_tree.hpp"
 #include "tethash/error.hpp"
-#include "tethash/split_tree.hpp"
 #include "tethash/study/json.hpp"
 #include "tethash/study/table.hpp"
 

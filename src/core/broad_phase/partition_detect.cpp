@@ -4,9 +4,9 @@
 // sort fixes the order, so the output is bit for bit the same for every method and thread count.
 #include "partition_detect.hpp"
 
-#include "team.hpp"
+#include "../team.hpp"
+#include "../timing.hpp"
 #include "tethash/predicates.hpp"
-#include "timing.hpp"
 
 #include <algorithm>
 #include <cassert>

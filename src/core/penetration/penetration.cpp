@@ -1,7 +1,7 @@
 #include "tethash/penetration.hpp"
 
-#include "timing.hpp"
-#include "triangle_bvh.hpp"
+#include "../timing.hpp"
+#include "../triangle_bvh.hpp"
 
 #include "tethash/geometry.hpp"
 

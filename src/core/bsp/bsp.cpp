@@ -13,8 +13,8 @@
 //
 // Query: exact orient3d against the node's original vertices; a zero follows both children, IN if either says
 // IN (the closed polyhedron is the union of the closed IN cells).
+#include "../timing.hpp"
 #include "bsp_impl.hpp"
-#include "timing.hpp"
 
 #include "tethash/error.hpp"
 #include "tethash/geometry.hpp"
