@@ -1,5 +1,5 @@
 #pragma once
-// Input checks shared by the Detector (src/core/detect.cpp) and the oracle (src/oracle): private header
+// Input checks shared by the Detector (src/core/hash/detect.cpp) and the oracle (src/oracle): private header
 // (defined in detect_checks.cpp; validate_params with the parameter grammar of detect_grammar.hpp in
 // detect_params.cpp).
 #include "table_size.hpp"
