@@ -343,7 +343,8 @@ void Proximity::hash_faces(const Positions& x)
     m_stamp.assign(nf, -1);
 }
 
-inline void Proximity::visit_face(Query& q, std::int32_t f, const Positions& x)
+// Inlined into query_cells' loop: the query's fields stay in registers, as in one function.
+__attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::int32_t f, const Positions& x)
 {
     const Face& fc = m_faces[static_cast<size_t>(f)];
     const Index p = q.p, op = q.op;
