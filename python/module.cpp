@@ -10,6 +10,7 @@
 #include "tethash/continuous.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/edge_contacts.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/oracle.hpp"

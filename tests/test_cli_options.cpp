@@ -1,9 +1,11 @@
 // Options that mean one thing in every command: --threads (bounded, 0 = every hardware thread), --cell-size
 // (L a length, xF a factor of the mean edge), --table-size (N, xF, auto), outputs (-o/--out), and options placed
 // before the positional arguments.
+#include "../src/core/hash/table_size.hpp"
 #include "support.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,10 +1,11 @@
 // Detector vs the brute-force oracle over many seeded scenes and every parameter kind; determinism;
 // object rules; API errors.
-#include "../src/core/hash_grid.hpp"
-#include "../src/core/scan.hpp"
+#include "../src/core/hash/hash_grid.hpp"
+#include "../src/core/hash/scan.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/oracle.hpp"
 #include "tethash/predicates.hpp"

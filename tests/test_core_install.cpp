@@ -80,6 +80,9 @@ TEST(CoreInstall, FindPackageConsumerBuildsAndRuns)
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/detect.hpp"));
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.h"));   // the C interface
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/tethash.f90")); // its Fortran module
+    // An embedder's surface: not the options' text grammar nor the broad phases' splitting-plane tree.
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/detect_grammar.hpp"));
+    EXPECT_FALSE(std::filesystem::exists(prefix / "include/tethash/split_tree.hpp"));
     // The io and meshing components with their headers; not the simulator's or the studies'.
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/io/mesh_io.hpp"));
     EXPECT_TRUE(std::filesystem::exists(prefix / "include/tethash/meshing/generate.hpp"));

@@ -2,11 +2,12 @@
 // scenes of the hash's own tests (random, inverted, lattice-aligned, offset, coincident, collapsed, object rules),
 // over each method's parameters, over moving scenes (structures kept across calls: refits, sweep orders, static
 // parts) and over thread counts.
-#include "../src/core/broad_phase.hpp"
-#include "../src/core/inside_batch.hpp"
+#include "../src/core/broad_phase/broad_phase.hpp"
+#include "../src/core/broad_phase/inside_batch.hpp"
 #include "core_scenes.hpp"
 #include "support.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/oracle.hpp"
 #include "tethash/predicates.hpp"

@@ -1,8 +1,8 @@
 // The splitting-plane tree (octree, k-d, BSP rules): every query equals a brute-force scan of closed box
 // overlaps, each item once; leaves cover every item; depth and leaf-size limits; statistics; bad arguments;
 // concurrent queries.
+#include "../src/core/broad_phase/split_tree.hpp"
 #include "tethash/error.hpp"
-#include "tethash/split_tree.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,6 +3,7 @@
 #include "surface_support.hpp"
 
 #include "tethash/error.hpp"
+#include "tethash/io/mesh_io.hpp"
 #include "tethash/io/surface.hpp"
 #include "tethash/mesh.hpp"
 #include "tethash/meshing/generate.hpp"
@@ -26,6 +27,23 @@ namespace {
     if (!io::have_assimp()) GTEST_SKIP() << "built without assimp"
 
 } // namespace
+
+TEST(Surface, ClassifyPathTellsTetMeshesSurfacesAndOtherFiles)
+{
+    // Every extension read_mesh reads is a tet mesh, whatever its case and folder; every surface extension a
+    // surface; scenes, text and names without an extension neither.
+    for (const char* p : {"a.vtk", "dir/b.VTU", "c.msh", "d.node", "e.ele", "f.mesh", "g.veg"}) {
+        EXPECT_EQ(io::classify_path(p), io::PathKind::tet_mesh) << p;
+        EXPECT_TRUE(io::is_tet_mesh_path(p)) << p;
+        EXPECT_FALSE(io::is_surface_path(p)) << p;
+    }
+    for (const char* p : {"a.obj", "dir/b.STL", "c.ply", "d.off", "e.gltf", "f.glb"}) {
+        EXPECT_EQ(io::classify_path(p), io::PathKind::surface) << p;
+        EXPECT_FALSE(io::is_tet_mesh_path(p)) << p;
+    }
+    for (const char* p : {"scene.toml", "notes.txt", "mesh", "", "dir.vtu/file"})
+        EXPECT_EQ(io::classify_path(p), io::PathKind::unknown) << p;
+}
 
 TEST(Surface, BoundaryOfAGeneratedMeshIsClosedAndOutward)
 {

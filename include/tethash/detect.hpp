@@ -22,7 +22,6 @@
 #include <limits>
 #include <memory>
 #include <span>
-#include <string>
 #include <vector>
 
 namespace tethash {
@@ -48,8 +47,7 @@ enum class HashFunction {
     teschner, ///< (x·73856093 xor y·19349663 xor z·83492791) mod n  (the 2003 paper)
     column,   ///< mix(x, y) + z: cells of one z-run land in consecutive buckets (one lookup per column)
 };
-/// "teschner" / "column"; throws Error for anything else.
-HashFunction parse_hash_function(const std::string& name);
+/// "teschner" / "column" (parse_hash_function in detect_grammar.hpp reads them).
 const char* to_string(HashFunction h);
 
 /// The broad phase that hands candidate (vertex, tet) pairs to the exact inside test. Every method returns the same
@@ -72,10 +70,8 @@ enum class Method {
     portals,           ///< cells and portals (portals.hpp): boxes by the cell of their centre, tracked by segment tests
     automatic,         ///< the method that measured fastest for the scene's kind (docs/results.md)
 };
-/// The names of the text grammar ("hash", "brute", "grid", "hgrid", "octree", "octree-point", "octree-loose", "kd",
-/// "kd-point", "bsp", "bsp-balanced", "sort-sweep", "bvh", "bvh-refit", "portals", "auto"); parse_method throws Error
-/// naming `option`, the text and the list.
-Method parse_method(const std::string& text, const std::string& option = "--method");
+/// The names of the text grammar ("hash", "brute", "grid", "hgrid", ..., "auto"; parse_method in detect_grammar.hpp
+/// reads them).
 const char* to_string(Method m);
 /// Every method but `automatic`, in the order above.
 std::span<const Method> all_methods();
@@ -120,43 +116,6 @@ struct DetectParams {
     Method method = Method::hash;
     PartitionParams partition{};
 };
-
-// ---- the text grammar of the detector's parameters: one parser for every command and scene file ----------
-// Lengths are plain numbers; factors are written with a leading x ("x0.5"). Every function throws Error naming
-// `option` and the text.
-
-/// Most threads any command accepts: 256, or the hardware threads if there are more. Beyond it the OpenMP
-/// runtime fails (or crashes) while starting the team, so it is refused before.
-int max_threads();
-/// "N": 0 = every hardware thread (OpenMP's default, OMP_NUM_THREADS where set), 1..max_threads().
-int parse_threads(const std::string& text, const std::string& option = "--threads");
-/// Checks a thread count given as a number (0 = all, 1..max_threads()); returns it.
-int check_threads(long long threads, const std::string& option = "--threads");
-/// "auto" (the mean edge length) | "L" (a length > 0) | "xF" (F > 0 times the mean edge length):
-/// sets params.cell_size_mode and params.cell_size.
-void parse_cell_size(const std::string& text, DetectParams& params, const std::string& option = "--cell-size");
-/// "auto" (0: the detector chooses) | "N" (N ≥ 1 buckets) | "xF" (F > 0 times `vertices`, rounded up to a power
-/// of two). Returns the table size for DetectParams::table_size. `vertices` 0: checks the syntax only.
-std::int64_t parse_table_size(const std::string& text, std::int64_t vertices,
-                              const std::string& option = "--table-size");
-/// "L" (a length ≥ 0; 0 = no candidate reuse) | "xF" (F ≥ 0 times the cell size): sets skin_mode and skin.
-void parse_skin(const std::string& text, DetectParams& params, const std::string& option = "--skin");
-/// The numbers of these grammars, also read by the study's value lists: a whole-string finite decimal number, a
-/// whole-string integer. Throw Error "OPTION: expected a number (an integer), found 'TEXT'".
-double parse_number(const std::string& text, const std::string& option);
-long long parse_integer(const std::string& text, const std::string& option);
-/// The smallest power of two ≥ n (n ≥ 1).
-std::int64_t next_power_of_two(std::int64_t n);
-/// The default table size for `vertices` hashed vertices: for the column hash the smallest power of two
-/// ≥ 2·vertices (so 2V..4V buckets; bucket ranges are masks), for Teschner's hash the smallest prime ≥ 2·vertices
-/// (the xor-product hash needs an odd modulus). At least 1.
-/// Measured (tethash_bench --table-factor, scenario 5: 19,600 vertices, CPU ms at one thread, ±5 %):
-/// 16,384 buckets (0.84 V) 6.3–7.3, 32,768 (1.7 V) 6.0, 65,536 (3.3 V, the default) 5.7, 131,072 (6.7 V) 5.9:
-/// below 2V the hash collisions scanned cost more than they save in table memory, beyond 4V the bigger offset
-/// array no longer stays in cache.
-std::int64_t auto_table_size(HashFunction hash, std::int64_t vertices);
-/// Smallest prime ≥ n (n ≥ 2).
-std::int64_t next_prime(std::int64_t n);
 
 /// Statistics of one detect() call. Times in milliseconds: ms_total is the whole call; ms_setup the one-off set-up
 /// of the first call after set_topology()/set_params() (automatic cell size, the static vertices' table; 0 on later

@@ -1,6 +1,7 @@
 // The C interface (include/tethash/tethash.h) over Detector, Penetration and the continuous queries: every entry point
 // checks its pointers and sizes, runs the C++ call inside guard(), which maps exceptions to a status and a thread-local
 // message, so nothing is thrown across the boundary.
+#include "tethash/detect_grammar.hpp"
 #include "tethash/tethash.h"
 
 #include "tethash/ccd.hpp"

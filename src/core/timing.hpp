@@ -1,5 +1,6 @@
 #pragma once
-// Wall-clock timing of the detector's stages (private header).
+// The one millisecond timer of tethash (private header): the detector's stages, penetration depth, the BSP
+// trees' build, and in the layers above (as "core/timing.hpp") the simulator's step stages and the spheres study.
 #include <chrono>
 
 namespace tethash::detail {

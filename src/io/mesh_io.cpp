@@ -79,6 +79,13 @@ bool is_tet_mesh_path(const std::string& path)
     return is_one_of(extension_of(path), k_tet_read);
 }
 
+PathKind classify_path(const std::string& path)
+{
+    if (is_tet_mesh_path(path)) return PathKind::tet_mesh;
+    if (is_surface_path(path)) return PathKind::surface;
+    return PathKind::unknown;
+}
+
 TetMesh read_mesh(const std::string& path, ReadNotes* notes, const ReadOptions& options)
 {
     if (!std::filesystem::exists(path)) throw Error(path + ": no such file");

@@ -28,12 +28,37 @@ struct ArrayPlace {
     int value_size = 0;    ///< bytes per value (binary)
 };
 
+/// What the sections of a file hold, as read.
+struct Sections {
+    std::vector<double> coords;
+    ArrayPlace coords_place;
+    bool have_points = false, have_cells = false, have_types = false;
+    std::int64_t num_points = 0, num_cells = 0;
+    std::vector<std::int64_t> offsets; ///< num_cells + 1 entries into `conn`
+    std::vector<std::int64_t> conn;    ///< point ids (new layout) or count-prefixed lists (old layout)
+    bool old_layout = false;
+    ArrayPlace conn_place, types_place;
+    std::vector<std::int64_t> types;
+    std::vector<NamedArray> point_arrays, cell_arrays;
+};
+
 class LegacyReader : FileReaderBase {
   public:
     using FileReaderBase::FileReaderBase;
     TetMesh read();
 
   private:
+    // ---- the parts of a file
+    /// Version line, title, ASCII/BINARY and the DATASET line.
+    void read_header();
+    void read_points(Sections& s);
+    /// CELLS in either layout: OFFSETS and CONNECTIVITY (version 5), or count-prefixed lists.
+    void read_cells(Sections& s);
+    void read_offsets_layout(Sections& s, std::int64_t a, std::int64_t b);
+    void read_count_prefixed_layout(Sections& s, std::int64_t a, std::int64_t b);
+    /// The mesh of the sections: finite points, the tets (type 10, or 24 with linearize) with ids in range, labels.
+    TetMesh make_mesh(Sections& s);
+
     // ---- positions and errors
     /// Place of the last token read (line in ASCII files, byte offset in binary ones).
     std::string at_token() const { return m_binary ? at_byte(m_tok_pos) : at_line(m_tok_line); }
@@ -326,11 +351,8 @@ void LegacyReader::read_attribute(const std::string& key, std::size_t count, std
     }
 }
 
-TetMesh LegacyReader::read()
+void LegacyReader::read_header()
 {
-    m_data = read_file(m_path);
-
-    // ---- header: version line, title, ASCII/BINARY
     const std::string first = read_line();
     const std::string magic = "# vtk datafile version";
     if (to_lower(first.substr(0, magic.size())) != magic)
@@ -366,123 +388,132 @@ TetMesh LegacyReader::read()
     next_token();
     if (to_lower(m_tok) != "unstructured_grid")
         fail(at_token(), "expected UNSTRUCTURED_GRID (the only dataset tethash reads), found " + found_token());
+}
 
-    // ---- sections
-    std::vector<double> coords;
-    ArrayPlace coords_place;
-    bool have_points = false, have_cells = false, have_types = false;
-    std::int64_t num_points = 0, num_cells = 0;
-    std::vector<std::int64_t> offsets; // num_cells + 1 entries into `conn`
-    std::vector<std::int64_t> conn;    // point ids (new layout) or count-prefixed lists (old layout)
-    bool old_layout = false;
-    ArrayPlace conn_place, types_place;
-    std::string cells_where;
-    std::vector<std::int64_t> types;
-    std::vector<NamedArray> point_arrays, cell_arrays;
+void LegacyReader::read_points(Sections& s)
+{
+    if (s.have_points) fail(at_token(), "expected one POINTS section, found a second one");
+    s.num_points = expect_int("the number of points", 0);
+    if (s.num_points > 2147483647)
+        fail(at_token(), "too many points for tethash (" + std::to_string(s.num_points) + ")");
+    const Scalar type = expect_type("POINTS");
+    // A bit holds no coordinate, and decoding bits costs a double per bit (64 times the file).
+    if (type == Scalar::Bit)
+        fail(at_token(), "expected the data type of POINTS to be a number type (float, double, int, ...), "
+                         "found bit");
+    s.coords = read_values<double>(3 * static_cast<std::size_t>(s.num_points), type,
+                                   "POINTS (" + std::to_string(s.num_points) + " points × 3)", &s.coords_place);
+    s.have_points = true;
+}
+
+void LegacyReader::read_cells(Sections& s)
+{
+    if (s.have_cells) fail(at_token(), "expected one CELLS section, found a second one");
+    const std::int64_t a = expect_int("the number of cells", 0);
+    const std::int64_t b = expect_int("the size of the cell list", 0);
+    if (to_lower(peek_token()) == "offsets")
+        read_offsets_layout(s, a, b);
+    else
+        read_count_prefixed_layout(s, a, b);
+    s.have_cells = true;
+}
+
+void LegacyReader::read_offsets_layout(Sections& s, std::int64_t a, std::int64_t b)
+{
+    // Version 5.x layout: OFFSETS (a values) then CONNECTIVITY (b values).
+    std::vector<std::int64_t>& offsets = s.offsets;
+    next_token();
+    const Scalar ot = expect_type("OFFSETS");
+    if (ot == Scalar::Bit) fail(at_token(), "expected the data type of OFFSETS to be an integer type, found bit");
+    ArrayPlace offsets_place;
+    offsets = read_values<std::int64_t>(static_cast<std::size_t>(a), ot, "OFFSETS", &offsets_place);
+    next_token();
+    if (to_lower(m_tok) != "connectivity") fail(at_token(), "expected CONNECTIVITY, found " + found_token());
+    const Scalar ct = expect_type("CONNECTIVITY");
+    if (ct == Scalar::Bit) fail(at_token(), "expected the data type of CONNECTIVITY to be an integer type, found bit");
+    s.conn = read_values<std::int64_t>(static_cast<std::size_t>(b), ct, "CONNECTIVITY", &s.conn_place);
+    const std::int64_t num_cells = a > 0 ? a - 1 : 0;
+    s.num_cells = num_cells;
+    if (a == 0) offsets.push_back(0);
+    if (offsets[0] != 0)
+        fail(at_value(offsets_place, 0), "expected the first offset to be 0, found " + std::to_string(offsets[0]));
+    for (std::int64_t c = 0; c < num_cells; ++c)
+        if (offsets[c + 1] < offsets[c] || offsets[c + 1] > b)
+            fail(at_value(offsets_place, static_cast<std::size_t>(c + 1)),
+                 "offset " + std::to_string(c + 1) + " is " + std::to_string(offsets[c + 1]) +
+                     ", expected a value from " + std::to_string(offsets[c]) + " to " + std::to_string(b) +
+                     " (the CONNECTIVITY size)");
+    if (offsets[num_cells] != b)
+        fail(at_value(offsets_place, static_cast<std::size_t>(num_cells)),
+             "expected the last offset to equal the CONNECTIVITY size " + std::to_string(b) + ", found " +
+                 std::to_string(offsets[num_cells]));
+}
+
+void LegacyReader::read_count_prefixed_layout(Sections& s, std::int64_t a, std::int64_t b)
+{
+    std::vector<std::int64_t>& conn = s.conn;
+    s.old_layout = true;
+    s.num_cells = a;
+    if (a > b)
+        fail(at_token(), "expected a cell list of at least " + std::to_string(a) + " values for " + std::to_string(a) +
+                             " cells, found CELLS " + std::to_string(a) + " " + std::to_string(b));
+    conn = read_values<std::int64_t>(static_cast<std::size_t>(b), Scalar::Int32,
+                                     "CELLS (" + std::to_string(a) + " cells, " + std::to_string(b) + " values)",
+                                     &s.conn_place);
+    s.offsets.resize(static_cast<std::size_t>(a) + 1);
+    std::size_t p = 0;
+    for (std::int64_t c = 0; c < a; ++c) {
+        if (p >= conn.size())
+            fail(at_value(s.conn_place, p), "expected cell " + std::to_string(c) + " of " + std::to_string(a) +
+                                                ", found the end of the CELLS list (" + std::to_string(b) +
+                                                " values); the counts in 'CELLS " + std::to_string(a) + " " +
+                                                std::to_string(b) + "' do not match");
+        const std::int64_t k = conn[p];
+        if (k < 0 || static_cast<std::size_t>(k) >= conn.size() - p)
+            fail(at_value(s.conn_place, p), "cell " + std::to_string(c) + " has " + std::to_string(k) +
+                                                " points, but only " + std::to_string(conn.size() - p - 1) +
+                                                " values remain in the CELLS list");
+        s.offsets[static_cast<std::size_t>(c)] = static_cast<std::int64_t>(p);
+        p += static_cast<std::size_t>(k) + 1;
+    }
+    s.offsets[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(p);
+    if (p != conn.size())
+        fail(at_value(s.conn_place, p), "expected " + std::to_string(a) + " cells to use all " + std::to_string(b) +
+                                            " values of the CELLS list, but they use " + std::to_string(p));
+}
+
+TetMesh LegacyReader::read()
+{
+    m_data = read_file(m_path);
+    read_header();
+
+    Sections s;
     enum class Mode { None, Point, Cell } mode = Mode::None;
-
     for (;;) {
         next_token();
         if (m_tok.empty()) break;
         const std::string key = to_lower(m_tok);
         if (key == "points") {
-            if (have_points) fail(at_token(), "expected one POINTS section, found a second one");
-            num_points = expect_int("the number of points", 0);
-            if (num_points > 2147483647)
-                fail(at_token(), "too many points for tethash (" + std::to_string(num_points) + ")");
-            const Scalar type = expect_type("POINTS");
-            // A bit holds no coordinate, and decoding bits costs a double per bit (64 times the file).
-            if (type == Scalar::Bit)
-                fail(at_token(), "expected the data type of POINTS to be a number type (float, double, int, ...), "
-                                 "found bit");
-            coords = read_values<double>(3 * static_cast<std::size_t>(num_points), type,
-                                         "POINTS (" + std::to_string(num_points) + " points × 3)", &coords_place);
-            have_points = true;
+            read_points(s);
             mode = Mode::None;
         } else if (key == "cells") {
-            if (have_cells) fail(at_token(), "expected one CELLS section, found a second one");
-            cells_where = at_token();
-            const std::int64_t a = expect_int("the number of cells", 0);
-            const std::int64_t b = expect_int("the size of the cell list", 0);
-            if (to_lower(peek_token()) == "offsets") {
-                // Version 5.x layout: OFFSETS (a values) then CONNECTIVITY (b values).
-                next_token();
-                const Scalar ot = expect_type("OFFSETS");
-                if (ot == Scalar::Bit)
-                    fail(at_token(), "expected the data type of OFFSETS to be an integer type, found bit");
-                ArrayPlace offsets_place;
-                offsets = read_values<std::int64_t>(static_cast<std::size_t>(a), ot, "OFFSETS", &offsets_place);
-                next_token();
-                if (to_lower(m_tok) != "connectivity")
-                    fail(at_token(), "expected CONNECTIVITY, found " + found_token());
-                const Scalar ct = expect_type("CONNECTIVITY");
-                if (ct == Scalar::Bit)
-                    fail(at_token(), "expected the data type of CONNECTIVITY to be an integer type, found bit");
-                conn = read_values<std::int64_t>(static_cast<std::size_t>(b), ct, "CONNECTIVITY", &conn_place);
-                num_cells = a > 0 ? a - 1 : 0;
-                if (a == 0) offsets.push_back(0);
-                if (offsets[0] != 0)
-                    fail(at_value(offsets_place, 0),
-                         "expected the first offset to be 0, found " + std::to_string(offsets[0]));
-                for (std::int64_t c = 0; c < num_cells; ++c)
-                    if (offsets[c + 1] < offsets[c] || offsets[c + 1] > b)
-                        fail(at_value(offsets_place, static_cast<std::size_t>(c + 1)),
-                             "offset " + std::to_string(c + 1) + " is " + std::to_string(offsets[c + 1]) +
-                                 ", expected a value from " + std::to_string(offsets[c]) + " to " + std::to_string(b) +
-                                 " (the CONNECTIVITY size)");
-                if (offsets[num_cells] != b)
-                    fail(at_value(offsets_place, static_cast<std::size_t>(num_cells)),
-                         "expected the last offset to equal the CONNECTIVITY size " + std::to_string(b) + ", found " +
-                             std::to_string(offsets[num_cells]));
-            } else {
-                old_layout = true;
-                num_cells = a;
-                if (a > b)
-                    fail(at_token(), "expected a cell list of at least " + std::to_string(a) + " values for " +
-                                         std::to_string(a) + " cells, found CELLS " + std::to_string(a) + " " +
-                                         std::to_string(b));
-                conn = read_values<std::int64_t>(
-                    static_cast<std::size_t>(b), Scalar::Int32,
-                    "CELLS (" + std::to_string(a) + " cells, " + std::to_string(b) + " values)", &conn_place);
-                offsets.resize(static_cast<std::size_t>(a) + 1);
-                std::size_t p = 0;
-                for (std::int64_t c = 0; c < a; ++c) {
-                    if (p >= conn.size())
-                        fail(at_value(conn_place, p), "expected cell " + std::to_string(c) + " of " +
-                                                          std::to_string(a) + ", found the end of the CELLS list (" +
-                                                          std::to_string(b) + " values); the counts in 'CELLS " +
-                                                          std::to_string(a) + " " + std::to_string(b) +
-                                                          "' do not match");
-                    const std::int64_t k = conn[p];
-                    if (k < 0 || static_cast<std::size_t>(k) >= conn.size() - p)
-                        fail(at_value(conn_place, p), "cell " + std::to_string(c) + " has " + std::to_string(k) +
-                                                          " points, but only " + std::to_string(conn.size() - p - 1) +
-                                                          " values remain in the CELLS list");
-                    offsets[static_cast<std::size_t>(c)] = static_cast<std::int64_t>(p);
-                    p += static_cast<std::size_t>(k) + 1;
-                }
-                offsets[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(p);
-                if (p != conn.size())
-                    fail(at_value(conn_place, p), "expected " + std::to_string(a) + " cells to use all " +
-                                                      std::to_string(b) + " values of the CELLS list, but they use " +
-                                                      std::to_string(p));
-            }
-            have_cells = true;
+            read_cells(s);
             mode = Mode::None;
         } else if (key == "cell_types") {
-            if (!have_cells) fail(at_token(), "expected CELLS before CELL_TYPES");
+            if (!s.have_cells) fail(at_token(), "expected CELLS before CELL_TYPES");
             const std::int64_t n = expect_int("the number of cell types", 0);
-            if (n != num_cells)
-                fail(at_token(), "expected CELL_TYPES " + std::to_string(num_cells) + " (the number of CELLS), found " +
-                                     std::to_string(n));
-            types = read_values<std::int64_t>(static_cast<std::size_t>(n), Scalar::Int32, "CELL_TYPES", &types_place);
-            have_types = true;
+            if (n != s.num_cells)
+                fail(at_token(), "expected CELL_TYPES " + std::to_string(s.num_cells) +
+                                     " (the number of CELLS), found " + std::to_string(n));
+            s.types =
+                read_values<std::int64_t>(static_cast<std::size_t>(n), Scalar::Int32, "CELL_TYPES", &s.types_place);
+            s.have_types = true;
             mode = Mode::None;
         } else if (key == "point_data" || key == "cell_data") {
             const bool point = key == "point_data";
             const std::int64_t n = expect_int("the number of " + std::string(point ? "points" : "cells"), 0);
-            const std::int64_t expected = point ? num_points : num_cells;
-            if ((point ? have_points : have_cells) && n != expected)
+            const std::int64_t expected = point ? s.num_points : s.num_cells;
+            if ((point ? s.have_points : s.have_cells) && n != expected)
                 fail(at_token(), "expected " + std::string(point ? "POINT_DATA " : "CELL_DATA ") +
                                      std::to_string(expected) + " (the number of " + (point ? "points" : "cells") +
                                      "), found " + std::to_string(n));
@@ -496,11 +527,12 @@ TetMesh LegacyReader::read()
                     key == "tensors6" || key == "texture_coordinates" || key == "color_scalars" ||
                     key == "lookup_table" || key == "global_ids" || key == "pedigree_ids")) {
             const bool point = mode == Mode::Point;
-            const std::size_t count = static_cast<std::size_t>(point ? num_points : num_cells);
+            const std::size_t count = static_cast<std::size_t>(point ? s.num_points : s.num_cells);
             std::vector<NamedArray> found;
             read_attribute(key, count, &found);
             for (auto& a : found)
-                if (is_label_array_name(a.name, !point)) (point ? point_arrays : cell_arrays).push_back(std::move(a));
+                if (is_label_array_name(a.name, !point))
+                    (point ? s.point_arrays : s.cell_arrays).push_back(std::move(a));
         } else {
             fail(at_token(), "expected a section keyword (POINTS, CELLS, CELL_TYPES, POINT_DATA, CELL_DATA, FIELD, "
                              "SCALARS, ...), found " +
@@ -509,16 +541,21 @@ TetMesh LegacyReader::read()
     }
 
     // at_token() is now the end of the file.
-    if (have_cells && !have_types) fail(at_token(), "expected CELL_TYPES, found end of file");
-    if (!have_points) fail(at_token(), "expected POINTS, found end of file");
+    if (s.have_cells && !s.have_types) fail(at_token(), "expected CELL_TYPES, found end of file");
+    if (!s.have_points) fail(at_token(), "expected POINTS, found end of file");
+    return make_mesh(s);
+}
 
+TetMesh LegacyReader::make_mesh(Sections& s)
+{
+    const std::int64_t num_points = s.num_points, num_cells = s.num_cells;
     TetMesh mesh;
     mesh.positions.resize(num_points, 3);
     for (std::int64_t i = 0; i < num_points; ++i)
         for (int k = 0; k < 3; ++k) {
-            const double v = coords[static_cast<std::size_t>(3 * i + k)];
+            const double v = s.coords[static_cast<std::size_t>(3 * i + k)];
             if (!std::isfinite(v))
-                fail(at_value(coords_place, static_cast<std::size_t>(3 * i + k)),
+                fail(at_value(s.coords_place, static_cast<std::size_t>(3 * i + k)),
                      "point " + std::to_string(i) + " has a non-finite coordinate");
             mesh.positions(i, k) = v;
         }
@@ -527,36 +564,36 @@ TetMesh LegacyReader::read()
     std::map<std::int64_t, std::int64_t> skipped;
     for (std::int64_t c = 0; c < num_cells; ++c) {
         const std::size_t cs = static_cast<std::size_t>(c);
-        const bool quadratic = types[cs] == 24 && m_options.linearize; // corners first, then mid-edge nodes
-        if (types[cs] != 10 && !quadratic) {
-            ++skipped[types[cs]];
+        const bool quadratic = s.types[cs] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+        if (s.types[cs] != 10 && !quadratic) {
+            ++skipped[s.types[cs]];
             continue;
         }
-        const std::size_t first = static_cast<std::size_t>(offsets[cs]) + (old_layout ? 1 : 0);
-        const std::size_t size = static_cast<std::size_t>(offsets[cs + 1]) - first;
+        const std::size_t first = static_cast<std::size_t>(s.offsets[cs]) + (s.old_layout ? 1 : 0);
+        const std::size_t size = static_cast<std::size_t>(s.offsets[cs + 1]) - first;
         if (size != (quadratic ? 10u : 4u))
-            fail(at_value(types_place, cs), "cell " + std::to_string(c) + " has type " +
-                                                (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") + " but " +
-                                                std::to_string(size) + " points, expected " + (quadratic ? "10" : "4"));
+            fail(at_value(s.types_place, cs),
+                 "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
+                     " but " + std::to_string(size) + " points, expected " + (quadratic ? "10" : "4"));
         for (std::size_t k = 0; k < 4; ++k) {
-            const std::int64_t v = conn[first + k];
+            const std::int64_t v = s.conn[first + k];
             if (v < 0 || v >= num_points)
-                fail(at_value(conn_place, first + k), "tet " + std::to_string(tet_cells.size()) + " (cell " +
-                                                          std::to_string(c) + ") refers to point " + std::to_string(v) +
-                                                          ", but the file has only " + std::to_string(num_points) +
-                                                          " points (0-based ids)");
+                fail(at_value(s.conn_place, first + k), "tet " + std::to_string(tet_cells.size()) + " (cell " +
+                                                            std::to_string(c) + ") refers to point " +
+                                                            std::to_string(v) + ", but the file has only " +
+                                                            std::to_string(num_points) + " points (0-based ids)");
         }
         tet_cells.push_back(c);
     }
     mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
     for (std::size_t t = 0; t < tet_cells.size(); ++t) {
         const std::size_t first =
-            static_cast<std::size_t>(offsets[static_cast<std::size_t>(tet_cells[t])]) + (old_layout ? 1 : 0);
+            static_cast<std::size_t>(s.offsets[static_cast<std::size_t>(tet_cells[t])]) + (s.old_layout ? 1 : 0);
         for (int k = 0; k < 4; ++k)
-            mesh.tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(conn[first + k]);
+            mesh.tets(static_cast<Eigen::Index>(t), k) = static_cast<Index>(s.conn[first + k]);
     }
     note_skipped_cells(skipped);
-    apply_label_arrays(mesh, point_arrays, cell_arrays, tet_cells, static_cast<std::size_t>(num_cells), m_notes);
+    apply_label_arrays(mesh, s.point_arrays, s.cell_arrays, tet_cells, static_cast<std::size_t>(num_cells), m_notes);
     return mesh;
 }
 

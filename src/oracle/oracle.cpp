@@ -1,8 +1,8 @@
 // Brute-force reference: all vertices × all tets (x-sorted to skip pairs whose x-extents cannot meet).
 #include "tethash/oracle.hpp"
 
-#include "../core/boundary_edges.hpp"
-#include "../core/detect_checks.hpp"
+#include "core/ccd/boundary_edges.hpp"
+#include "core/hash/detect_checks.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>

@@ -525,11 +525,11 @@ void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
                 f[2] += fn * gnz;
                 H.add_outer(k + c * inv_h, gnx, gny, gnz);
                 if (g.friction > 0) {
-                    // Coulomb friction on the tangential displacement, smoothed below 1 mm/s of sliding
+                    // Coulomb friction on the tangential displacement, smoothed below Model::friction_speed
                     // (lagged normal force: Hessian μ fn / max(|t|, ε) on the tangent plane).
                     const double tx = dx - dn * gnx, ty = dy - dn * gny, tz = dz - dn * gnz;
                     const double tl = std::sqrt(tx * tx + ty * ty + tz * tz);
-                    const double s = g.friction * fn / std::max(tl, 1e-3 * h);
+                    const double s = g.friction * fn / std::max(tl, model.friction_speed[u] * h);
                     f[0] -= s * tx;
                     f[1] -= s * ty;
                     f[2] -= s * tz;
@@ -558,7 +558,7 @@ void BlockDescent::add_lane_terms(const LaneGroup& grp, int l, LaneTerms& terms,
         if (mu > 0) {
             const double tx = c.rel[0] - rn * c.n[0], ty = c.rel[1] - rn * c.n[1], tz = c.rel[2] - rn * c.n[2];
             const double tl = std::sqrt(tx * tx + ty * ty + tz * tz);
-            const double sf = mu * fn / std::max(tl, 1e-3 * h);
+            const double sf = mu * fn / std::max(tl, model.friction_speed[u] * h);
             f[0] -= vc.coef * sf * tx;
             f[1] -= vc.coef * sf * ty;
             f[2] -= vc.coef * sf * tz;

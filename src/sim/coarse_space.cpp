@@ -18,8 +18,8 @@ constexpr size_t max_nodes_per_object = 400;
 /// The weight-to-bending number ρ g L³ / (E t²) above which a thin sheet's weight folds it (no lattice, below).
 constexpr double sheet_folds = 10.0;
 /// The ω h up to which a sheet that folds converges with the sweeps alone. Above it the sweeps cannot carry the
-/// sheet's long waves (docs/simulator.md: a 5 cm mat landing on its edge stayed standing, buckled, with 4.3 times the
-/// drop's energy stored in its springs), and the lattice's corrections are what makes the step converge.
+/// sheet's long waves (a small mat landing on its edge stayed standing, buckled, its springs holding several times
+/// the drop's energy: docs/simulator.md), and the lattice's corrections are what makes the step converge.
 constexpr double sheet_sweeps_alone = 20.0;
 
 /// The rotation closest to the 3 × 3 matrix s (its polar factor; a reflection turned into a rotation).
@@ -64,13 +64,12 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
             lo = lo.cwiseMin(x.row(i).transpose());
             hi = hi.cwiseMax(x.row(i).transpose());
         }
-        // A sheet thinner than half a cell (the mat: one tet layer, 8 mm over 1 m) that its weight folds gets no
-        // lattice: the cells span its folds, and the start state's matrix points nowhere useful once it crumples
-        // (its corrections slowed the sweeps: mean height 0.11-0.18 m at 0.5 s where the converged step is at
-        // 0.044). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
-        // large: 1,500 for the mat of young 1e5 at 1 m. A stiff sheet keeps its lattice: the mat of young 1e9 at 1 m
-        // (0.15) ended its drop at 124 times its start energy with the sweeps alone, at 0.99 with the lattice. So does
-        // a sheet whose ω h the sweeps alone cannot converge (sheet_sweeps_alone): the mat at 1 cm to 15 cm.
+        // A sheet thinner than half a cell (one tet layer) that its weight folds gets no lattice: the cells span its
+        // folds, and the start state's matrix points nowhere useful once it crumples (its corrections slowed the
+        // sweeps). Its weight folds it where ρ g L³ / (E t²) (L its extent, t its thickness; E / ρ = ω² L̄²) is
+        // large. A stiff sheet keeps its lattice: without it, the sweeps alone let its drop gain energy many times
+        // over (docs/simulator.md, "Figures behind the code's constants"). So does a sheet whose ω h the sweeps alone
+        // cannot converge (sheet_sweeps_alone: the mat below 1 m landing on its edge stayed standing, buckled).
         const Eigen::Vector3d extent3 = hi - lo;
         const double omega_h = std::sqrt(model.object_frequency_sq[o]) * h;
         if (extent3.minCoeff() < 0.5 * std::max(2.0 * model.object_mean_edge[o], extent3.maxCoeff() / 6.0)) {
@@ -83,8 +82,8 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
         const double extent = (hi - lo).maxCoeff();
         double cell = std::max(2.0 * model.object_mean_edge[o], extent / cells_per_extent);
         // At most a quarter as many nodes as the object has vertices (125 for any object), and max_nodes_per_object:
-        // the factorisation grows about as the square of the nodes (the hand at 5 cm with cells of two mean edges:
-        // 300 ms a substep).
+        // the factorisation grows about as the square of the nodes (hundreds of milliseconds a substep on a real
+        // mesh with cells of two mean edges; docs/simulator.md).
         const size_t cap = std::min<size_t>(max_nodes_per_object, std::max<size_t>(125, vs.size() / 4));
         Eigen::Array3i dims;
         std::vector<std::int32_t> id;

@@ -1,7 +1,10 @@
 #include "contact_response.hpp"
 
+#include "core/timing.hpp"
+
+#include "tethash/detect_grammar.hpp"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace tethash::sim {
@@ -10,12 +13,8 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using tethash::detail::Clock;
+using tethash::detail::ms_since;
 
 /// A self-contact whose tet lies within this many mean edge lengths of the vertex in the rest state is local
 /// inversion (a fold of the vertex's own neighbourhood), left to the elastic and volume terms: pushing the
@@ -212,11 +211,11 @@ void ContactResponse::add_forces(const Positions& vel, Positions& f, double h, b
         const double fn = w * std::max(0.0, scale * (m_k[q] * c.depth - m_c[q] * vn));
         Vec3 force = fn * nrm;
         if (m_mu > 0 && fn > 0) {
-            // Coulomb friction along the relative tangential velocity, smoothed below 1 mm/s and capped so
-            // that it cannot reverse the relative sliding in one step.
+            // Coulomb friction along the relative tangential velocity, smoothed below the vertex's object's
+            // friction_speed and capped so that it cannot reverse the relative sliding in one step.
             const Vec3 vt = vrel - vn * nrm;
             const double speed = vt.norm();
-            double ft = m_mu * fn * std::min(1.0, speed / 1e-3);
+            double ft = m_mu * fn * std::min(1.0, speed / m_model->friction_speed[static_cast<size_t>(c.vertex)]);
             if (h > 0 && m_mred[q] > 0) ft = std::min(ft, w * m_mred[q] * speed / h);
             if (speed > 0) force -= ft * vt / speed;
         }

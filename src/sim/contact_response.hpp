@@ -10,7 +10,7 @@
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
-#include "tethash/sim/simulation.hpp"
+#include "tethash/sim/step_stats.hpp"
 
 #include <Eigen/Sparse>
 

@@ -66,6 +66,94 @@ void gershgorin(const Model& m, const Positions& x, std::vector<double>& ksum, s
 
 } // namespace
 
+namespace {
+
+/// Per vertex: friction_smoothing × the largest side of its object's rest bounding box.
+std::vector<double> friction_speeds(const Positions& rest, const std::vector<Index>& vertex_object, size_t objects)
+{
+    std::vector<Vec3> lo(objects, Vec3::Constant(std::numeric_limits<double>::infinity()));
+    std::vector<Vec3> hi(objects, Vec3::Constant(-std::numeric_limits<double>::infinity()));
+    for (Index i = 0; i < rest.rows(); ++i) {
+        const size_t o = static_cast<size_t>(vertex_object[static_cast<size_t>(i)]);
+        lo[o] = lo[o].cwiseMin(row(rest, i));
+        hi[o] = hi[o].cwiseMax(row(rest, i));
+    }
+    std::vector<double> speed(static_cast<size_t>(rest.rows()));
+    for (Index i = 0; i < rest.rows(); ++i) {
+        const size_t o = static_cast<size_t>(vertex_object[static_cast<size_t>(i)]);
+        speed[static_cast<size_t>(i)] = friction_smoothing * (hi[o] - lo[o]).maxCoeff();
+    }
+    return speed;
+}
+
+/// Per spring: the rest volume of the tets around its edge (per vertex a sorted list of (other end, edge), then
+/// every tet's six edges).
+std::vector<double> edge_volumes(const Edges& edges, const Tets& tets, const std::vector<double>& rest_volume, Index n)
+{
+    const Index ne = static_cast<Index>(edges.rows());
+    std::vector<double> edge_volume(static_cast<size_t>(ne), 0.0);
+    std::vector<Index> start(static_cast<size_t>(n + 1), 0);
+    for (Index e = 0; e < ne; ++e)
+        ++start[static_cast<size_t>(edges(e, 0) + 1)];
+    for (Index i = 0; i < n; ++i)
+        start[static_cast<size_t>(i + 1)] += start[static_cast<size_t>(i)];
+    std::vector<Index> other(static_cast<size_t>(ne)), id(static_cast<size_t>(ne));
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (Index e = 0; e < ne; ++e) {
+        const size_t k = static_cast<size_t>(fill[static_cast<size_t>(edges(e, 0))]++);
+        other[k] = edges(e, 1);
+        id[k] = e;
+    }
+    auto find_edge = [&](Index a, Index b) {
+        if (a > b) std::swap(a, b);
+        for (Index k = start[static_cast<size_t>(a)]; k < start[static_cast<size_t>(a + 1)]; ++k)
+            if (other[static_cast<size_t>(k)] == b) return id[static_cast<size_t>(k)];
+        return Index{-1};
+    };
+    for (Index q = 0; q < tets.rows(); ++q)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                const Index e = find_edge(tets(q, a), tets(q, b));
+                if (e >= 0) edge_volume[static_cast<size_t>(e)] += rest_volume[static_cast<size_t>(q)];
+            }
+    return edge_volume;
+}
+
+/// The mass floor of Model::build (free vertices with edges): at least the mass that keeps each vertex's Gershgorin
+/// bound of stiffness / mass at (2 / h_m)², the mass added taken back from the vertices above the floor.
+void floor_masses(Model& m, const Positions& rest, const std::vector<double>& vertex_edge_count, size_t objects)
+{
+    const Index n = m.num_vertices();
+    std::vector<double> ksum, csum;
+    gershgorin(m, rest, ksum, csum);
+    std::vector<double> total(static_cast<size_t>(objects), 0.0), floored(static_cast<size_t>(objects), 0.0);
+    std::vector<double> above(static_cast<size_t>(objects), 0.0);
+    std::vector<char> at_floor(static_cast<size_t>(n), 0);
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const size_t o = static_cast<size_t>(m.vertex_object[u]);
+        if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
+        total[o] += m.mass[u];
+        const double floor = ksum[u] * material_courant * material_courant / (4 * m.object_frequency_sq[o]);
+        if (floor > m.mass[u]) {
+            m.mass[u] = floor;
+            at_floor[u] = 1;
+            floored[o] += floor;
+        } else {
+            above[o] += m.mass[u];
+        }
+    }
+    for (Index i = 0; i < n; ++i) {
+        const size_t u = static_cast<size_t>(i);
+        const size_t o = static_cast<size_t>(m.vertex_object[u]);
+        if (m.fixed[u] || !(vertex_edge_count[u] > 0) || at_floor[u]) continue;
+        // Floors holding more than 90 % of an object's mass (none on the shared meshes) add mass instead.
+        if (above[o] > 0 && total[o] - floored[o] > 0.1 * total[o]) m.mass[u] *= (total[o] - floored[o]) / above[o];
+    }
+}
+
+} // namespace
+
 Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, const std::vector<char>& object_static)
 {
     Model m;
@@ -140,35 +228,7 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         dyn_tets.row(static_cast<Index>(q)) = m.volumes.tets.row(static_cast<Index>(q));
     m.springs.edges = unique_edges(dyn_tets);
     const Index ne = static_cast<Index>(m.springs.edges.rows());
-    // Volume around each edge: per vertex a sorted list of (other end, edge), then every tet's six edges.
-    std::vector<double> edge_volume(static_cast<size_t>(ne), 0.0);
-    {
-        std::vector<Index> start(static_cast<size_t>(n + 1), 0);
-        for (Index e = 0; e < ne; ++e)
-            ++start[static_cast<size_t>(m.springs.edges(e, 0) + 1)];
-        for (Index i = 0; i < n; ++i)
-            start[static_cast<size_t>(i + 1)] += start[static_cast<size_t>(i)];
-        std::vector<Index> other(static_cast<size_t>(ne)), id(static_cast<size_t>(ne));
-        std::vector<Index> fill(start.begin(), start.end() - 1);
-        for (Index e = 0; e < ne; ++e) {
-            const size_t k = static_cast<size_t>(fill[static_cast<size_t>(m.springs.edges(e, 0))]++);
-            other[k] = m.springs.edges(e, 1);
-            id[k] = e;
-        }
-        auto find_edge = [&](Index a, Index b) {
-            if (a > b) std::swap(a, b);
-            for (Index k = start[static_cast<size_t>(a)]; k < start[static_cast<size_t>(a + 1)]; ++k)
-                if (other[static_cast<size_t>(k)] == b) return id[static_cast<size_t>(k)];
-            return Index{-1};
-        };
-        for (size_t q = 0; q < dyn.size(); ++q)
-            for (int a = 0; a < 4; ++a)
-                for (int b = a + 1; b < 4; ++b) {
-                    const Index e =
-                        find_edge(m.volumes.tets(static_cast<Index>(q), a), m.volumes.tets(static_cast<Index>(q), b));
-                    if (e >= 0) edge_volume[static_cast<size_t>(e)] += m.volumes.rest[q];
-                }
-    }
+    const std::vector<double> edge_volume = edge_volumes(m.springs.edges, m.volumes.tets, m.volumes.rest, n);
     m.springs.rest.resize(static_cast<size_t>(ne));
     m.springs.k.resize(static_cast<size_t>(ne));
     m.springs.c.resize(static_cast<size_t>(ne));
@@ -200,8 +260,9 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
     // Each object has a wave speed c = sqrt(young / density) and a frequency ω = c / L̄ at its mean edge L̄
     // (object_frequency_sq); every free vertex gets at least the mass that keeps its Gershgorin bound of
     // stiffness / mass at (2 / h_m)², h_m = material_courant / ω, so no vertex's explicit limit falls below
-    // h_m whatever the tets' shapes. The mass the floor adds (0.13 % of the hand, 7 % of its vertices) is taken
-    // back from the vertices above the floor, so each object keeps density × volume.
+    // h_m whatever the tets' shapes. The mass the floor adds (a small fraction of a real mesh's, on its slivers'
+    // vertices; docs/simulator.md) is taken back from the vertices above the floor, so each object keeps
+    // density × volume.
     m.object_frequency_sq.assign(static_cast<size_t>(objects), 0.0);
     for (Index o = 0; o < objects; ++o) {
         const double lbar = m.object_mean_edge[static_cast<size_t>(o)];
@@ -210,37 +271,11 @@ Model Model::build(const TetMesh& mesh, const std::vector<Material>& materials, 
         const double young = mat.stiffness > 0 ? mat.stiffness / lbar : mat.young;
         m.object_frequency_sq[static_cast<size_t>(o)] = young / (mat.density * lbar * lbar);
     }
-    {
-        std::vector<double> ksum, csum;
-        gershgorin(m, rest, ksum, csum);
-        std::vector<double> total(static_cast<size_t>(objects), 0.0), floored(static_cast<size_t>(objects), 0.0);
-        std::vector<double> above(static_cast<size_t>(objects), 0.0);
-        std::vector<char> at_floor(static_cast<size_t>(n), 0);
-        for (Index i = 0; i < n; ++i) {
-            const size_t u = static_cast<size_t>(i);
-            const size_t o = static_cast<size_t>(m.vertex_object[u]);
-            if (m.fixed[u] || !(vertex_edge_count[u] > 0)) continue;
-            total[o] += m.mass[u];
-            const double floor = ksum[u] * material_courant * material_courant / (4 * m.object_frequency_sq[o]);
-            if (floor > m.mass[u]) {
-                m.mass[u] = floor;
-                at_floor[u] = 1;
-                floored[o] += floor;
-            } else {
-                above[o] += m.mass[u];
-            }
-        }
-        for (Index i = 0; i < n; ++i) {
-            const size_t u = static_cast<size_t>(i);
-            const size_t o = static_cast<size_t>(m.vertex_object[u]);
-            if (m.fixed[u] || !(vertex_edge_count[u] > 0) || at_floor[u]) continue;
-            // Floors holding more than 90 % of an object's mass (none on the shared meshes) add mass instead.
-            if (above[o] > 0 && total[o] - floored[o] > 0.1 * total[o]) m.mass[u] *= (total[o] - floored[o]) / above[o];
-        }
-    }
+    floor_masses(m, rest, vertex_edge_count, static_cast<size_t>(objects));
     for (Index i = 0; i < n; ++i)
         if (!m.fixed[static_cast<size_t>(i)] && !(m.mass[static_cast<size_t>(i)] > 0))
             m.fixed[static_cast<size_t>(i)] = 1; // unreferenced vertex: nothing moves it
+    m.friction_speed = friction_speeds(rest, m.vertex_object, static_cast<size_t>(objects));
     return m;
 }
 
@@ -286,8 +321,8 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
             if (ground.friction > 0) {
                 const Vec3 vt = vi - vn * nrm;
                 const double speed = vt.norm();
-                double ft = ground.friction * fn; // Coulomb, smoothed below 1 mm/s of sliding
-                ft *= speed / std::max(speed, 1e-3);
+                double ft = ground.friction * fn; // Coulomb, smoothed below the object's friction_speed
+                ft *= speed / std::max(speed, friction_speed[static_cast<size_t>(i)]);
                 if (opt.h > 0) ft = std::min(ft, mass[static_cast<size_t>(i)] * speed / opt.h);
                 if (speed > 0) force -= ft * vt / speed;
             }

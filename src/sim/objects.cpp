@@ -23,7 +23,7 @@ TetMesh load_object(const ObjectSpec& o)
 {
     TetMesh m;
     if (!o.mesh.empty()) {
-        if (io::is_surface_path(o.mesh) && !io::is_tet_mesh_path(o.mesh)) {
+        if (io::classify_path(o.mesh) == io::PathKind::surface) {
             meshing::TetrahedralizeParams tp;
             tp.resolution = o.surface_resolution;
             m = meshing::tetrahedralize(io::read_surface(o.mesh), tp);

@@ -96,16 +96,13 @@ using Vec3 = Eigen::Vector3d;
 
 /// A vertex's reach is this many times its travel in the substep ...
 constexpr double radius_travel = 1.5;
-/// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On the mat (a one-layer sheet
-/// crumpling, every vertex moving) 0.5 cost twice as much as 0.25 per step at 1/240 (87 against 38 ms of
-/// proximity; 724 against 248 at 1/60) for about as many far self-penetrations at the worst frame (41 and 39 of
-/// 20,000 vertices); 1.5 cost twice as much again (docs/simulator.md).
+/// ... at most this many mean edges: the faces a vertex looks at grow with its cube. On a crumpling sheet (every
+/// vertex moving) twice this cap cost twice as much per step for about as many far self-penetrations
+/// (docs/simulator.md, "Figures behind the code's constants").
 constexpr double radius_edges = 0.25;
-/// The grid's cell, in mean edges. Each face is entered in every cell its grown box meets (about 35 at one mean
-/// edge on the hand); at two, a face meets fewer cells and a query reads more faces per cell, and the stage cost
-/// less on every shared-mesh drop measured at 1/240 (alternating runs: the hand 3.15 → 2.96 ms a step, octocat
-/// 3.7 → 3.0, the two armadillos 1.72 → 1.40, quintupleTorus 6.8 → 4.8, the mat 30 → 20); at three the hand's
-/// went up again (3.5).
+/// The grid's cell, in mean edges. Each face is entered in every cell its grown box meets (tens at one mean edge);
+/// at two, a face meets fewer cells and a query reads more faces per cell, and the stage cost less on every
+/// shared-mesh drop measured; at three it cost more again (docs/simulator.md, "Open").
 constexpr double cell_edges = 2.0;
 /// Two objects thrown at each other: their whole surfaces close at once, so the cap is wider (it costs only while
 /// they approach fast).
@@ -198,7 +195,7 @@ void Proximity::setup(const TetMesh& mesh, const Positions& rest, const Model& m
     for (Index i = 0; i < mesh.num_vertices(); ++i)
         if (is_boundary[static_cast<size_t>(i)]) m_vertices.push_back(i);
     // Vertices and faces in Morton order of their rest positions: consecutive queries read the same cells and
-    // consecutive faces write to nearby ones (2.6 MB of cells on the hand: out of the cache in index order).
+    // consecutive faces write to nearby ones (a real mesh's cells take megabytes: out of the cache in index order).
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (Index i : m_vertices) {
         lo = lo.cwiseMin(rest.row(i).transpose());
@@ -346,6 +343,111 @@ void Proximity::hash_faces(const Positions& x)
     m_stamp.assign(nf, -1);
 }
 
+// Inlined into query_cells' loop: the query's fields stay in registers, as in one function.
+__attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::int32_t f, const Positions& x)
+{
+    const Face& fc = m_faces[static_cast<size_t>(f)];
+    const Index p = q.p, op = q.op;
+    bool near_rest = false; // the corners decide whether the face is local (below)
+    if (fc.object == op) {
+        if (q.reach2 < 0) return; // self-collision off
+        // Squared: dr + radius < local_reach, dr − radius < far_reach (dr the centre's distance).
+        const double dr2 = (fc.rest_centre - q.rp).squaredNorm();
+        const double inner = q.local_reach - fc.rest_radius, outer = q.far_reach + fc.rest_radius;
+        if (inner > 0 && dr2 < inner * inner) return; // every corner near: local
+        near_rest = dr2 < outer * outer;
+    } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
+        return;
+    }
+    if (!q.one_cell) {
+        if (m_stamp[static_cast<size_t>(f)] == p) return;
+        m_stamp[static_cast<size_t>(f)] = static_cast<std::int32_t>(p);
+    }
+    if (fc.v[0] == p || fc.v[1] == p || fc.v[2] == p) return;
+    const std::vector<char>& fixed = m_model->fixed;
+    if (fixed[static_cast<size_t>(p)] && fixed[static_cast<size_t>(fc.v[0])] && fixed[static_cast<size_t>(fc.v[1])] &&
+        fixed[static_cast<size_t>(fc.v[2])])
+        return;
+    if (near_rest) {
+        bool local = false;
+        for (Index c : fc.v)
+            local = local || (m_rest.row(c).transpose() - q.rp).squaredNorm() < q.reach2;
+        if (local) return;
+    }
+    const Vec3 a = x.row(fc.v[0]).transpose(), bb = x.row(fc.v[1]).transpose(), c = x.row(fc.v[2]).transpose();
+    const Vec3 cp = closest_point_on_triangle(q.xp, a, bb, c);
+    const double d2 = (q.xp - cp).squaredNorm();
+    const size_t objects = m_margin.size();
+    const double watch =
+        m_margin_max + q.r + face_reach(m_reach, fc) +
+        (op == fc.object ? 0.0 : m_pair_now[static_cast<size_t>(op) * objects + static_cast<size_t>(fc.object)]);
+    if (d2 >= watch * watch) return;
+    q.clearance = std::min(q.clearance, d2);
+    // The vertex must be on the outer side of the face (else it is inside, or beside the face's back: the
+    // penetration response or another face answers).
+    Vec3 n = (bb - a).cross(c - a);
+    if (n.dot(x.row(fc.opp).transpose() - a) > 0) n = -n;
+    if (!((q.xp - cp).dot(n) > 0)) return;
+    const double d = std::sqrt(d2);
+    auto it = std::find_if(m_best.begin(), m_best.end(), [&](const Best& bs) { return bs.object == fc.object; });
+    if (it == m_best.end())
+        m_best.push_back({fc.object, f, d, cp});
+    else if (d < it->dist || (d == it->dist && f < it->face))
+        *it = {fc.object, f, d, cp};
+}
+
+void Proximity::query_cells(Query& q, const Positions& x)
+{
+    const double inv_cell = 1.0 / (cell_edges * m_edge);
+    const double rq = q.r + m_object_reach[static_cast<size_t>(q.op)]; // the query box: any partner object
+    std::int64_t lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = static_cast<std::int64_t>(std::floor((q.xp[k] - rq) * inv_cell));
+        hi[k] = static_cast<std::int64_t>(std::floor((q.xp[k] + rq) * inv_cell));
+    }
+    q.one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
+    // The query box in single precision, rounded outwards like the faces' boxes: lo x, y, z, hi x, y, z.
+    float qbox[6];
+    for (int k = 0; k < 3; ++k) {
+        qbox[k] = round_down(q.xp[k] - rq);
+        qbox[3 + k] = round_up(q.xp[k] + rq);
+    }
+    const float* const columns[6] = {m_cell_box[0].data(), m_cell_box[1].data(), m_cell_box[2].data(),
+                                     m_cell_box[3].data(), m_cell_box[4].data(), m_cell_box[5].data()};
+    for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
+        for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
+            for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
+                const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
+                const std::int32_t begin = m_bucket_start[bk], end = m_bucket_start[bk + 1];
+                if (m_hits.size() < static_cast<size_t>(end - begin)) m_hits.resize(static_cast<size_t>(end - begin));
+                const std::int32_t hits = detail::chosen_box_filter(columns, begin, end, qbox, m_hits.data());
+                for (std::int32_t hit = 0; hit < hits; ++hit)
+                    visit_face(q, m_cell_face[static_cast<size_t>(m_hits[static_cast<size_t>(hit)])], x);
+            }
+}
+
+void Proximity::keep_contacts(const Query& q, const Positions& x, const std::vector<Contact>& inside,
+                              std::vector<Contact>& out)
+{
+    const Index p = q.p;
+    std::sort(m_best.begin(), m_best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
+    // The vertex's penetration contacts (`inside` is sorted by vertex): the objects it is inside answer for it.
+    const auto in_begin =
+        std::lower_bound(inside.begin(), inside.end(), p, [](const Contact& c, Index vtx) { return c.vertex < vtx; });
+    auto in_end = in_begin;
+    while (in_end != inside.end() && in_end->vertex == p)
+        ++in_end;
+    // The vertex's margin never exceeds the clearance it has had: a body that starts nearer than the margin to
+    // another (stacked, resting, touching) is not pushed apart by it; the margin grows back as it separates.
+    const double clearance = in_begin != in_end ? 0.0 : q.clearance; // penetrating: no clearance at all
+    double& vm = m_vertex_margin[static_cast<size_t>(p)];
+    const double full = m_margin[static_cast<size_t>(q.op)];
+    vm = std::min(full, m_first ? std::sqrt(clearance) : std::max(vm, std::sqrt(clearance)));
+    for (const Best& bs : m_best)
+        if (std::none_of(in_begin, in_end, [&](const Contact& c) { return c.tet_object == bs.object; }))
+            out.push_back(margin_contact(x, p, q.op, bs.object, bs.face, bs.dist, bs.q));
+}
+
 void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
                        std::vector<Contact>& out)
 {
@@ -353,114 +455,22 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
     motion(v, h);
     hash_faces(x);
     const Model& model = *m_model;
-    const std::vector<char>& fixed = model.fixed;
-    const size_t objects = m_margin.size();
-    const double inv_cell = 1.0 / (cell_edges * m_edge);
-    std::vector<Best>& best = m_best;
-    const float* const columns[6] = {m_cell_box[0].data(), m_cell_box[1].data(), m_cell_box[2].data(),
-                                     m_cell_box[3].data(), m_cell_box[4].data(), m_cell_box[5].data()};
+    Query q;
     for (Index p : m_vertices) {
-        const Index op = model.vertex_object[static_cast<size_t>(p)];
-        const Vec3 xp = x.row(p).transpose();
-        const Vec3 rp = m_rest.row(p).transpose();
-        const double r = m_reach[static_cast<size_t>(p)];
-        const double rq = r + m_object_reach[static_cast<size_t>(op)]; // the query box: any partner object
-        double clearance = std::numeric_limits<double>::infinity();    // squared distance to the nearest far face
+        q.p = p;
+        q.op = model.vertex_object[static_cast<size_t>(p)];
+        q.xp = x.row(p).transpose();
+        q.rp = m_rest.row(p).transpose();
+        q.r = m_reach[static_cast<size_t>(p)];
+        q.clearance = std::numeric_limits<double>::infinity();
         // The local reach with a little slack for rounding: a face whose rest sphere lies wholly inside
         // `local_reach` is local; one wholly beyond `far_reach` is not; between, its corners decide.
-        const double reach2 = m_reach2[static_cast<size_t>(op)];
-        const double local_reach = reach2 > 0 ? std::sqrt(reach2) * (1 - 1e-5) : -1.0;
-        const double far_reach = reach2 > 0 ? std::sqrt(reach2) * (1 + 1e-5) : -1.0;
-        best.clear();
-        std::int64_t lo[3], hi[3];
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = static_cast<std::int64_t>(std::floor((xp[k] - rq) * inv_cell));
-            hi[k] = static_cast<std::int64_t>(std::floor((xp[k] + rq) * inv_cell));
-        }
-        const bool one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
-        // The query box in single precision, rounded outwards like the faces' boxes: lo x, y, z, hi x, y, z.
-        float qbox[6];
-        for (int k = 0; k < 3; ++k) {
-            qbox[k] = round_down(xp[k] - rq);
-            qbox[3 + k] = round_up(xp[k] + rq);
-        }
-        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
-            for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
-                for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
-                    const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
-                    const std::int32_t begin = m_bucket_start[bk], end = m_bucket_start[bk + 1];
-                    if (m_hits.size() < static_cast<size_t>(end - begin))
-                        m_hits.resize(static_cast<size_t>(end - begin));
-                    const std::int32_t hits = detail::chosen_box_filter(columns, begin, end, qbox, m_hits.data());
-                    for (std::int32_t hit = 0; hit < hits; ++hit) {
-                        const std::int32_t f = m_cell_face[static_cast<size_t>(m_hits[static_cast<size_t>(hit)])];
-                        const Face& fc = m_faces[static_cast<size_t>(f)];
-                        bool near_rest = false; // the corners decide whether the face is local (below)
-                        if (fc.object == op) {
-                            if (reach2 < 0) continue; // self-collision off
-                            // Squared: dr + radius < local_reach, dr − radius < far_reach (dr the centre's distance).
-                            const double dr2 = (fc.rest_centre - rp).squaredNorm();
-                            const double inner = local_reach - fc.rest_radius, outer = far_reach + fc.rest_radius;
-                            if (inner > 0 && dr2 < inner * inner) continue; // every corner near: local
-                            near_rest = dr2 < outer * outer;
-                        } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
-                            continue;
-                        }
-                        if (!one_cell) {
-                            if (m_stamp[static_cast<size_t>(f)] == p) continue;
-                            m_stamp[static_cast<size_t>(f)] = static_cast<std::int32_t>(p);
-                        }
-                        if (fc.v[0] == p || fc.v[1] == p || fc.v[2] == p) continue;
-                        if (fixed[static_cast<size_t>(p)] && fixed[static_cast<size_t>(fc.v[0])] &&
-                            fixed[static_cast<size_t>(fc.v[1])] && fixed[static_cast<size_t>(fc.v[2])])
-                            continue;
-                        if (near_rest) {
-                            bool local = false;
-                            for (Index c : fc.v)
-                                local = local || (m_rest.row(c).transpose() - rp).squaredNorm() < reach2;
-                            if (local) continue;
-                        }
-                        const Vec3 a = x.row(fc.v[0]).transpose(), bb = x.row(fc.v[1]).transpose(),
-                                   c = x.row(fc.v[2]).transpose();
-                        const Vec3 q = closest_point_on_triangle(xp, a, bb, c);
-                        const double d2 = (xp - q).squaredNorm();
-                        const double watch =
-                            m_margin_max + r + face_reach(m_reach, fc) +
-                            (op == fc.object
-                                 ? 0.0
-                                 : m_pair_now[static_cast<size_t>(op) * objects + static_cast<size_t>(fc.object)]);
-                        if (d2 >= watch * watch) continue;
-                        clearance = std::min(clearance, d2);
-                        // The vertex must be on the outer side of the face (else it is inside, or beside the
-                        // face's back: the penetration response or another face answers).
-                        Vec3 n = (bb - a).cross(c - a);
-                        if (n.dot(x.row(fc.opp).transpose() - a) > 0) n = -n;
-                        if (!((xp - q).dot(n) > 0)) continue;
-                        const double d = std::sqrt(d2);
-                        auto it = std::find_if(best.begin(), best.end(),
-                                               [&](const Best& bs) { return bs.object == fc.object; });
-                        if (it == best.end())
-                            best.push_back({fc.object, f, d, q});
-                        else if (d < it->dist || (d == it->dist && f < it->face))
-                            *it = {fc.object, f, d, q};
-                    }
-                }
-        std::sort(best.begin(), best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
-        // The vertex's penetration contacts (`inside` is sorted by vertex): the objects it is inside answer for it.
-        const auto in_begin = std::lower_bound(inside.begin(), inside.end(), p,
-                                               [](const Contact& c, Index vtx) { return c.vertex < vtx; });
-        auto in_end = in_begin;
-        while (in_end != inside.end() && in_end->vertex == p)
-            ++in_end;
-        // The vertex's margin never exceeds the clearance it has had: a body that starts nearer than the margin to
-        // another (stacked, resting, touching) is not pushed apart by it; the margin grows back as it separates.
-        if (in_begin != in_end) clearance = 0; // penetrating: no clearance at all
-        double& vm = m_vertex_margin[static_cast<size_t>(p)];
-        const double full = m_margin[static_cast<size_t>(op)];
-        vm = std::min(full, m_first ? std::sqrt(clearance) : std::max(vm, std::sqrt(clearance)));
-        for (const Best& bs : best)
-            if (std::none_of(in_begin, in_end, [&](const Contact& c) { return c.tet_object == bs.object; }))
-                out.push_back(margin_contact(x, p, op, bs.object, bs.face, bs.dist, bs.q));
+        q.reach2 = m_reach2[static_cast<size_t>(q.op)];
+        q.local_reach = q.reach2 > 0 ? std::sqrt(q.reach2) * (1 - 1e-5) : -1.0;
+        q.far_reach = q.reach2 > 0 ? std::sqrt(q.reach2) * (1 + 1e-5) : -1.0;
+        m_best.clear();
+        query_cells(q, x);
+        keep_contacts(q, x, inside, out);
     }
     m_first = false;
 }

@@ -73,6 +73,23 @@ class Proximity {
     /// Faces' boxes grown by their reach and the largest margin, counting-sorted into the grid's buckets.
     void hash_faces(const Positions& x);
     static double face_reach(const std::vector<double>& reach, const Face& f);
+    /// One boundary vertex's query: where it is, what it reaches, what is local to it, its nearest far face so far.
+    struct Query {
+        Index p = -1, op = -1; ///< the vertex and its object
+        Eigen::Vector3d xp, rp;
+        double r = 0;                                      ///< its reach in the substep
+        double reach2 = 0, local_reach = 0, far_reach = 0; ///< its object's local reach (squared), with slack
+        bool one_cell = false;                             ///< the query box lies in one cell: each face met once
+        double clearance = 0;                              ///< squared distance to the nearest far face
+    };
+    /// The faces in the cells of q's box: for each far face within watch on its outer side, the nearest per object
+    /// into m_best; q.clearance the nearest far face's squared distance.
+    void query_cells(Query& q, const Positions& x);
+    void visit_face(Query& q, std::int32_t f, const Positions& x);
+    /// The vertex's margin from its clearance, and its margin contacts (one per object of m_best that it is not
+    /// inside already) appended to `out`.
+    void keep_contacts(const Query& q, const Positions& x, const std::vector<Contact>& inside,
+                       std::vector<Contact>& out);
     Contact margin_contact(const Positions& x, Index p, Index op, Index object, Index face, double dist,
                            const Eigen::Vector3d& q) const;
 

@@ -1,9 +1,10 @@
 #include "tethash/sim/scene.hpp"
+#include "tethash/detect_grammar.hpp"
 
 #include "core/enum_names.hpp"
 
 #include "tethash/error.hpp"
-#include "tethash/io/surface.hpp"
+#include "tethash/io/mesh_io.hpp"
 
 #include <toml++/toml.h>
 
@@ -394,10 +395,232 @@ ObjectSpec read_object(const Reader& r, const toml::table& t, const std::string&
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object needs 'mesh' or 'generate'");
     if (!o.mesh.empty() && o.generate)
         r.fail(&t, pre.substr(0, pre.size() - 1), "an object has either 'mesh' or 'generate', not both");
-    if (o.collider == Collider::bsp && (!o.is_static || o.mesh.empty() || !io::is_surface_path(o.mesh)))
+    if (o.collider == Collider::bsp &&
+        (!o.is_static || o.mesh.empty() || io::classify_path(o.mesh) != io::PathKind::surface))
         r.fail(t.get("collider"), pre + "collider",
                "collider = \"bsp\" needs a static object (static = true) whose mesh is a closed surface file");
     return o;
+}
+
+/// The keys of [ground] and [contact].
+const std::vector<Key<Ground>>& ground_keys()
+{
+    static const std::vector<Key<Ground>> keys = joined(
+        {
+            key("enabled", &Ground::enabled, &Reader::boolean),
+            key("height", &Ground::height, &Reader::number),
+            {"normal",
+             [](const Reader& r, const toml::node& v, const std::string& k, Ground& g) {
+                 g.normal = r.vec3(v, k);
+                 if (!(g.normal.norm() > 0)) r.fail(&v, k, "must not be the zero vector");
+                 g.normal.normalize();
+             }},
+        },
+        penalty_keys<Ground>());
+    return keys;
+}
+
+const std::vector<Key<ContactParams>>& contact_keys()
+{
+    static const std::vector<Key<ContactParams>> keys =
+        joined(penalty_keys<ContactParams>(), {key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
+                                               key("margin", &ContactParams::margin, &Reader::non_negative),
+                                               key("speculative", &ContactParams::speculative, &Reader::boolean)});
+    return keys;
+}
+
+/// The keys of the scene's top level; `up` receives the `up` key's axis (applied once the whole scene is read).
+std::vector<Key<Scene>> scene_keys(std::optional<Eigen::Vector3d>& up)
+{
+    // Errors from the parameters' own grammar (integrator and solver names) name the key's line.
+    const auto named = [](auto parse, auto field) {
+        return [parse, field](const Reader& r, const toml::node& v, const std::string& k, Scene& out) {
+            try {
+                out.*field = parse(r.string(v, k));
+            } catch (const Error& e) {
+                r.fail(&v, k, e.what());
+            }
+        };
+    };
+    return {
+        key("dt", &Scene::dt, &Reader::seconds),
+        int_key("steps", &Scene::steps, 0),
+        int_key("substeps", &Scene::substeps, 1),
+        int_key("max_substeps", &Scene::max_substeps, 0),
+        {"integrator", named(parse_integrator, &Scene::integrator)},
+        {"solver", named(parse_linear_solver, &Scene::solver)},
+        int_key("iterations", &Scene::iterations, 0),
+        int_key("max_iterations", &Scene::max_iterations, 1),
+        key("convergence", &Scene::convergence, &Reader::fraction_below_one),
+        key("coarse_space", &Scene::coarse_space, &Reader::boolean),
+        key("tolerance", &Scene::tolerance, &Reader::positive),
+        key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
+        key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
+        key("inversion_guard", &Scene::inversion_guard, &Reader::boolean),
+        key("gravity", &Scene::gravity, &Reader::vec3),
+        // The scene's up axis (applied by parse_scene): gravity 9.81 m/s² against it and the ground's normal along
+        // it (meshes made with y up are common; the default is z up). A `gravity` or `[ground] normal` given too wins.
+        {"up",
+         [&up](const Reader& r, const toml::node& v, const std::string& k, Scene&) {
+             const std::string name = r.string(v, k);
+             const bool minus = !name.empty() && name[0] == '-';
+             const std::string axis = minus ? name.substr(1) : name;
+             if (axis != "x" && axis != "y" && axis != "z")
+                 r.fail(&v, k, "expected \"x\", \"y\", \"z\" or one of them with a minus sign, found \"" + name + "\"");
+             up = Eigen::Vector3d::Zero();
+             (*up)[axis[0] - 'x'] = minus ? -1.0 : 1.0;
+         }},
+    };
+}
+
+/// One key of [detector]. Numbers are lengths or counts; strings go through the detector's own grammar
+/// (detect_grammar.hpp), so a value means here what it means on the command line.
+void read_detector_key(const Reader& r, const std::string& d, const toml::node& node, Scene& s)
+{
+    const std::string full = "detector." + d;
+    const auto grammar = [&r, &node, &full](auto&& parse) {
+        try {
+            parse(r.string(node, full));
+        } catch (const Error& e) {
+            r.fail(&node, full, e.what());
+        }
+    };
+    // A number (where a length or count is meant) is read by `number`, text by `parse`.
+    const auto number_or_grammar = [&](auto&& number, auto&& parse) {
+        if (node.is_number())
+            number();
+        else
+            grammar(parse);
+    };
+    // The cell size and the skin: a number is an absolute length, text may give a factor instead.
+    const auto length = [&](auto& mode, auto absolute, double& value,
+                            double (Reader::*check)(const toml::node&, const std::string&) const,
+                            void (*parse)(const std::string&, DetectParams&, const std::string&)) {
+        number_or_grammar(
+            [&] {
+                mode = absolute;
+                value = (r.*check)(node, full);
+            },
+            [&](const std::string& text) { parse(text, s.detect, full); });
+    };
+    if (d == "cell_size") {
+        length(s.detect.cell_size_mode, DetectParams::CellSizeMode::absolute, s.detect.cell_size, &Reader::positive,
+               parse_cell_size);
+    } else if (d == "table_size") {
+        number_or_grammar(
+            [&] {
+                s.detect.table_size = r.integer_at_least(node, full, 1);
+                s.table_size_of_vertices.clear();
+            },
+            [&](const std::string& text) {
+                // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
+                s.detect.table_size = parse_table_size(text, 0, full);
+                s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
+            });
+    } else if (d == "hash") {
+        grammar([&](const std::string& text) { s.detect.hash = parse_hash_function(text); });
+    } else if (d == "threads") {
+        const long long threads = r.int_at_least(node, full, 0);
+        try {
+            s.detect.threads = check_threads(threads, full);
+        } catch (const Error& e) {
+            r.fail(&node, full, e.what());
+        }
+    } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
+        length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin, &Reader::non_negative, parse_skin);
+    } else if (d == "method") { // the broad phase (detect_grammar.hpp: parse_method)
+        grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
+    } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
+        PartitionParams& q = s.detect.partition;
+        if (d == "looseness")
+            q.looseness = r.positive(node, full);
+        else
+            (d == "max_depth"   ? q.max_depth
+             : d == "leaf_size" ? q.leaf_size
+                                : q.levels) = static_cast<int>(r.int_at_least(node, full, 1));
+        try {
+            Detector check(s.detect);
+        } catch (const Error& e) {
+            r.fail(&node, full, e.what());
+        }
+    }
+}
+
+void read_detector(const Reader& r, const toml::table& t, Scene& s)
+{
+    r.check_keys(t, "detector.",
+                 {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size", "looseness",
+                  "levels"});
+    for (auto&& [dk, dv] : t)
+        read_detector_key(r, std::string(dk.str()), dv, s);
+}
+
+void read_output(const Reader& r, const toml::table& t, Scene& s)
+{
+    r.check_keys(t, "output.", {"every", "fields"});
+    for (auto&& [ok, ov] : t) {
+        const std::string o(ok.str()), full = "output." + o;
+        if (o == "every")
+            s.output.every = r.int_at_least(ov, full, 0);
+        else if (o == "fields") {
+            const toml::array* a = ov.as_array();
+            if (!a) r.fail(&ov, full, std::string("expected an array of strings, found ") + Reader::type_name(ov));
+            s.output.fields.clear();
+            for (const toml::node& e : *a) {
+                const std::string f = r.string(e, full);
+                if (f != "velocity" && f != "contact" && f != "depth" && f != "object")
+                    r.fail(&e, full, "unknown field '" + f + "' (velocity, contact, depth, object)");
+                s.output.fields.push_back(f);
+            }
+        }
+    }
+}
+
+/// [[pin]] number i (the table `t` of node `e`).
+PinRegion read_pin(const Reader& r, const toml::node& e, const toml::table& t, size_t i)
+{
+    const std::string pre = "pin[" + std::to_string(i) + "].";
+    PinRegion p;
+    r.check_keys(t, pre, {"object", "vertices", "box_min", "box_max"});
+    bool has_min = false, has_max = false;
+    for (auto&& [pk, pv] : t) {
+        const std::string pkey(pk.str()), full = pre + pkey;
+        if (pkey == "object")
+            p.object = r.int_at_least(pv, full, 0);
+        else if (pkey == "vertices") {
+            const toml::array* va = pv.as_array();
+            if (!va) r.fail(&pv, full, std::string("expected an array of integers, found ") + Reader::type_name(pv));
+            for (const toml::node& id : *va)
+                p.vertices.push_back(r.int_at_least(id, full, 0));
+        } else if (pkey == "box_min") {
+            p.box_min = r.vec3(pv, full);
+            has_min = true;
+        } else if (pkey == "box_max") {
+            p.box_max = r.vec3(pv, full);
+            has_max = true;
+        }
+    }
+    if (has_min != has_max) r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
+    p.has_box = has_min;
+    if (!p.has_box && p.vertices.empty())
+        r.fail(&e, "pin[" + std::to_string(i) + "]", "a pin needs 'vertices' or 'box_min'/'box_max'");
+    return p;
+}
+
+/// [[object]] and [[pin]]: arrays of tables.
+void read_objects_or_pins(const Reader& r, const std::string& key, const toml::node& v, Scene& s)
+{
+    const toml::array* a = v.as_array();
+    if (!a)
+        r.fail(&v, key, std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
+    for (size_t i = 0; i < a->size(); ++i) {
+        const toml::node& e = *a->get(i);
+        const toml::table& t = r.table(e, key + "[" + std::to_string(i) + "]");
+        if (key == "object")
+            s.objects.push_back(read_object(r, t, key + "[" + std::to_string(i) + "].", i));
+        else
+            s.pins.push_back(read_pin(r, e, t, i));
+    }
 }
 
 } // namespace
@@ -414,214 +637,22 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
     const Reader r(source_name, base_dir);
     Scene s;
     s.source = source_name;
-    // Errors from the parameters' own grammar (integrator and solver names) name the key's line.
-    const auto named = [](auto parse, auto field) {
-        return [parse, field](const Reader& r, const toml::node& v, const std::string& k, Scene& out) {
-            try {
-                out.*field = parse(r.string(v, k));
-            } catch (const Error& e) {
-                r.fail(&v, k, e.what());
-            }
-        };
-    };
-    static const std::vector<Key<Ground>> ground_keys = joined(
-        {
-            key("enabled", &Ground::enabled, &Reader::boolean),
-            key("height", &Ground::height, &Reader::number),
-            {"normal",
-             [](const Reader& r, const toml::node& v, const std::string& k, Ground& g) {
-                 g.normal = r.vec3(v, k);
-                 if (!(g.normal.norm() > 0)) r.fail(&v, k, "must not be the zero vector");
-                 g.normal.normalize();
-             }},
-        },
-        penalty_keys<Ground>());
-    static const std::vector<Key<ContactParams>> contact_keys =
-        joined(penalty_keys<ContactParams>(), {key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
-                                               key("margin", &ContactParams::margin, &Reader::non_negative),
-                                               key("speculative", &ContactParams::speculative, &Reader::boolean)});
     std::optional<Eigen::Vector3d> up;
-    const std::vector<Key<Scene>> keys = {
-        key("dt", &Scene::dt, &Reader::seconds),
-        int_key("steps", &Scene::steps, 0),
-        int_key("substeps", &Scene::substeps, 1),
-        int_key("max_substeps", &Scene::max_substeps, 0),
-        {"integrator", named(parse_integrator, &Scene::integrator)},
-        {"solver", named(parse_linear_solver, &Scene::solver)},
-        int_key("iterations", &Scene::iterations, 0),
-        int_key("max_iterations", &Scene::max_iterations, 1),
-        key("convergence", &Scene::convergence, &Reader::fraction_below_one),
-        key("coarse_space", &Scene::coarse_space, &Reader::boolean),
-        key("tolerance", &Scene::tolerance, &Reader::positive),
-        key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
-        key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
-        key("inversion_guard", &Scene::inversion_guard, &Reader::boolean),
-        key("gravity", &Scene::gravity, &Reader::vec3),
-        // The scene's up axis (applied below): gravity 9.81 m/s² against it and the ground's normal along it
-        // (meshes made with y up are common; the default is z up). A `gravity` or `[ground] normal` given too wins.
-        {"up",
-         [&up](const Reader& r, const toml::node& v, const std::string& k, Scene&) {
-             const std::string name = r.string(v, k);
-             const bool minus = !name.empty() && name[0] == '-';
-             const std::string axis = minus ? name.substr(1) : name;
-             if (axis != "x" && axis != "y" && axis != "z")
-                 r.fail(&v, k, "expected \"x\", \"y\", \"z\" or one of them with a minus sign, found \"" + name + "\"");
-             up = Eigen::Vector3d::Zero();
-             (*up)[axis[0] - 'x'] = minus ? -1.0 : 1.0;
-         }},
-    };
-    read_table(
-        r, root, "", keys, s, {"ground", "contact", "detector", "output", "object", "pin"},
-        [&](const std::string& key, const toml::node& v, const std::string&) {
-            if (key == "ground") {
-                s.ground.enabled = true;
-                read_table(r, r.table(v, key), "ground.", ground_keys, s.ground);
-            } else if (key == "contact") {
-                read_table(r, r.table(v, key), "contact.", contact_keys, s.contact);
-            } else if (key == "detector") {
-                const toml::table& t = r.table(v, key);
-                r.check_keys(t, "detector.",
-                             {"cell_size", "table_size", "hash", "threads", "skin", "method", "max_depth", "leaf_size",
-                              "looseness", "levels"});
-                for (auto&& [dk, dv] : t) {
-                    const std::string d(dk.str()), full = "detector." + d;
-                    // Numbers are lengths or counts; strings go through the detector's own grammar (detect.hpp), so
-                    // a value means here what it means on the command line.
-                    const toml::node& node = dv; // (a structured binding cannot be captured before C++20's P1091)
-                    const auto grammar = [&r, &node, &full](auto&& parse) {
-                        try {
-                            parse(r.string(node, full));
-                        } catch (const Error& e) {
-                            r.fail(&node, full, e.what());
-                        }
-                    };
-                    // A number (where a length or count is meant) is read by `number`, text by `parse`.
-                    const auto number_or_grammar = [&](auto&& number, auto&& parse) {
-                        if (node.is_number())
-                            number();
-                        else
-                            grammar(parse);
-                    };
-                    // The cell size and the skin: a number is an absolute length, text may give a factor instead.
-                    const auto length = [&](auto& mode, auto absolute, double& value,
-                                            double (Reader::*check)(const toml::node&, const std::string&) const,
-                                            void (*parse)(const std::string&, DetectParams&, const std::string&)) {
-                        number_or_grammar(
-                            [&] {
-                                mode = absolute;
-                                value = (r.*check)(node, full);
-                            },
-                            [&](const std::string& text) { parse(text, s.detect, full); });
-                    };
-                    if (d == "cell_size") {
-                        length(s.detect.cell_size_mode, DetectParams::CellSizeMode::absolute, s.detect.cell_size,
-                               &Reader::positive, parse_cell_size);
-                    } else if (d == "table_size") {
-                        number_or_grammar(
-                            [&] {
-                                s.detect.table_size = r.integer_at_least(node, full, 1);
-                                s.table_size_of_vertices.clear();
-                            },
-                            [&](const std::string& text) {
-                                // "auto", "N" or "xF" (F × the scene's vertex count, resolved when the scene is built)
-                                s.detect.table_size = parse_table_size(text, 0, full);
-                                s.table_size_of_vertices = text[0] == 'x' ? text : std::string();
-                            });
-                    } else if (d == "hash") {
-                        grammar([&](const std::string& text) { s.detect.hash = parse_hash_function(text); });
-                    } else if (d == "threads") {
-                        const long long threads = r.int_at_least(dv, full, 0);
-                        try {
-                            s.detect.threads = check_threads(threads, full);
-                        } catch (const Error& e) {
-                            r.fail(&dv, full, e.what());
-                        }
-                    } else if (d == "skin") { // candidate reuse: a length ≥ 0 (0 = off) or "xF" (F × cell size)
-                        length(s.detect.skin_mode, DetectParams::SkinMode::absolute, s.detect.skin,
-                               &Reader::non_negative, parse_skin);
-                    } else if (d == "method") { // the broad phase (detect.hpp: parse_method)
-                        grammar([&](const std::string& text) { s.detect.method = parse_method(text, full); });
-                    } else { // max_depth, leaf_size, looseness, levels: checked by the detector's own validation
-                        PartitionParams& q = s.detect.partition;
-                        if (d == "looseness")
-                            q.looseness = r.positive(dv, full);
-                        else
-                            (d == "max_depth"   ? q.max_depth
-                             : d == "leaf_size" ? q.leaf_size
-                                                : q.levels) = static_cast<int>(r.int_at_least(dv, full, 1));
-                        try {
-                            Detector check(s.detect);
-                        } catch (const Error& e) {
-                            r.fail(&dv, full, e.what());
-                        }
-                    }
-                }
-            } else if (key == "output") {
-                const toml::table& t = r.table(v, key);
-                r.check_keys(t, "output.", {"every", "fields"});
-                for (auto&& [ok, ov] : t) {
-                    const std::string o(ok.str()), full = "output." + o;
-                    if (o == "every")
-                        s.output.every = r.int_at_least(ov, full, 0);
-                    else if (o == "fields") {
-                        const toml::array* a = ov.as_array();
-                        if (!a)
-                            r.fail(&ov, full,
-                                   std::string("expected an array of strings, found ") + Reader::type_name(ov));
-                        s.output.fields.clear();
-                        for (const toml::node& e : *a) {
-                            const std::string f = r.string(e, full);
-                            if (f != "velocity" && f != "contact" && f != "depth" && f != "object")
-                                r.fail(&e, full, "unknown field '" + f + "' (velocity, contact, depth, object)");
-                            s.output.fields.push_back(f);
-                        }
-                    }
-                }
-            } else if (key == "object" || key == "pin") {
-                const toml::array* a = v.as_array();
-                if (!a)
-                    r.fail(&v, key,
-                           std::string("expected an array of tables ([[") + key + "]]), found " + Reader::type_name(v));
-                for (size_t i = 0; i < a->size(); ++i) {
-                    const toml::node& e = *a->get(i);
-                    const std::string pre = key + "[" + std::to_string(i) + "].";
-                    const toml::table& t = r.table(e, key + "[" + std::to_string(i) + "]");
-                    if (key == "object") {
-                        s.objects.push_back(read_object(r, t, pre, i));
-                        continue;
-                    }
-                    PinRegion p;
-                    r.check_keys(t, pre, {"object", "vertices", "box_min", "box_max"});
-                    bool has_min = false, has_max = false;
-                    for (auto&& [pk, pv] : t) {
-                        const std::string pkey(pk.str()), full = pre + pkey;
-                        if (pkey == "object")
-                            p.object = r.int_at_least(pv, full, 0);
-                        else if (pkey == "vertices") {
-                            const toml::array* va = pv.as_array();
-                            if (!va)
-                                r.fail(&pv, full,
-                                       std::string("expected an array of integers, found ") + Reader::type_name(pv));
-                            for (const toml::node& id : *va)
-                                p.vertices.push_back(r.int_at_least(id, full, 0));
-                        } else if (pkey == "box_min") {
-                            p.box_min = r.vec3(pv, full);
-                            has_min = true;
-                        } else if (pkey == "box_max") {
-                            p.box_max = r.vec3(pv, full);
-                            has_max = true;
-                        }
-                    }
-                    if (has_min != has_max)
-                        r.fail(&e, pre + (has_min ? "box_max" : "box_min"), "box_min and box_max go together");
-                    p.has_box = has_min;
-                    if (!p.has_box && p.vertices.empty())
-                        r.fail(&e, key + "[" + std::to_string(i) + "]",
-                               "a pin needs 'vertices' or 'box_min'/'box_max'");
-                    s.pins.push_back(std::move(p));
-                }
-            }
-        });
+    read_table(r, root, "", scene_keys(up), s, {"ground", "contact", "detector", "output", "object", "pin"},
+               [&](const std::string& key, const toml::node& v, const std::string&) {
+                   if (key == "ground") {
+                       s.ground.enabled = true;
+                       read_table(r, r.table(v, key), "ground.", ground_keys(), s.ground);
+                   } else if (key == "contact") {
+                       read_table(r, r.table(v, key), "contact.", contact_keys(), s.contact);
+                   } else if (key == "detector") {
+                       read_detector(r, r.table(v, key), s);
+                   } else if (key == "output") {
+                       read_output(r, r.table(v, key), s);
+                   } else if (key == "object" || key == "pin") {
+                       read_objects_or_pins(r, key, v, s);
+                   }
+               });
     for (size_t i = 0; i < s.pins.size(); ++i)
         if (s.pins[i].object >= static_cast<int>(s.objects.size()))
             throw Error(source_name + ": key 'pin[" + std::to_string(i) + "].object': object " +

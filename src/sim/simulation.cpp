@@ -8,6 +8,8 @@
 #include "objects.hpp"
 #include "obstacles.hpp"
 
+#include "core/timing.hpp"
+
 #include "tethash/error.hpp"
 #include "tethash/sim/quality.hpp"
 
@@ -15,7 +17,6 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -23,12 +24,8 @@ namespace tethash::sim {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using tethash::detail::Clock;
+using tethash::detail::ms_since;
 
 /// Explicit stability limit of the model with, per vertex, the stiffer of its stiffest possible contact and the
 /// ground (with their damping). A contact's effective mass is at most the vertex's own.
@@ -407,8 +404,8 @@ void Simulation::step()
     // twice as many substeps, up to max_substeps (a step that blows up or whose energy explodes likewise): the time
     // step a user picks stays the frame step, and the work grows only where the material or a contact needs it. A
     // refined step count is kept for 0.05 s of simulated time, then halved, so a body that needs it does not pay for a
-    // failed attempt every step. (At 0.5 % instead of 1 %, transient inversions of impacts that recover by themselves
-    // were refined too: screw at 1/240 cost 2.3× as much and ended with more inverted tets, not fewer.)
+    // failed attempt every step. (A lower threshold also refines the transient inversions of impacts that recover by
+    // themselves, at a high cost and with no fewer inverted tets at the end; docs/simulator.md.)
     const int max_substeps = std::max(substeps, s.scene.max_substeps > 0                ? s.scene.max_substeps
                                                 : s.scene.integrator == Integrator::vbd ? s.auto_max_substeps
                                                                                         : substeps);
@@ -478,8 +475,8 @@ void Simulation::step()
         s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now);
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
-        // stiff body: the armadillo with young 1e9 at 1/60 gained 13 % of the scene's energy in one such substep):
-        // taken again in more substeps, like a blow-up.
+        // stiff body, which can gain the scene a tenth of its energy in one such substep; docs/simulator.md): taken
+        // again in more substeps, like a blow-up.
         if (st.unconverged > 0 && refine()) continue;
         break;
     }

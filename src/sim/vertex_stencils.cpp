@@ -174,8 +174,7 @@ int solve_scalar(const LaneTerms& t, double d[3][4])
 
 #ifdef TETHASH_X86
 /// Loads the coordinates of the four vertices `ids` (positions with a stride of 4 doubles, 32-byte aligned):
-/// four row loads and a 4 × 4 transpose. (Three vgatherdpd instead made the hand drop's integration 7.9-8.4 ms
-/// per step against 5.0-5.6, interleaved runs on the 2-core EPYC.)
+/// four row loads and a 4 × 4 transpose. (Three vgatherdpd instead were slower: docs/simulator.md.)
 __attribute__((target("avx2,fma"), always_inline)) inline void load3(const double* x, const std::int32_t* ids,
                                                                      __m256d& px, __m256d& py, __m256d& pz)
 {

@@ -1,5 +1,6 @@
 // The broad-phase methods side by side (methods.hpp).
 #include "tethash/study/methods.hpp"
+#include "tethash/detect_grammar.hpp"
 
 #include "value_list.hpp"
 

@@ -6,6 +6,9 @@
 #include "report.hpp"
 #include "value_list.hpp"
 
+#include "core/hash/table_size.hpp"
+
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/study/methods.hpp"

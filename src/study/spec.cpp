@@ -1,5 +1,6 @@
 // What a study is (spec.hpp): the names of the sweeps and the shard option.
 #include "tethash/study/spec.hpp"
+#include "tethash/detect_grammar.hpp"
 
 #include "value_list.hpp"
 

@@ -3,14 +3,15 @@
 
 #include "report.hpp"
 
+#include "core/timing.hpp"
+
+#include "core/broad_phase/split_tree.hpp"
 #include "tethash/error.hpp"
-#include "tethash/split_tree.hpp"
 #include "tethash/study/json.hpp"
 #include "tethash/study/table.hpp"
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -24,6 +25,7 @@ namespace tethash::study {
 namespace {
 
 using Vec = std::array<double, 3>;
+using tethash::detail::ms_since;
 using Pair = std::pair<std::uint32_t, std::uint32_t>;
 
 constexpr double kGravity = -9.81; ///< m/s^2 along z
@@ -154,11 +156,6 @@ void respond(std::vector<Vec>& x, std::vector<Vec>& v, const std::vector<Pair>& 
         }
 }
 
-double ms_since(std::chrono::steady_clock::time_point t0)
-{
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 /// The options of the run, as spheres.json's "options" object.
 void write_options(JsonWriter& j, const SpheresOptions& o)
 {
@@ -269,7 +266,7 @@ SpheresResult run_spheres(const SpheresOptions& o, const SpheresHooks& hooks)
     std::vector<SplitBox> boxes;
     std::vector<Pair> reference, pairs;
     LeafScratch scratch;
-    const auto started = std::chrono::steady_clock::now();
+    const auto started = tethash::detail::Clock::now();
 
     for (int frame = 0; frame < o.frames; ++frame) {
         if (hooks.stop && hooks.stop->load()) {
@@ -304,7 +301,7 @@ SpheresResult run_spheres(const SpheresOptions& o, const SpheresHooks& hooks)
             pairs.clear();
             std::int64_t tests = 0;
             double build_ms = 0;
-            const auto t0 = std::chrono::steady_clock::now();
+            const auto t0 = tethash::detail::Clock::now();
             if (m.brute) {
                 tests = brute_pairs(x, d2, pairs);
             } else {

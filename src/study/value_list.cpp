@@ -2,6 +2,7 @@
 #include "value_list.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 
 #include <cmath>

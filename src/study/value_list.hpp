@@ -1,6 +1,6 @@
 #pragma once
 // The grammar of the study's value lists (spec.hpp): comma-separated items, each a single value in the grammar
-// of every command (detect.hpp for the detector's parameters; numbers: detect.hpp's parse_number and
+// of every command (detect_grammar.hpp for the detector's parameters; numbers: its parse_number and
 // parse_integer) or a range. Shared by every sweep.
 #include <string>
 #include <vector>

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -12,6 +13,17 @@ namespace tethash::bench {
 namespace {
 /// The hash of the 2003 paper, written here so that the baseline shares no code with the detector it is
 /// compared with: (x·73856093 xor y·19349663 xor z·83492791) on 32-bit wrapping integers.
+/// The paper's table size: a prime (the smallest ≥ n, n ≥ 2), by trial division.
+std::int64_t prime_at_least(std::int64_t n)
+{
+    for (;; ++n) {
+        bool prime = n >= 2;
+        for (std::int64_t d = 2; prime && d * d <= n; ++d)
+            prime = n % d != 0;
+        if (prime) return n;
+    }
+}
+
 std::uint64_t teschner_hash(std::int32_t x, std::int32_t y, std::int32_t z)
 {
     return static_cast<std::uint32_t>(static_cast<std::uint32_t>(x) * 73856093u ^
@@ -24,7 +36,7 @@ void Baseline2003::run(const TetMesh& m, double l, std::vector<std::pair<Index, 
 {
     const Index n = m.num_vertices();
     if (m_table == 0) {
-        m_table = static_cast<std::size_t>(next_prime(2 * n));
+        m_table = static_cast<std::size_t>(prime_at_least(std::max<Index>(2 * n, 2)));
         m_buckets.assign(m_table, {});
         m_stamp.assign(m_table, 0);
     }
@@ -77,6 +89,15 @@ void Baseline2003::run(const TetMesh& m, double l, std::vector<std::pair<Index, 
                     }
                 }
     }
+}
+
+bool same_pairs(std::vector<std::pair<Index, Index>> pairs, const std::vector<Contact>& contacts)
+{
+    if (pairs.size() != contacts.size()) return false;
+    std::sort(pairs.begin(), pairs.end());
+    for (std::size_t i = 0; i < pairs.size(); ++i)
+        if (pairs[i].first != contacts[i].vertex || pairs[i].second != contacts[i].tet) return false;
+    return true;
 }
 
 } // namespace tethash::bench

@@ -1,6 +1,7 @@
 #pragma once
 // The baseline of tethash_bench: Teschner et al. 2003 as the paper describes it, a second detector kept apart
 // from the library so that the comparison measures the paper's algorithm, not ours.
+#include "tethash/detect.hpp"
 #include "tethash/mesh.hpp"
 
 #include <cstdint>
@@ -26,5 +27,10 @@ class Baseline2003 {
     std::uint32_t m_step = 0;
     std::vector<std::int32_t> m_cell;
 };
+
+/// Whether the baseline's pairs (any order) are the (vertex, tet) pairs of `contacts` (the detector's or the
+/// oracle's, sorted by vertex then tet): the benchmark checks the baseline against them as it checks every method,
+/// so that it compares times of equal answers.
+bool same_pairs(std::vector<std::pair<Index, Index>> pairs, const std::vector<Contact>& contacts);
 
 } // namespace tethash::bench

@@ -14,6 +14,7 @@
 //   object
 //                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -79,6 +80,7 @@ struct Measured {
     double cpu_ms = 0;         ///< CPU time of the calling thread (meaningful at 1 thread)
     double process_cpu_ms = 0; ///< CPU time of all threads (includes OpenMP spin-waiting)
     DetectStats stats;
+    std::vector<Contact> contacts; ///< of the warm-up call (the oracle's, as the tests hold)
 };
 
 Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
@@ -86,7 +88,7 @@ Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
     Detector det(p);
     det.set_topology(m);
     DetectStats st;
-    det.detect(m.positions); // warm-up (auto cell size, buffers)
+    std::vector<Contact> contacts = det.detect(m.positions); // warm-up (auto cell size, buffers)
     std::vector<double> ms, cpu, pcpu, s1, s2, s3, s4;
     for (int r = 0; r < repeat; ++r) {
         const double c0 = thread_cpu_ms(), p0 = process_cpu_ms();
@@ -108,13 +110,13 @@ Measured measure(const TetMesh& m, const DetectParams& p, int repeat)
     st.ms_tets = median(s2);
     st.ms_inside = median(s3);
     st.ms_sort = median(s4);
-    return {median(ms), median(cpu), median(pcpu), st};
+    return {median(ms), median(cpu), median(pcpu), st, std::move(contacts)};
 }
 
-double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& contacts, double& cpu_ms)
+double measure_baseline(const TetMesh& m, double l, int repeat, std::vector<std::pair<Index, Index>>& out,
+                        double& cpu_ms)
 {
     bench::Baseline2003 b;
-    std::vector<std::pair<Index, Index>> out;
     b.run(m, l, out);
     std::vector<double> ms, cpu;
     for (int r = 0; r < repeat; ++r) {
@@ -124,7 +126,6 @@ double measure_baseline(const TetMesh& m, double l, int repeat, std::size_t& con
         ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
         cpu.push_back(thread_cpu_ms() - c0);
     }
-    contacts = out.size();
     cpu_ms = median(cpu);
     return median(ms);
 }
@@ -182,11 +183,13 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
     if (all.stats.contacts != one.stats.contacts) std::printf("  ERROR: contact counts differ between thread counts\n");
     double baseline_cpu = 0;
     if (baseline) {
-        std::size_t bc = 0;
-        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), bc, baseline_cpu);
+        std::vector<std::pair<Index, Index>> pairs;
+        const double bms = measure_baseline(m, s.cell_size, std::max(3, repeat / 3), pairs, baseline_cpu);
         std::printf("  baseline 2003  %8.3f ms (1 thread, cpu %.3f ms, %zu contacts)   ratio: %.1fx at 1 thread "
-                    "(cpu %.1fx), %.1fx at %d threads\n",
-                    bms, baseline_cpu, bc, bms / one.ms, baseline_cpu / one.cpu_ms, bms / all.ms, all.stats.threads);
+                    "(cpu %.1fx), %.1fx at %d threads%s\n",
+                    bms, baseline_cpu, pairs.size(), bms / one.ms, baseline_cpu / one.cpu_ms, bms / all.ms,
+                    all.stats.threads,
+                    bench::same_pairs(pairs, one.contacts) ? "" : "  ERROR: contacts differ from the hash");
     }
     // The other broad phases at 1 thread, same scene and parameters (DetectStats::candidates: the pairs handed to
     // the exact test; nodes: cells, nodes or levels of the structure).
@@ -439,189 +442,222 @@ void report_edges(const char* name, const TetMesh& m, const DetectParams& base, 
     std::fflush(stdout);
 }
 
-int main(int argc, char** argv)
-{
+namespace {
+
+/// The benchmark's options (tethash_bench --help).
+struct BenchOptions {
     int repeat = 21, threads = 0, only = -1, profile = 0, steps = 100, rooms = 0, leaf_size = 0;
     bool sweep = false, no_meshes = false, no_baseline = false, moving = false, walk = false, edges = false;
     double speed = 0.01, cell_factor = 1.0, table_factor = 0, walk_speed = 0.05;
     std::string hash = "column", methods_text, partition_scenes = "all";
-    CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
-                 "threads for the five scenarios of Teschner et al. 2003 and ../shared/meshes, against a plain "
-                 "implementation of the 2003 algorithm"};
-    app.add_option("--repeat", repeat, "measured detections per scene (median; at least 1)")->capture_default_str();
-    app.add_option("--threads", threads, "threads of the 'all threads' runs; 0 = every hardware thread")
+};
+
+void add_options(CLI::App& app, BenchOptions& o)
+{
+    app.add_option("--repeat", o.repeat, "measured detections per scene (median; at least 1)")->capture_default_str();
+    app.add_option("--threads", o.threads, "threads of the 'all threads' runs; 0 = every hardware thread")
         ->capture_default_str();
-    app.add_option("--scenario", only, "only this scenario (1..5); with --moving or --profile: which one")
+    app.add_option("--scenario", o.only, "only this scenario (1..5); with --moving or --profile: which one")
         ->check(CLI::Range(1, 5));
-    app.add_flag("--sweep", sweep, "flatness sweep: ns per tet from 1,000 to 1,000,000 tets at 1 thread");
-    app.add_flag("--no-meshes", no_meshes, "skip the meshes of ../shared/meshes");
-    app.add_flag("--no-baseline", no_baseline, "skip the 2003 baseline");
-    app.add_option("--profile", profile,
+    app.add_flag("--sweep", o.sweep, "flatness sweep: ns per tet from 1,000 to 1,000,000 tets at 1 thread");
+    app.add_flag("--no-meshes", o.no_meshes, "skip the meshes of ../shared/meshes");
+    app.add_flag("--no-baseline", o.no_baseline, "skip the 2003 baseline");
+    app.add_option("--profile", o.profile,
                    "N detections of one scenario without statistics, for callgrind "
                    "(--toggle-collect='*profile_detects*')");
-    app.add_option("--table-factor", table_factor,
+    app.add_option("--table-factor", o.table_factor,
                    "table size: the power of two nearest to F × vertices (default: automatic)");
-    app.add_option("--cell-factor", cell_factor, "cell size as a factor of the mean edge length")
+    app.add_option("--cell-factor", o.cell_factor, "cell size as a factor of the mean edge length")
         ->capture_default_str();
-    app.add_option("--hash", hash, "hash function: column or teschner")->capture_default_str();
-    app.add_option("--methods", methods_text,
+    app.add_option("--hash", o.hash, "hash function: column or teschner")->capture_default_str();
+    app.add_option("--methods", o.methods_text,
                    "other broad phases to measure on every scene at 1 thread (detect --method names, or all)");
-    app.add_option("--partition-scenes", partition_scenes,
+    app.add_option("--partition-scenes", o.partition_scenes,
                    "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, "
                    "building, hall, all or none")
         ->capture_default_str();
-    app.add_flag("--edges", edges,
+    app.add_flag("--edges", o.edges,
                  "the edge-face contacts (set-up, find at 1 and all threads) beside vertex-in-tet detection, on the "
                  "scenarios (--scenario I: one) and the shared meshes (two copies overlapping; --no-meshes: none)");
-    app.add_flag("--moving", moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
-    app.add_option("--steps", steps, "--moving: steps (at least 2)")->capture_default_str();
-    app.add_option("--speed", speed, "--moving: fastest vertex per step, as a factor of the mean edge")
+    app.add_flag("--moving", o.moving, "a moving scene (scenario 5 by default): candidate reuse at several skins");
+    app.add_option("--steps", o.steps, "--moving: steps (at least 2)")->capture_default_str();
+    app.add_option("--speed", o.speed, "--moving: fastest vertex per step, as a factor of the mean edge")
         ->capture_default_str();
-    app.add_flag("--walk", walk,
+    app.add_flag("--walk", o.walk,
                  "the building and the hall with every object walking (--steps, --walk-speed; --methods, default "
                  "hash, grid, sort-sweep, bvh-refit, portals)");
-    app.add_option("--walk-speed", walk_speed, "--walk: distance each object moves per step")->capture_default_str();
-    app.add_option("--leaf-size", leaf_size,
+    app.add_option("--walk-speed", o.walk_speed, "--walk: distance each object moves per step")->capture_default_str();
+    app.add_option("--leaf-size", o.leaf_size,
                    "trees: items per leaf; portals: vertices per slab of a cell (0: the method's default)")
         ->check(CLI::Range(0, 1 << 30));
-    app.add_option("--rooms", rooms, "--walk: a building of N x N rooms instead of the partition scene's 4 x 4")
+    app.add_option("--rooms", o.rooms, "--walk: a building of N x N rooms instead of the partition scene's 4 x 4")
         ->capture_default_str();
+}
+
+/// The scenes of --partition-scenes (a comma-separated list, all or none); throws Error naming an unknown one.
+std::vector<std::string> partition_scene_list(const std::string& text)
+{
+    const auto& known = study::partition_scene_names();
+    if (text == "all") return known;
+    std::vector<std::string> names;
+    if (text == "none") return names;
+    std::string item;
+    for (std::size_t i = 0; i <= text.size(); ++i) {
+        if (i < text.size() && text[i] != ',') {
+            item += text[i];
+            continue;
+        }
+        if (std::find(known.begin(), known.end(), item) == known.end())
+            throw Error("--partition-scenes: unknown scene '" + item +
+                        "' (expected bars, sizes, corner, thin, building, hall, all or none)");
+        names.push_back(item);
+        item.clear();
+    }
+    return names;
+}
+
+/// What the run measures on: compiler, flags, threads, the machine and the scan kernel.
+void print_header(const BenchOptions& o, int threads_all)
+{
+    std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
+                "table auto, hash %s\n",
+                TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, o.repeat, o.cell_factor, o.hash.c_str());
+    std::ifstream cpu("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(cpu, line))
+        if (line.rfind("model name", 0) == 0) {
+            std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
+            break;
+        }
+    const char* simd = std::getenv("TETHASH_SIMD");
+    std::printf("scan kernel: %s\n\n",
+                simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
+}
+
+/// --sweep: ns per tet from 1,000 to 1,000,000 tets at one thread.
+void report_sweep(const DetectParams& base, int repeat)
+{
+    std::printf("flatness sweep: copies of the scenario-5 object (551 tets) packed as in scenario 5, 1 thread\n");
+    for (int tets : {1000, 3000, 10000, 30000, 100000, 300000, 1000000}) {
+        const TetMesh m = bench::lattice_scene(std::max(2, (tets + 275) / 551), 7);
+        DetectParams p = base;
+        p.threads = 1;
+        const Measured r = measure(m, p, std::max(3, repeat / (tets >= 300000 ? 4 : 1)));
+        std::printf("  tets %8d  vertices %8d  %9.3f ms (cpu %.3f)  %6.1f ns/tet (cpu)  %6.1f B/tet  contacts %lld "
+                    "(%.2f per tet)\n",
+                    m.num_tets(), m.num_vertices(), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / m.num_tets(),
+                    double(r.stats.memory_bytes) / m.num_tets(), static_cast<long long>(r.stats.contacts),
+                    double(r.stats.contacts) / m.num_tets());
+        std::fflush(stdout);
+    }
+}
+
+/// --profile N: one scenario (default 5) at --threads (default 1), N detections, no statistics.
+void run_profile(const BenchOptions& o, const DetectParams& base)
+{
+    const study::Scenario sc = study::teschner_scenario(o.only > 0 ? o.only - 1 : 4);
+    DetectParams p = base;
+    p.threads = o.threads > 0 ? o.threads : 1;
+    Detector det(p);
+    det.set_topology(sc.mesh);
+    det.detect(sc.mesh.positions);
+    const std::size_t n = profile_detects(det, sc.mesh, o.profile);
+    std::printf("profile: scenario %d, %d detections, %zu contacts in all\n", o.only > 0 ? o.only : 5, o.profile, n);
+}
+
+/// The default run: the five scenarios, the partition scenes and the shared meshes, each against the baseline and
+/// the other methods asked for.
+void report_scenes(const BenchOptions& o, const DetectParams& base, int threads_all,
+                   const std::vector<std::string>& scene_names, const std::vector<Method>& methods)
+{
+    const bool baseline = !o.no_baseline;
+    // The five scenarios exactly as `tethash study --teschner-scenarios` builds them (study/scenarios.hpp),
+    // so that the benchmark and the study measure the same scenes.
+    for (int k = 0; k < 5; ++k) {
+        if (o.only > 0 && o.only != k + 1) continue;
+        const study::Scenario sc = study::teschner_scenario(k);
+        char name[96];
+        std::snprintf(name, sizeof name, "scenario %d (%s r%d; paper %d/%d/%d)", k + 1, sc.shape.c_str(), sc.resolution,
+                      sc.spec.objects, sc.spec.tets, sc.spec.vertices);
+        report(name, sc.mesh, base, threads_all, o.repeat, baseline, o.table_factor, methods);
+    }
+    if (o.only >= 0) return;
+    // Scenes unlike scenario 5 (study/scenarios.hpp: partition_scene): many objects each touching several at
+    // V/T 0.5, and the scenes where the hash is at its worst.
+    for (const std::string& n : scene_names) {
+        const study::NamedScene ps = study::partition_scene(n);
+        std::printf("%s: %s\n", n.c_str(), ps.description.c_str());
+        DetectParams with_cells = base; // the scene's cells and portals, for --method portals
+        with_cells.partition.cells = ps.cells;
+        report(n.c_str(), ps.mesh, with_cells, threads_all, std::max(3, o.repeat / 3), baseline, o.table_factor,
+               methods);
+    }
+    if (!o.no_meshes)
+        for_each_shared_mesh_pair([&](const char* name, const TetMesh& two) {
+            report(name, two, base, threads_all, std::max(3, o.repeat / 3), baseline, o.table_factor, methods);
+        });
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    BenchOptions o;
+    CLI::App app{"tethash_bench: ms per detection (median), ns per tet, stage split and contacts at 1 and all "
+                 "threads for the five scenarios of Teschner et al. 2003 and ../shared/meshes, against a plain "
+                 "implementation of the 2003 algorithm"};
+    add_options(app, o);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e) == 0 ? 0 : 2;
     }
-    repeat = std::max(1, repeat);
+    o.repeat = std::max(1, o.repeat);
     std::vector<Method> methods;
     std::vector<std::string> scene_names;
     try {
-        if (!methods_text.empty()) methods = study::parse_method_list(methods_text, "--methods");
-        const auto& known = study::partition_scene_names();
-        if (partition_scenes == "all") {
-            scene_names = known;
-        } else if (partition_scenes != "none") {
-            std::string item;
-            for (std::size_t i = 0; i <= partition_scenes.size(); ++i) {
-                if (i < partition_scenes.size() && partition_scenes[i] != ',') {
-                    item += partition_scenes[i];
-                    continue;
-                }
-                if (std::find(known.begin(), known.end(), item) == known.end())
-                    throw Error("--partition-scenes: unknown scene '" + item +
-                                "' (expected bars, sizes, corner, thin, building, hall, all or none)");
-                scene_names.push_back(item);
-                item.clear();
-            }
-        }
+        if (!o.methods_text.empty()) methods = study::parse_method_list(o.methods_text, "--methods");
+        scene_names = partition_scene_list(o.partition_scenes);
     } catch (const Error& e) {
         std::fprintf(stderr, "tethash_bench: error: %s\n", e.what());
         return 2;
     }
-    steps = std::max(2, steps);
-    const bool meshes = !no_meshes, baseline = !no_baseline;
+    o.steps = std::max(2, o.steps);
 #ifdef _OPENMP
-    const int threads_all = threads > 0 ? threads : omp_get_max_threads();
+    const int threads_all = o.threads > 0 ? o.threads : omp_get_max_threads();
 #else
     const int threads_all = 1;
 #endif
     DetectParams base;
     base.cell_size_mode = DetectParams::CellSizeMode::factor_of_mean_edge;
-    base.cell_size = cell_factor;
-    base.hash = parse_hash_function(hash);
-    base.partition.leaf_size = leaf_size;
-    std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
-                "table auto, hash %s\n",
-                TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, repeat, cell_factor, hash.c_str());
-    {
-        std::ifstream cpu("/proc/cpuinfo");
-        std::string line;
-        while (std::getline(cpu, line))
-            if (line.rfind("model name", 0) == 0) {
-                std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
-                break;
-            }
-    }
-    const char* simd = std::getenv("TETHASH_SIMD");
-    std::printf("scan kernel: %s\n\n",
-                simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
+    base.cell_size = o.cell_factor;
+    base.hash = parse_hash_function(o.hash);
+    base.partition.leaf_size = o.leaf_size;
+    print_header(o, threads_all);
 
-    if (sweep) {
-        std::printf("flatness sweep: copies of the scenario-5 object (551 tets) packed as in scenario 5, 1 thread\n");
-        for (int tets : {1000, 3000, 10000, 30000, 100000, 300000, 1000000}) {
-            const TetMesh m = bench::lattice_scene(std::max(2, (tets + 275) / 551), 7);
-            DetectParams p = base;
-            p.threads = 1;
-            const Measured r = measure(m, p, std::max(3, repeat / (tets >= 300000 ? 4 : 1)));
-            std::printf("  tets %8d  vertices %8d  %9.3f ms (cpu %.3f)  %6.1f ns/tet (cpu)  %6.1f B/tet  contacts %lld "
-                        "(%.2f per tet)\n",
-                        m.num_tets(), m.num_vertices(), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / m.num_tets(),
-                        double(r.stats.memory_bytes) / m.num_tets(), static_cast<long long>(r.stats.contacts),
-                        double(r.stats.contacts) / m.num_tets());
-            std::fflush(stdout);
-        }
-        return 0;
-    }
-
-    if (walk) {
+    if (o.sweep) {
+        report_sweep(base, o.repeat);
+    } else if (o.walk) {
         if (methods.empty())
             methods = {Method::hash, Method::uniform_grid, Method::sort_sweep, Method::bvh_refit, Method::portals};
-        report_walk(methods, base, std::max(2, steps), walk_speed, rooms);
-        return 0;
-    }
-    if (edges) {
+        report_walk(methods, base, std::max(2, o.steps), o.walk_speed, o.rooms);
+    } else if (o.edges) {
         for (int k = 0; k < 5; ++k) {
-            if (only > 0 && only != k + 1) continue;
+            if (o.only > 0 && o.only != k + 1) continue;
             const study::Scenario sc = study::teschner_scenario(k);
             const std::string name = "scenario " + std::to_string(k + 1);
-            report_edges(name.c_str(), sc.mesh, base, threads_all, repeat);
+            report_edges(name.c_str(), sc.mesh, base, threads_all, o.repeat);
         }
-        if (meshes && only < 0)
+        if (!o.no_meshes && o.only < 0)
             for_each_shared_mesh_pair([&](const char* name, const TetMesh& two) {
-                report_edges(name, two, base, threads_all, std::max(3, repeat / 3));
+                report_edges(name, two, base, threads_all, std::max(3, o.repeat / 3));
             });
-        return 0;
+    } else if (o.moving) {
+        report_moving(study::teschner_scenario(o.only > 0 ? o.only - 1 : 4), base, threads_all, o.steps, o.speed);
+    } else if (o.profile > 0) {
+        run_profile(o, base);
+    } else {
+        report_scenes(o, base, threads_all, scene_names, methods);
     }
-
-    if (moving) {
-        report_moving(study::teschner_scenario(only > 0 ? only - 1 : 4), base, threads_all, steps, speed);
-        return 0;
-    }
-
-    if (profile > 0) { // one scenario (default 5) at --threads (default 1), N detections, no statistics
-        const study::Scenario sc = study::teschner_scenario(only > 0 ? only - 1 : 4);
-        DetectParams p = base;
-        p.threads = threads > 0 ? threads : 1;
-        Detector det(p);
-        det.set_topology(sc.mesh);
-        det.detect(sc.mesh.positions);
-        const std::size_t n = profile_detects(det, sc.mesh, profile);
-        std::printf("profile: scenario %d, %d detections, %zu contacts in all\n", only > 0 ? only : 5, profile, n);
-        return 0;
-    }
-    // The five scenarios exactly as `tethash study --teschner-scenarios` builds them (study/scenarios.hpp),
-    // so that the benchmark and the study measure the same scenes.
-    for (int k = 0; k < 5; ++k) {
-        if (only > 0 && only != k + 1) continue;
-        const study::Scenario sc = study::teschner_scenario(k);
-        char name[96];
-        std::snprintf(name, sizeof name, "scenario %d (%s r%d; paper %d/%d/%d)", k + 1, sc.shape.c_str(), sc.resolution,
-                      sc.spec.objects, sc.spec.tets, sc.spec.vertices);
-        report(name, sc.mesh, base, threads_all, repeat, baseline, table_factor, methods);
-    }
-    // Scenes unlike scenario 5 (study/scenarios.hpp: partition_scene): many objects each touching several at
-    // V/T 0.5, and the scenes where the hash is at its worst.
-    if (only < 0)
-        for (const std::string& n : scene_names) {
-            const study::NamedScene ps = study::partition_scene(n);
-            std::printf("%s: %s\n", n.c_str(), ps.description.c_str());
-            DetectParams with_cells = base; // the scene's cells and portals, for --method portals
-            with_cells.partition.cells = ps.cells;
-            report(n.c_str(), ps.mesh, with_cells, threads_all, std::max(3, repeat / 3), baseline, table_factor,
-                   methods);
-        }
-    if (meshes && only < 0)
-        for_each_shared_mesh_pair([&](const char* name, const TetMesh& two) {
-            report(name, two, base, threads_all, std::max(3, repeat / 3), baseline, table_factor, methods);
-        });
     return 0;
 }

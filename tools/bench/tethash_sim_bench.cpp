@@ -200,11 +200,8 @@ double parse_dt(const std::string& v)
     }
 }
 
-} // namespace
-
-int main(int argc, char** argv)
-{
-    CLI::App app{"tethash_sim_bench: the simulator on the shared real meshes (drops and a collision)"};
+/// The benchmark's options (tethash_sim_bench --help).
+struct SimBenchOptions {
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     std::vector<double> sizes{1.0}, youngs;
@@ -215,43 +212,184 @@ int main(int argc, char** argv)
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
     bool no_speculative = false, inversion_guard = false;
     bool no_peer = false;
+};
+
+void add_options(CLI::App& app, SimBenchOptions& o)
+{
     // Three sections in --help: what runs, what each scene is made to do differently, and the peer.
     CLI::Option_group* runs = app.add_option_group("Runs");
-    runs->add_option("--meshes", meshes_dir, "folder of the shared meshes")->capture_default_str();
-    runs->add_option("--scenes", filter, "only scenes whose name contains this");
-    runs->add_option("--integrator", integrators, "integrators (vbd, implicit_euler, symplectic_euler)")
+    runs->add_option("--meshes", o.meshes_dir, "folder of the shared meshes")->capture_default_str();
+    runs->add_option("--scenes", o.filter, "only scenes whose name contains this");
+    runs->add_option("--integrator", o.integrators, "integrators (vbd, implicit_euler, symplectic_euler)")
         ->delimiter(',');
-    runs->add_option("--dt", dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
-    runs->add_option("--size", sizes,
+    runs->add_option("--dt", o.dts, "time steps (seconds or fractions like 1/240), comma-separated")->delimiter(',');
+    runs->add_option("--size", o.sizes,
                      "body sizes (longest extent, m), comma-separated; drops start 0.2 sizes above the ground, the "
                      "two armadillos 1.4 sizes apart")
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
-    runs->add_option("--young", youngs,
+    runs->add_option("--young", o.youngs,
                      "Young's moduli (Pa), comma-separated; each scene runs at each (default: the scenes' 1e5)")
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
-    runs->add_option("--seconds", seconds, "simulated time per run")->capture_default_str();
-    runs->add_option("--threads", threads, "detector and solver threads")->capture_default_str();
-    runs->add_option("--csv", csv, "write the rows as CSV to this file");
+    runs->add_option("--seconds", o.seconds, "simulated time per run")->capture_default_str();
+    runs->add_option("--threads", o.threads, "detector and solver threads")->capture_default_str();
+    runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
     CLI::Option_group* overrides = app.add_option_group("Scene overrides", "each defaults to the scene's own value");
-    overrides->add_option("--iterations", iterations, "solver iterations (sweeps) per step; 0 = the scene default");
-    overrides->add_option("--max-substeps", max_substeps,
+    overrides->add_option("--iterations", o.iterations, "solver iterations (sweeps) per step; 0 = the scene default");
+    overrides->add_option("--max-substeps", o.max_substeps,
                           "refine a step that inverts tets or blows up into up to this many substeps; 1 = never; "
                           "0 = the scene default");
-    overrides->add_option("--convergence", convergence, "vbd automatic sweeps: relative tolerance in [0, 1)");
-    overrides->add_option("--max-iterations", max_iterations, "vbd automatic sweeps: the cap per substep");
-    overrides->add_flag("--no-coarse", no_coarse, "vbd: sweeps alone, without the coarse space's corrections");
-    overrides->add_option("--sweep-tolerance", sweep_tolerance, "vbd early stop (fraction of the mean edge)");
-    overrides->add_option("--acceleration", rho, "vbd Chebyshev acceleration ρ in [0, 1)");
-    overrides->add_option("--skin", skin, "detector candidate reuse, as a factor of the cell size");
-    overrides->add_option("--margin", margin, "contact margin, as a fraction of the mean edge (0: off)")
+    overrides->add_option("--convergence", o.convergence, "vbd automatic sweeps: relative tolerance in [0, 1)");
+    overrides->add_option("--max-iterations", o.max_iterations, "vbd automatic sweeps: the cap per substep");
+    overrides->add_flag("--no-coarse", o.no_coarse, "vbd: sweeps alone, without the coarse space's corrections");
+    overrides->add_option("--sweep-tolerance", o.sweep_tolerance, "vbd early stop (fraction of the mean edge)");
+    overrides->add_option("--acceleration", o.rho, "vbd Chebyshev acceleration ρ in [0, 1)");
+    overrides->add_option("--skin", o.skin, "detector candidate reuse, as a factor of the cell size");
+    overrides->add_option("--margin", o.margin, "contact margin, as a fraction of the mean edge (0: off)")
         ->check(CLI::NonNegativeNumber);
-    overrides->add_flag("--no-speculative", no_speculative, "no speculative contacts (proximity.hpp)");
-    overrides->add_flag("--inversion-guard", inversion_guard, "vbd: keep tets the right way out (inversion_guard)");
+    overrides->add_flag("--no-speculative", o.no_speculative, "no speculative contacts (proximity.hpp)");
+    overrides->add_flag("--inversion-guard", o.inversion_guard, "vbd: keep tets the right way out (inversion_guard)");
     CLI::Option_group* peer = app.add_option_group("Peer", "Bullet's soft bodies, when built with libbullet-dev");
-    peer->add_flag("--no-peer", no_peer, "do not run the peer even when built with it");
-    peer->add_option("--peer-iterations", peer_iterations, "the peer's position iterations")->capture_default_str();
+    peer->add_flag("--no-peer", o.no_peer, "do not run the peer even when built with it");
+    peer->add_option("--peer-iterations", o.peer_iterations, "the peer's position iterations")->capture_default_str();
+}
+
+/// What the run measures on: compiler, flags, threads, the machine's load, the peer.
+void print_header(SimBenchOptions& o)
+{
+    double load[3] = {0, 0, 0};
+    if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+        if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
+        std::fclose(f);
+    }
+    std::printf("tethash_sim_bench: %s, flags '%s', %u hardware threads, %d thread(s), load %.2f %.2f %.2f\n",
+                TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), o.threads, load[0],
+                load[1], load[2]);
+    std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", o.seconds).c_str());
+#ifdef TETHASH_HAVE_BULLET
+    std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
+                bench::bullet_version() / 100, bench::bullet_version() % 100, o.peer_iterations,
+                o.no_peer ? " (off: --no-peer)" : "");
+#else
+    std::printf("peer: Bullet not found at build time (install libbullet-dev and rebuild to compare)\n");
+    o.no_peer = true;
+#endif
+}
+
+/// The scenes: each shared mesh dropped at each size and modulus, and the two armadillos thrown at each other.
+std::vector<std::pair<std::string, sim::Scene>> make_scenes(const SimBenchOptions& o)
+{
+    std::vector<std::pair<std::string, sim::Scene>> scenes;
+    const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node",    "screw.msh",
+                                            "P1.msh",           "raptorTetra_8418.vtu", "32770_octocat.msh",
+                                            "hand.mesh",        "mat100x100t40.msh",    "quintupleTorus.veg"};
+    // A size's scenes are named with it ("drop hand 5cm") unless only 1 m is run (the rows' historic names).
+    auto size_name = [&](double size) {
+        if (o.sizes.size() == 1 && size == 1.0) return std::string();
+        return size < 1 ? fmt::format(" {:g}cm", 100 * size) : fmt::format(" {:g}m", size);
+    };
+    // With --young, each scene runs at each modulus and is named with it ("drop hand 5cm E1e+09").
+    const std::vector<double> moduli = o.youngs.empty() ? std::vector<double>{0.0} : o.youngs;
+    auto with_young = [&](const sim::ObjectSpec& base, double young) {
+        sim::ObjectSpec obj = base;
+        if (young > 0) obj.material.young = young;
+        return obj;
+    };
+    auto young_name = [](double young) { return young > 0 ? fmt::format(" E{:.0e}", young) : std::string(); };
+    for (const std::string& file : files) {
+        const std::filesystem::path p = std::filesystem::path(o.meshes_dir) / file;
+        if (!std::filesystem::exists(p)) continue;
+        const TetMesh mesh = io::read_mesh(p.string());
+        for (double size : o.sizes)
+            for (double young : moduli) {
+                sim::Scene s;
+                s.objects.push_back(with_young(placed(mesh, 0.2, size), young));
+                s.ground.enabled = true;
+                s.output.every = 0;
+                scenes.emplace_back("drop " + p.stem().string() + size_name(size) + young_name(young), s);
+                if (file == "armadillo_4k.node") {
+                    sim::Scene two;
+                    for (int k = 0; k < 2; ++k) {
+                        sim::ObjectSpec obj = with_young(placed(mesh, 0.3, size), young);
+                        obj.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
+                        obj.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
+                        two.objects.push_back(obj);
+                    }
+                    two.ground.enabled = true;
+                    two.output.every = 0;
+                    scenes.emplace_back("two armadillos at 2 m/s" + size_name(size) + young_name(young), two);
+                }
+            }
+    }
+    return scenes;
+}
+
+/// The options' scene overrides, and the integrator and time step of one run.
+void apply_overrides(sim::Scene& scene, const SimBenchOptions& o, sim::Integrator integrator, double dt)
+{
+    scene.integrator = integrator;
+    scene.dt = dt;
+    scene.detect.threads = o.threads;
+    if (o.iterations > 0) scene.iterations = o.iterations;
+    if (o.max_substeps > 0) scene.max_substeps = o.max_substeps;
+    if (o.sweep_tolerance >= 0) scene.sweep_tolerance = o.sweep_tolerance;
+    if (o.convergence >= 0) scene.convergence = o.convergence;
+    if (o.max_iterations > 0) scene.max_iterations = o.max_iterations;
+    if (o.no_coarse) scene.coarse_space = false;
+    if (o.rho >= 0) scene.acceleration = o.rho;
+    if (o.margin >= 0) scene.contact.margin = o.margin;
+    if (o.no_speculative) scene.contact.speculative = false;
+    if (o.inversion_guard) scene.inversion_guard = true;
+    if (o.skin >= 0) {
+        scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
+        scene.detect.skin = o.skin;
+    }
+}
+
+/// Teschner et al. 2004: the largest stable dt of those run, divided by the cost per step at that dt.
+void print_stable_dt(const std::vector<Row>& rows)
+{
+    std::map<std::pair<std::string, std::string>, std::pair<double, double>> best;
+    for (const Row& r : rows)
+        if (r.stable) {
+            auto& b = best[{r.scene, r.integrator}];
+            if (r.dt > b.first) b = {r.dt, r.ms_mean};
+        }
+    std::printf("\nlargest stable dt / ms per step (Teschner et al. 2004), over the dt run:\n");
+    for (const auto& [key, v] : best)
+        std::printf("  %-34s %-16s dt %.5f s at %.2f ms/step: %.3g s/ms\n", key.first.c_str(), key.second.c_str(),
+                    v.first, v.second, v.first / v.second);
+}
+
+/// --csv FILE: the rows, written whole or not at all.
+void write_csv(const std::string& csv, const std::vector<Row>& rows)
+{
+    const std::string tmp = csv + ".partial";
+    {
+        std::ofstream out(tmp);
+        if (!out) throw Error("--csv: cannot write '" + tmp + "'");
+        out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
+               "ms_response,ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,"
+               "energy_ratio,volume_ratio,unconverged,stable,failure\n";
+        for (const Row& r : rows)
+            out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},"
+                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},\"{}\"\n",
+                               r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
+                               r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, r.inverted,
+                               r.far_self, r.far_self_max, r.mean_z, r.energy_ratio, r.volume_ratio, r.unconverged,
+                               r.stable ? 1 : 0, r.failure);
+    }
+    std::filesystem::rename(tmp, csv);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"tethash_sim_bench: the simulator on the shared real meshes (drops and a collision)"};
+    SimBenchOptions o;
+    add_options(app, o);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -259,80 +397,22 @@ int main(int argc, char** argv)
     }
     try {
         std::vector<double> steps_dt;
-        for (const std::string& d : dts) {
+        for (const std::string& d : o.dts) {
             const double v = parse_dt(d);
             if (!(v > 0)) throw Error("--dt must be positive, found '" + d + "'");
             steps_dt.push_back(v);
         }
         std::vector<sim::Integrator> integ;
-        for (const std::string& i : integrators)
+        for (const std::string& i : o.integrators)
             integ.push_back(sim::parse_integrator(i));
-        if (!(seconds > 0)) throw Error("--seconds must be positive");
-        if (threads < 1 || threads > 256) throw Error("--threads must be in 1..256");
-        if (!std::filesystem::is_directory(meshes_dir)) {
-            std::printf("shared meshes not found at %s: nothing to run\n", meshes_dir.c_str());
+        if (!(o.seconds > 0)) throw Error("--seconds must be positive");
+        if (o.threads < 1 || o.threads > 256) throw Error("--threads must be in 1..256");
+        if (!std::filesystem::is_directory(o.meshes_dir)) {
+            std::printf("shared meshes not found at %s: nothing to run\n", o.meshes_dir.c_str());
             return 0;
         }
-        double load[3] = {0, 0, 0};
-        if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
-            if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
-            std::fclose(f);
-        }
-        std::printf("tethash_sim_bench: %s, flags '%s', %u hardware threads, %d thread(s), load %.2f %.2f %.2f\n",
-                    TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), threads, load[0],
-                    load[1], load[2]);
-        std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", seconds).c_str());
-#ifdef TETHASH_HAVE_BULLET
-        std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
-                    bench::bullet_version() / 100, bench::bullet_version() % 100, peer_iterations,
-                    no_peer ? " (off: --no-peer)" : "");
-#else
-        std::printf("peer: Bullet not found at build time (install libbullet-dev and rebuild to compare)\n");
-        no_peer = true;
-#endif
-
-        std::vector<std::pair<std::string, sim::Scene>> scenes;
-        const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node",    "screw.msh",
-                                                "P1.msh",           "raptorTetra_8418.vtu", "32770_octocat.msh",
-                                                "hand.mesh",        "mat100x100t40.msh",    "quintupleTorus.veg"};
-        // A size's scenes are named with it ("drop hand 5cm") unless only 1 m is run (the rows' historic names).
-        auto size_name = [&](double size) {
-            if (sizes.size() == 1 && size == 1.0) return std::string();
-            return size < 1 ? fmt::format(" {:g}cm", 100 * size) : fmt::format(" {:g}m", size);
-        };
-        // With --young, each scene runs at each modulus and is named with it ("drop hand 5cm E1e+09").
-        const std::vector<double> moduli = youngs.empty() ? std::vector<double>{0.0} : youngs;
-        auto with_young = [&](const sim::ObjectSpec& base, double young) {
-            sim::ObjectSpec o = base;
-            if (young > 0) o.material.young = young;
-            return o;
-        };
-        auto young_name = [](double young) { return young > 0 ? fmt::format(" E{:.0e}", young) : std::string(); };
-        for (const std::string& file : files) {
-            const std::filesystem::path p = std::filesystem::path(meshes_dir) / file;
-            if (!std::filesystem::exists(p)) continue;
-            const TetMesh mesh = io::read_mesh(p.string());
-            for (double size : sizes)
-                for (double young : moduli) {
-                    sim::Scene s;
-                    s.objects.push_back(with_young(placed(mesh, 0.2, size), young));
-                    s.ground.enabled = true;
-                    s.output.every = 0;
-                    scenes.emplace_back("drop " + p.stem().string() + size_name(size) + young_name(young), s);
-                    if (file == "armadillo_4k.node") {
-                        sim::Scene two;
-                        for (int k = 0; k < 2; ++k) {
-                            sim::ObjectSpec o = with_young(placed(mesh, 0.3, size), young);
-                            o.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
-                            o.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
-                            two.objects.push_back(o);
-                        }
-                        two.ground.enabled = true;
-                        two.output.every = 0;
-                        scenes.emplace_back("two armadillos at 2 m/s" + size_name(size) + young_name(young), two);
-                    }
-                }
-        }
+        print_header(o);
+        std::vector<std::pair<std::string, sim::Scene>> scenes = make_scenes(o);
         std::printf(
             "%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  %s\n",
             "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
@@ -340,71 +420,28 @@ int main(int argc, char** argv)
             "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
-            if (!filter.empty() && name.find(filter) == std::string::npos) continue;
+            if (!o.filter.empty() && name.find(o.filter) == std::string::npos) continue;
             for (sim::Integrator i : integ)
                 for (double dt : steps_dt) {
-                    scene.integrator = i;
-                    scene.dt = dt;
-                    scene.detect.threads = threads;
-                    if (iterations > 0) scene.iterations = iterations;
-                    if (max_substeps > 0) scene.max_substeps = max_substeps;
-                    if (sweep_tolerance >= 0) scene.sweep_tolerance = sweep_tolerance;
-                    if (convergence >= 0) scene.convergence = convergence;
-                    if (max_iterations > 0) scene.max_iterations = max_iterations;
-                    if (no_coarse) scene.coarse_space = false;
-                    if (rho >= 0) scene.acceleration = rho;
-                    if (margin >= 0) scene.contact.margin = margin;
-                    if (no_speculative) scene.contact.speculative = false;
-                    if (inversion_guard) scene.inversion_guard = true;
-                    if (skin >= 0) {
-                        scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
-                        scene.detect.skin = skin;
-                    }
-                    const int steps = std::max(1, static_cast<int>(std::lround(seconds / dt)));
+                    apply_overrides(scene, o, i, dt);
+                    const int steps = std::max(1, static_cast<int>(std::lround(o.seconds / dt)));
                     const Row r = run(name, scene, steps);
                     print(r);
                     rows.push_back(r);
                 }
 #ifdef TETHASH_HAVE_BULLET
-            if (!no_peer)
+            if (!o.no_peer)
                 for (double dt : steps_dt) {
                     scene.dt = dt;
-                    const Row r = run_peer(name, scene, std::max(1, static_cast<int>(std::lround(seconds / dt))),
-                                           peer_iterations);
+                    const Row r = run_peer(name, scene, std::max(1, static_cast<int>(std::lround(o.seconds / dt))),
+                                           o.peer_iterations);
                     print(r);
                     rows.push_back(r);
                 }
 #endif
         }
-        // Teschner et al. 2004: the largest stable dt of those run, divided by the cost per step at that dt.
-        std::map<std::pair<std::string, std::string>, std::pair<double, double>> best;
-        for (const Row& r : rows)
-            if (r.stable) {
-                auto& b = best[{r.scene, r.integrator}];
-                if (r.dt > b.first) b = {r.dt, r.ms_mean};
-            }
-        std::printf("\nlargest stable dt / ms per step (Teschner et al. 2004), over the dt run:\n");
-        for (const auto& [key, v] : best)
-            std::printf("  %-34s %-16s dt %.5f s at %.2f ms/step: %.3g s/ms\n", key.first.c_str(), key.second.c_str(),
-                        v.first, v.second, v.first / v.second);
-        if (!csv.empty()) {
-            const std::string tmp = csv + ".partial";
-            {
-                std::ofstream out(tmp);
-                if (!out) throw Error("--csv: cannot write '" + tmp + "'");
-                out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
-                       "ms_response,ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,"
-                       "energy_ratio,volume_ratio,unconverged,stable,failure\n";
-                for (const Row& r : rows)
-                    out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},"
-                                       "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},\"{}\"\n",
-                                       r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect,
-                                       r.depth, r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts,
-                                       r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio, r.volume_ratio,
-                                       r.unconverged, r.stable ? 1 : 0, r.failure);
-            }
-            std::filesystem::rename(tmp, csv);
-        }
+        print_stable_dt(rows);
+        if (!o.csv.empty()) write_csv(o.csv, rows);
     } catch (const Error& e) {
         std::fprintf(stderr, "tethash_sim_bench: %s\n", e.what());
         return 2;

@@ -5,6 +5,7 @@
 
 #include "tethash/bsp.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/cells.hpp"
@@ -251,18 +252,14 @@ void run_continuous_detection(const DetectOptions& o)
     run_continuous(c);
 }
 
-void run(const DetectOptions& o)
+/// The detector's parameters of the options (their grammar checked; the table size's value comes with the scene).
+DetectParams params_of(const DetectOptions& o, bool side_by_side)
 {
-    if (o.continuous) {
-        run_continuous_detection(o);
-        return;
-    }
     DetectParams params;
     parse_cell_size(o.cell_size, params);
     parse_table_size(o.table_size, 0); // the syntax now; the value once the vertices are counted
     parse_skin(o.skin, params);
     params.hash = parse_hash_function(o.hash);
-    const bool side_by_side = o.method == "all"; // every method side by side
     if (!side_by_side) params.method = parse_method(o.method, "--method");
     for (const auto& [option, text] : {std::pair{"--max-depth", &o.max_depth}, std::pair{"--leaf-size", &o.leaf_size},
                                        std::pair{"--looseness", &o.looseness}, std::pair{"--levels", &o.levels}})
@@ -273,19 +270,12 @@ void run(const DetectOptions& o)
                         o.method);
         params.partition.cells = std::make_shared<CellLayout>(io::read_cells(o.cells_path));
     }
-    const int repeat = o.repeat_given ? o.repeat : side_by_side ? 3 : 1;
-    if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
-    const bool edges = o.edges || !o.edge_contacts_path.empty();
-    if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty() || edges))
-        throw Error(std::string(!o.contacts_path.empty()       ? "--contacts"
-                                : !o.stats_path.empty()        ? "--stats"
-                                : !o.obstacles.empty()         ? "--obstacle"
-                                : o.edge_contacts_path.empty() ? "--edges"
-                                                               : "--edge-contacts") +
-                    ": not with --method all, which prints the comparison table (give one --method NAME)");
-    params.threads = set_threads(parse_threads(o.threads));
-    check_objects_from_labels_value(o.objects_from_labels);
-    // Output files are checked before the work, so that a typo does not cost a long run.
+    return params;
+}
+
+/// Output files are checked before the work, so that a typo does not cost a long run.
+void check_output_paths(const DetectOptions& o)
+{
     if (!o.contacts_path.empty()) {
         io::check_output_file(o.contacts_path, "--contacts");
         const std::string e = io::extension_of(o.contacts_path);
@@ -300,109 +290,123 @@ void run(const DetectOptions& o)
             throw Error("--edge-contacts " + o.edge_contacts_path + ": unknown format '" +
                         io::extension_of(o.edge_contacts_path) + "' (expected .csv)");
     }
-    // Obstacles: read and built (checked closed, not self-intersecting) before the work.
-    ObstacleSet obstacles;
-    for (const std::string& path : o.obstacles) {
-        const io::SurfaceMesh surface = io::read_surface(path);
-        obstacles.add(Bsp(surface.vertices, surface.triangles, "--obstacle " + path));
-    }
+}
 
-    // The scene: each file one object (or the objects of its 'object' cell data, or of its labels); ids global in
-    // argument order.
-    TetMesh scene;
+/// The scene of the files given: each file one object (or the objects of its 'object' cell data, or of its labels);
+/// ids global in argument order.
+struct DetectScene {
+    TetMesh mesh;
     std::vector<Index> vobj, tobj;
-    Index nv = 0, nt = 0;
-    std::vector<TetMesh> meshes;
+    Index nv = 0, nt = 0, num_objects = 0;
     std::vector<InputFile> files;
-    Index num_objects = 0;
+    std::vector<ObjectOptions> objects;
+};
+
+/// Reads one file of the scene (its notes printed) with its objects as the options say.
+TetMesh read_scene_file(const DetectOptions& o, const std::string& path, InputFile& file)
+{
     io::ReadOptions read_options;
     read_options.linearize = o.linearize;
-    for (const std::string& path : o.meshes) {
-        InputFile file{path, nv, nt, {}};
-        meshes.push_back(io::read_tet_mesh(path, &file.notes, read_options));
-        TetMesh& mesh = meshes.back();
-        for (const std::string& m : file.notes.messages)
-            if (m.rfind("--linearize", 0) == 0) fmt::print("{}: note: {}\n", path, m);
-        if (!o.objects_from_labels.empty()) {
-            fmt::print("{}: {}\n", path, objects_from_labels(mesh, path, o.objects_from_labels));
-        } else if (!mesh.tet_object.empty() && mesh.num_objects() > 1) {
-            // A simulation frame (or any file with 'object' cell data) keeps its objects.
-            fmt::print("{}: {} objects from its 'object' cell data\n", path, mesh.num_objects());
-        } else { // one object
-            mesh.vertex_object.clear();
-            mesh.tet_object.clear();
-        }
-        mesh.ensure_object_ids();
-        std::int64_t collapsed = 0;
-        for (Index t = 0; t < mesh.num_tets(); ++t) {
-            const auto r = mesh.tets.row(t);
-            collapsed += r(0) == r(1) || r(0) == r(2) || r(0) == r(3) || r(1) == r(2) || r(1) == r(3) || r(2) == r(3);
-        }
-        if (collapsed)
-            fmt::print("{}: note: {} tets with a repeated vertex (collapsed, zero volume) are skipped like the other "
-                       "degenerate tets ('tethash info' lists them)\n",
-                       path, collapsed);
-        files.push_back(std::move(file));
-        num_objects += std::max<Index>(1, meshes.back().num_objects()); // an empty file is still an object
-        nv += meshes.back().num_vertices();
-        nt += meshes.back().num_tets();
+    TetMesh mesh = io::read_tet_mesh(path, &file.notes, read_options);
+    for (const std::string& m : file.notes.messages)
+        if (m.rfind("--linearize", 0) == 0) fmt::print("{}: note: {}\n", path, m);
+    if (!o.objects_from_labels.empty()) {
+        fmt::print("{}: {}\n", path, objects_from_labels(mesh, path, o.objects_from_labels));
+    } else if (!mesh.tet_object.empty() && mesh.num_objects() > 1) {
+        // A simulation frame (or any file with 'object' cell data) keeps its objects.
+        fmt::print("{}: {} objects from its 'object' cell data\n", path, mesh.num_objects());
+    } else { // one object
+        mesh.vertex_object.clear();
+        mesh.tet_object.clear();
     }
-    scene.positions.resize(nv, 3);
-    scene.tets.resize(nt, 4);
+    mesh.ensure_object_ids();
+    std::int64_t collapsed = 0;
+    for (Index t = 0; t < mesh.num_tets(); ++t) {
+        const auto r = mesh.tets.row(t);
+        collapsed += r(0) == r(1) || r(0) == r(2) || r(0) == r(3) || r(1) == r(2) || r(1) == r(3) || r(2) == r(3);
+    }
+    if (collapsed)
+        fmt::print("{}: note: {} tets with a repeated vertex (collapsed, zero volume) are skipped like the other "
+                   "degenerate tets ('tethash info' lists them)\n",
+                   path, collapsed);
+    return mesh;
+}
+
+DetectScene load_detect_scene(const DetectOptions& o)
+{
+    DetectScene sc;
+    std::vector<TetMesh> meshes;
+    for (const std::string& path : o.meshes) {
+        InputFile file{path, sc.nv, sc.nt, {}};
+        meshes.push_back(read_scene_file(o, path, file));
+        sc.files.push_back(std::move(file));
+        sc.num_objects += std::max<Index>(1, meshes.back().num_objects()); // an empty file is still an object
+        sc.nv += meshes.back().num_vertices();
+        sc.nt += meshes.back().num_tets();
+    }
+    sc.mesh.positions.resize(sc.nv, 3);
+    sc.mesh.tets.resize(sc.nt, 4);
     Index v0 = 0, t0 = 0, o0 = 0;
-    for (std::size_t k = 0; k < meshes.size(); ++k) {
-        const TetMesh& m = meshes[k];
-        scene.positions.middleRows(v0, m.num_vertices()) = m.positions;
-        scene.tets.middleRows(t0, m.num_tets()) = m.tets.array() + v0;
+    for (const TetMesh& m : meshes) {
+        sc.mesh.positions.middleRows(v0, m.num_vertices()) = m.positions;
+        sc.mesh.tets.middleRows(t0, m.num_tets()) = m.tets.array() + v0;
         for (Index id : m.vertex_object)
-            vobj.push_back(o0 + id);
+            sc.vobj.push_back(o0 + id);
         for (Index id : m.tet_object)
-            tobj.push_back(o0 + id);
+            sc.tobj.push_back(o0 + id);
         v0 += m.num_vertices();
         t0 += m.num_tets();
         o0 += std::max<Index>(1, m.num_objects());
     }
-    std::vector<ObjectOptions> objects(static_cast<std::size_t>(num_objects));
-    for (auto& ob : objects)
+    sc.objects.resize(static_cast<std::size_t>(sc.num_objects));
+    for (auto& ob : sc.objects)
         ob.self_collision = !o.no_self;
     for (int s : o.static_objects) {
-        if (s < 0 || s >= num_objects)
-            throw Error("--static: object " + std::to_string(s) + " out of range [0, " + std::to_string(num_objects) +
+        if (s < 0 || s >= sc.num_objects)
+            throw Error("--static: object " + std::to_string(s) + " out of range [0, " +
+                        std::to_string(sc.num_objects) +
                         ") (objects are the mesh files, in order, or their labels with --objects-from-labels)");
-        objects[static_cast<std::size_t>(s)].is_static = true;
+        sc.objects[static_cast<std::size_t>(s)].is_static = true;
     }
+    return sc;
+}
 
-    params.table_size = parse_table_size(o.table_size, nv);
-    if (side_by_side) {
-        compare_all_methods(scene, nv, nt, num_objects, vobj, tobj, objects, params, repeat);
-        return;
-    }
-    Detector det(params);
-    det.set_topology(scene.tets, nv, vobj, tobj, objects);
+/// The first call (the one-off set-up) and `repeat` timed calls after it; `stats` is the median call's.
+struct TimedDetection {
+    DetectStats first, stats;
+    std::vector<double> ms; ///< of each timed call, in order
+};
+
+TimedDetection time_detection(Detector& det, const Positions& positions, int repeat)
+{
     // The first call does the one-off set-up (automatic cell size, static vertices) and warms caches: it is
     // reported apart, and the K timed calls follow it. The stages printed are those of the median call.
-    DetectStats first;
-    det.detect(scene.positions, &first);
+    TimedDetection t;
+    det.detect(positions, &t.first);
     std::vector<DetectStats> runs(static_cast<std::size_t>(repeat));
-    std::vector<double> ms;
     for (DetectStats& run : runs) {
-        det.detect(scene.positions, &run);
-        ms.push_back(run.ms_total);
+        det.detect(positions, &run);
+        t.ms.push_back(run.ms_total);
     }
     std::vector<std::size_t> order(runs.size());
     for (std::size_t i = 0; i < order.size(); ++i)
         order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ms[a] < ms[b]; });
-    const DetectStats& stats = runs[order[order.size() / 2]];
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return t.ms[a] < t.ms[b]; });
+    t.stats = runs[order[order.size() / 2]];
+    return t;
+}
+
+void print_detection(const DetectScene& sc, const DetectParams& params, const TimedDetection& t, int repeat,
+                     std::size_t contacts)
+{
+    const DetectStats& stats = t.stats;
     const double median_ms = stats.ms_total;
     const double stages = stats.ms_vertices + stats.ms_tets + stats.ms_inside + stats.ms_sort;
-    const std::vector<Contact>& contacts = det.contacts();
-
-    fmt::print("scene: {} objects, {} vertices, {} tets\n", num_objects, nv, nt);
+    fmt::print("scene: {} objects, {} vertices, {} tets\n", sc.num_objects, sc.nv, sc.nt);
     fmt::print("grid: cell size {:.6g}, table size {}, hash {}, threads {}\n", stats.cell_size, stats.table_size,
                to_string(params.hash), stats.threads);
     fmt::print("first call: {:.3f} ms, of which set-up {:.3f} ms (cell size, static vertices; once per scene)\n",
-               first.ms_total, first.ms_setup);
+               t.first.ms_total, t.first.ms_setup);
     fmt::print("time: {:.3f} ms per detection (median of {} after the first): vertices {:.3f}, tets {:.3f}, inside "
                "{:.3f}, sort {:.3f}, other {:.3f}\n",
                median_ms, repeat, stats.ms_vertices, stats.ms_tets, stats.ms_inside, stats.ms_sort,
@@ -416,76 +420,135 @@ void run(const DetectOptions& o)
     if (params.method == Method::portals)
         fmt::print("portals: {} cells, {} segment tests, {} boxes entered beyond their own cell\n", stats.nodes,
                    stats.ray_tests, stats.portal_overlaps);
-    fmt::print("contacts: {}\n", contacts.size());
-    std::vector<ObstacleContact> inside;
-    if (obstacles.size() > 0) {
-        const auto t0 = std::chrono::steady_clock::now();
-        inside = obstacles.query(scene.positions);
-        const double obstacle_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        for (Index k = 0; k < obstacles.size(); ++k) {
-            const BspStats& b = obstacles[k].stats();
-            const auto n =
-                std::count_if(inside.begin(), inside.end(), [k](const ObstacleContact& c) { return c.obstacle == k; });
-            fmt::print("obstacle {}: {}: {} vertices inside (bsp: {} triangles, {} planes, {} nodes, depth {})\n", k,
-                       o.obstacles[static_cast<std::size_t>(k)], n, b.triangles, b.planes, b.nodes, b.depth);
-        }
-        fmt::print("obstacle contacts: {} ({:.3f} ms, depth and direction included)\n", inside.size(), obstacle_ms);
+    fmt::print("contacts: {}\n", contacts);
+}
+
+/// The vertices inside the obstacles, each obstacle's count printed.
+std::vector<ObstacleContact> query_obstacles(const ObstacleSet& obstacles, const Positions& positions,
+                                             const std::vector<std::string>& paths)
+{
+    if (obstacles.size() == 0) return {};
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<ObstacleContact> inside = obstacles.query(positions);
+    const double obstacle_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    for (Index k = 0; k < obstacles.size(); ++k) {
+        const BspStats& b = obstacles[k].stats();
+        const auto n =
+            std::count_if(inside.begin(), inside.end(), [k](const ObstacleContact& c) { return c.obstacle == k; });
+        fmt::print("obstacle {}: {}: {} vertices inside (bsp: {} triangles, {} planes, {} nodes, depth {})\n", k,
+                   paths[static_cast<std::size_t>(k)], n, b.triangles, b.planes, b.nodes, b.depth);
     }
+    fmt::print("obstacle contacts: {} ({:.3f} ms, depth and direction included)\n", inside.size(), obstacle_ms);
+    return inside;
+}
+
+/// --contacts FILE: a table (.csv, with the obstacles' rows and depths where there are obstacles) or the meshes
+/// (.vtu, with the contacts' depths filled in).
+void write_contacts(const DetectOptions& o, DetectScene& sc, std::vector<Contact>& contacts,
+                    const std::vector<ObstacleContact>& inside, bool obstacles)
+{
+    if (io::extension_of(o.contacts_path) == ".vtu") {
+        sc.mesh.vertex_object = sc.vobj;
+        sc.mesh.tet_object = sc.tobj;
+        write_contacts_vtu(o.contacts_path, sc.mesh, contacts, inside);
+    } else if (obstacles) {
+        // Rows carry depths: the tet contacts' are computed here.
+        std::vector<Contact> valued = contacts;
+        sc.mesh.vertex_object = sc.vobj;
+        sc.mesh.tet_object = sc.tobj;
+        compute_penetration(sc.mesh, valued);
+        io::write_text_file(o.contacts_path, contacts_csv(valued, sc.files, o.obstacles, inside, sc.vobj));
+    } else {
+        io::write_text_file(o.contacts_path, contacts_csv(contacts, sc.files));
+    }
+}
+
+/// --stats FILE: the run's figures as JSON.
+void write_stats(const DetectOptions& o, const DetectScene& sc, const DetectParams& params, const TimedDetection& t,
+                 int repeat, std::size_t contacts, std::size_t obstacle_contacts, const EdgeFaceResult* edges,
+                 double edges_ms)
+{
+    study::JsonWriter j;
+    j.begin_object()
+        .member("objects", sc.num_objects)
+        .member("vertices", sc.nv)
+        .member("tets", sc.nt)
+        .member("contacts", contacts)
+        .member("obstacle_contacts", obstacle_contacts);
+    if (edges) j.member("edge_face_contacts", edges->contacts.size()).member("edge_face_ms", edges_ms);
+    j.member("hash", to_string(params.hash))
+        .member("method", to_string(params.method))
+        .member("repeat", repeat)
+        .member("median_ms", t.stats.ms_total)
+        .member("first_call_ms", t.first.ms_total)
+        .member("setup_ms", t.first.ms_setup);
+    j.key("run_ms").begin_array();
+    for (const double ms : t.ms)
+        j.value(ms);
+    j.end_array();
+    for (const study::StatField& field : study::k_detect_stats)
+        if (field.use & study::in_detect) study::write_stat(j, field, t.stats);
+    j.end_object();
+    const std::string f = j.str() + "\n";
+    io::write_text_file(o.stats_path, f);
+}
+
+void run(const DetectOptions& o)
+{
+    if (o.continuous) {
+        run_continuous_detection(o);
+        return;
+    }
+    const bool side_by_side = o.method == "all"; // every method side by side
+    DetectParams params = params_of(o, side_by_side);
+    const int repeat = o.repeat_given ? o.repeat : side_by_side ? 3 : 1;
+    if (repeat < 1) throw Error("--repeat: expected ≥ 1, got " + std::to_string(repeat));
+    const bool edges = o.edges || !o.edge_contacts_path.empty();
+    if (side_by_side && (!o.contacts_path.empty() || !o.stats_path.empty() || !o.obstacles.empty() || edges))
+        throw Error(std::string(!o.contacts_path.empty()       ? "--contacts"
+                                : !o.stats_path.empty()        ? "--stats"
+                                : !o.obstacles.empty()         ? "--obstacle"
+                                : o.edge_contacts_path.empty() ? "--edges"
+                                                               : "--edge-contacts") +
+                    ": not with --method all, which prints the comparison table (give one --method NAME)");
+    params.threads = set_threads(parse_threads(o.threads));
+    check_objects_from_labels_value(o.objects_from_labels);
+    check_output_paths(o);
+    // Obstacles: read and built (checked closed, not self-intersecting) before the work.
+    ObstacleSet obstacles;
+    for (const std::string& path : o.obstacles) {
+        const io::SurfaceMesh surface = io::read_surface(path);
+        obstacles.add(Bsp(surface.vertices, surface.triangles, "--obstacle " + path));
+    }
+    DetectScene sc = load_detect_scene(o);
+    params.table_size = parse_table_size(o.table_size, sc.nv);
+    if (side_by_side) {
+        compare_all_methods(sc.mesh, sc.nv, sc.nt, sc.num_objects, sc.vobj, sc.tobj, sc.objects, params, repeat);
+        return;
+    }
+    Detector det(params);
+    det.set_topology(sc.mesh.tets, sc.nv, sc.vobj, sc.tobj, sc.objects);
+    const TimedDetection timed = time_detection(det, sc.mesh.positions, repeat);
+    const std::vector<Contact>& contacts = det.contacts();
+    print_detection(sc, params, timed, repeat, contacts.size());
+    const std::vector<ObstacleContact> inside = query_obstacles(obstacles, sc.mesh.positions, o.obstacles);
     EdgeFaceResult edge_result;
     double edges_ms = 0;
     if (edges) {
         const auto t0 = std::chrono::steady_clock::now();
-        edge_result = find_edge_face_contacts(scene.tets, scene.positions, vobj, tobj, objects, params.threads);
+        edge_result =
+            find_edge_face_contacts(sc.mesh.tets, sc.mesh.positions, sc.vobj, sc.tobj, sc.objects, params.threads);
         edges_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         fmt::print("edge-face contacts: {} ({:.3f} ms; {} boundary edges, {} boundary faces, {} candidates)\n",
                    edge_result.contacts.size(), edges_ms, edge_result.edges.rows(), edge_result.faces.rows(),
                    edge_result.candidates);
         if (!o.edge_contacts_path.empty())
-            io::write_text_file(o.edge_contacts_path, edge_contacts_csv(edge_result, files));
+            io::write_text_file(o.edge_contacts_path, edge_contacts_csv(edge_result, sc.files));
     }
-
-    if (!o.contacts_path.empty()) {
-        if (io::extension_of(o.contacts_path) == ".vtu") {
-            scene.vertex_object = vobj;
-            scene.tet_object = tobj;
-            write_contacts_vtu(o.contacts_path, scene, det.contacts(), inside);
-        } else if (obstacles.size() > 0) {
-            // Rows carry depths: the tet contacts' are computed here.
-            std::vector<Contact> valued = contacts;
-            scene.vertex_object = vobj;
-            scene.tet_object = tobj;
-            compute_penetration(scene, valued);
-            io::write_text_file(o.contacts_path, contacts_csv(valued, files, o.obstacles, inside, vobj));
-        } else {
-            io::write_text_file(o.contacts_path, contacts_csv(contacts, files));
-        }
-    }
-    if (!o.stats_path.empty()) {
-        study::JsonWriter j;
-        j.begin_object()
-            .member("objects", num_objects)
-            .member("vertices", nv)
-            .member("tets", nt)
-            .member("contacts", contacts.size())
-            .member("obstacle_contacts", inside.size());
-        if (edges) j.member("edge_face_contacts", edge_result.contacts.size()).member("edge_face_ms", edges_ms);
-        j.member("hash", to_string(params.hash))
-            .member("method", to_string(params.method))
-            .member("repeat", repeat)
-            .member("median_ms", median_ms)
-            .member("first_call_ms", first.ms_total)
-            .member("setup_ms", first.ms_setup);
-        j.key("run_ms").begin_array();
-        for (const double t : ms)
-            j.value(t);
-        j.end_array();
-        for (const study::StatField& field : study::k_detect_stats)
-            if (field.use & study::in_detect) study::write_stat(j, field, stats);
-        j.end_object();
-        const std::string f = j.str() + "\n";
-        io::write_text_file(o.stats_path, f);
-    }
+    if (!o.contacts_path.empty()) write_contacts(o, sc, det.contacts(), inside, obstacles.size() > 0);
+    if (!o.stats_path.empty())
+        write_stats(o, sc, params, timed, repeat, contacts.size(), inside.size(), edges ? &edge_result : nullptr,
+                    edges_ms);
 }
 
 Registrar reg{

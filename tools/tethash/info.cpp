@@ -199,7 +199,7 @@ void run(const InfoOptions& given)
     InfoOptions opt = given;
     std::vector<std::string> surfaces;
     std::erase_if(opt.meshes, [&](const std::string& path) {
-        const bool surface = io::is_surface_path(path) && !io::is_tet_mesh_path(path);
+        const bool surface = io::classify_path(path) == io::PathKind::surface;
         if (surface) surfaces.push_back(path);
         return surface;
     });

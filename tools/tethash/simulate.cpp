@@ -4,6 +4,7 @@
 #include "simulate_ccd.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -82,7 +83,7 @@ struct SimulateOptions {
 /// A file name whose extension is a mesh's (tet mesh or surface), not a scene's.
 bool looks_like_a_mesh(const std::string& path)
 {
-    return io::is_tet_mesh_path(path) || io::is_surface_path(path);
+    return io::classify_path(path) != io::PathKind::unknown;
 }
 
 /// The scene `--mesh FILE` runs: the mesh scaled by `scale`, its up axis `up`, centred over the origin with its

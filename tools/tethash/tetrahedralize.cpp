@@ -103,7 +103,7 @@ void run_tetrahedralize(const TetrahedralizeOptions& o)
 {
     if (o.resolution < 1 || o.resolution > 1000)
         throw Error("--resolution " + std::to_string(o.resolution) + ": must be at least 1 and at most 1000");
-    if (io::is_tet_mesh_path(o.surface) && !io::is_surface_path(o.surface))
+    if (io::classify_path(o.surface) == io::PathKind::tet_mesh)
         throw Error(o.surface + ": is a tet mesh format, expected a closed surface (.obj .stl .ply .off .gltf ...); "
                                 "'tethash convert' changes the format of tet meshes");
     io::check_mesh_output_file(o.out, "--out");

@@ -65,6 +65,11 @@ void write_mesh(const std::string& path, const TetMesh& mesh, const Fields& fiel
 /// True if `path` has an extension read_mesh knows.
 bool is_tet_mesh_path(const std::string& path);
 
+/// What a file holds, told by its extension: a tet mesh (read_mesh), a surface (io/surface.hpp: obstacles and
+/// tetrahedralization) or neither. The one test the simulator, `info` and `tetrahedralize` make.
+enum class PathKind { tet_mesh, surface, unknown };
+PathKind classify_path(const std::string& path);
+
 /// check_output_file plus: the extension is one write_mesh knows.
 void check_mesh_output_file(const std::string& path, const std::string& what = "output");
 

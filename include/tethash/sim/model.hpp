@@ -73,6 +73,13 @@ struct Energy {
 /// whose tets are much worse than regular are floored.
 inline constexpr double material_courant = 0.1;
 
+/// Coulomb friction (on the ground and in contacts) is smoothed below a sliding speed of this many times the object's
+/// size per second (the largest side of its rest bounding box; Model::friction_speed), so that a scene moves the same
+/// whatever the unit of length: 1 mm/s for a body 5 cm across, as the former absolute 1 mm/s, and 2 cm/s at 1 m.
+/// Smaller (1e-3: 50 µm/s at 5 cm) made the friction of small stiff bodies too stiff for the sweeps: a 5 cm octopus
+/// of young 1e9 gained 17 % of its scene's energy at 1/240 (test StiffSmallBodiesNeitherGainEnergyNorBlowUp).
+inline constexpr double friction_smoothing = 0.02;
+
 /// Everything computed once from the rest state.
 struct Model {
     Springs springs;
@@ -84,6 +91,9 @@ struct Model {
     std::vector<double> object_frequency_sq;
     std::vector<double> mass; ///< n lumped masses (static objects: their own mass, unused)
     std::vector<char> fixed;  ///< n: 1 = pinned or static (never moves)
+    /// n: the sliding speed (length / s) below which friction on the vertex is smoothed: friction_smoothing × the
+    /// size of its object.
+    std::vector<double> friction_speed;
     Eigen::Vector3d gravity{0, 0, 0};
     Ground ground;
     /// Per-vertex ground penalty stiffness and damping (n each); empty: ground.stiffness / ground.damping
@@ -134,8 +144,8 @@ struct Model {
     /// scale_k · K + scale_c · C at fixed positions, with every per-element quantity (spring blocks, volume
     /// gradients, ground coefficients) evaluated once, so that repeated products (CG iterations) cost no
     /// square roots or cross products. Same matrix as apply_matrix / add_matrix_diagonal at those positions.
-    /// Products are gathered per vertex over its springs and tets (no write conflicts; serial: on the shared
-    /// 2-core machine OpenMP regions per CG iteration measured 5-8× slower than one thread).
+    /// Products are gathered per vertex over its springs and tets (no write conflicts; serial: an OpenMP region per
+    /// CG iteration costs more than the products it shares out; docs/simulator.md has the figure).
     struct Linearised {
         std::vector<Eigen::Matrix3d> spring_block;     ///< per spring
         std::vector<Eigen::Matrix<double, 4, 3>> grad; ///< per volume term: ∇V scaled by sqrt(scale_k k_V / V0)

@@ -114,8 +114,8 @@ struct Scene {
     /// vbd, automatic sweeps: a substep has converged when a sweep's moves (in the local Hessians' norm: the energy
     /// they take out) are below this fraction of the largest sweep's, and below a thousandth of the energy the scene
     /// has to spend (or stalled below it); in [0, 1) (0: the energy test and stalls only). The energy test is what
-    /// keeps runs from gaining energy; this one buys accuracy (the hand at 1 m: 0.3 rests 5 % below the converged
-    /// height at 1.0× Bullet's mean step, 0.1 at 1.3 % below at 1.6×; docs/simulator.md).
+    /// keeps runs from gaining energy; this one buys accuracy: lower values rest closer to the converged state at
+    /// a higher cost per step (figures in docs/simulator.md, "Figures behind the code's constants").
     double convergence = 0.3;
     /// vbd, automatic sweeps: the most a substep may take; a substep that reaches it is counted unconverged
     /// (StepStats::unconverged, the run's summary and warnings).
@@ -125,14 +125,15 @@ struct Scene {
     bool coarse_space = true;
     /// vbd: Chebyshev acceleration of the sweeps (Wang 2015, as in the VBD paper): the estimated spectral radius
     /// ρ of one sweep, in [0, 1); 0 = off; negative (the default) = automatic: off with the coarse space, 0.9
-    /// without (6 sweeps with ρ 0.9 sagged closer to the converged answer than 10 plain sweeps on the hand).
+    /// without (a few accelerated sweeps come closer to the converged answer than more plain ones; docs/simulator.md).
     double acceleration = -1;
     /// vbd: keep tets the right way out. A vertex's step never lowers one of its tets (slivers aside) below a
     /// tenth of its rest volume, the sweeps start from a state that inverts none (corners taken back to the
-    /// substep's start), and tets still inverted at the end are turned back corner by corner. Off by default: it
-    /// leaves almost no tet inverted (P1 at 1/240: 2 instead of 36, the raptor 0 instead of 45, the mat 0 instead
-    /// of 518) but holds squeezed regions back, so a crumpling body collapses more slowly than the converged step
-    /// (the mat's mean height after 0.5 s at 1/60: 0.31 m against 0.044 converged; docs/simulator.md).
+    /// substep's start), and tets still inverted at the end of each substep are turned back corner by corner.
+    /// Without it the tets a step leaves inverted are still turned back after the step, which leaves a few in
+    /// tangles of thin parts; with it none but slivers stay inverted. Off by default: it holds squeezed regions
+    /// back, so a crumpling body collapses more slowly than the converged step (docs/simulator.md, "Inversion
+    /// guard", has the figures).
     bool inversion_guard = false;
     double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean
                                 ///< edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep
@@ -140,10 +141,10 @@ struct Scene {
     double tolerance = 1e-6;    ///< CG relative residual
     ContactParams contact;
     /// Detector parameters. threads defaults to 1 here (not 0 = all cores): the detection of a simulation step
-    /// is short, and on a shared 2-core machine the OpenMP workers spinning between steps slowed whole steps
-    /// 3-8× (default scene 13.6 vs 4.8 ms/step); `[detector] threads` or `--threads` choose more.
+    /// is short, and on a shared machine the OpenMP workers spinning between steps take the core the integrator
+    /// needs; `[detector] threads` or `--threads` choose more.
     /// skin defaults to 0.3 × the cell size: candidates are reused while every vertex moved less than half of
-    /// it (exact either way; measured 25-30 % less detection time per step on default.toml and pile.toml).
+    /// it (exact either way, less detection time per step on moving scenes; figures in docs/simulator.md).
     DetectParams detect = [] {
         DetectParams p;
         p.threads = 1;

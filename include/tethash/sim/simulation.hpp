@@ -17,6 +17,7 @@
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
+#include "tethash/sim/step_stats.hpp"
 
 #include <csignal>
 #include <cstdint>
@@ -31,25 +32,6 @@ namespace tethash::sim {
 class Interrupted : public std::runtime_error {
   public:
     using std::runtime_error::runtime_error;
-};
-
-/// Timing and contact figures of one step (all its substeps). Times in milliseconds.
-struct StepStats {
-    double ms_detect = 0;           ///< Detector::detect
-    double ms_depth = 0;            ///< penetration depth and direction (Penetration::compute)
-    double ms_proximity = 0;        ///< margin and speculative contacts (near pairs of far surfaces)
-    double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
-    double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
-    std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
-    std::int64_t near_contacts = 0; ///< margin contacts at the last substep: vertices near a far surface
-    std::int64_t ignored_local = 0; ///< self-contacts at the last substep left to the elastic terms: the tet lies
-                                    ///< within 2 mean edges of the vertex in the rest state (local inversion)
-    double max_depth = 0;           ///< largest penetration depth at the last substep (0 without contacts)
-    double mean_depth = 0;          ///< mean over contacts at the last substep
-    int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
-    int substeps = 1;               ///< substeps the step took (scene substeps, or more where it was refined)
-    int unconverged = 0;            ///< substeps whose iterations reached their cap unconverged (vbd: max_iterations)
-    int tightened = 0;              ///< times the step was taken again with tighter tolerances for energy it gained
 };
 
 /// How far a run can be trusted, kept over its steps so far (Simulation::health()). A passive scene (everything

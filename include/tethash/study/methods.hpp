@@ -23,7 +23,7 @@ void parse_partition_param(const std::string& option, const std::string& text, D
 /// "--levels": the hierarchical grid).
 bool method_uses(Method method, const std::string& option);
 
-/// Methods of a comma-separated list: names of the grammar (detect.hpp: parse_method) or "all" (every method
+/// Methods of a comma-separated list: names of the grammar (detect_grammar.hpp: parse_method) or "all" (every method
 /// but auto, in all_methods() order). Throws Error naming `option`.
 std::vector<Method> parse_method_list(const std::string& text, const std::string& option = "--methods");
 

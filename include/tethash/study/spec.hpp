@@ -3,7 +3,7 @@
 /// What a study is: the sweep, its scenes and the value lists of its parameters, as the command line gives them.
 ///
 /// Value lists ("specs") are comma-separated items:
-///  Single values follow the grammar of every command (detect.hpp: parse_cell_size, parse_table_size,
+///  Single values follow the grammar of every command (detect_grammar.hpp: parse_cell_size, parse_table_size,
 ///  parse_threads): a plain number is a length or a count, "xF" a factor.
 ///  - cell size: factors of the scene's mean edge length "x0.5,x1,x2", lengths "0.01", "auto" (= x1), or a
 ///    log-spaced range of factors "xFROM:xTO:POINTS" (e.g. "x0.125:x8:13") or of lengths "FROM:TO:POINTS".

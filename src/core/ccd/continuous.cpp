@@ -3,9 +3,9 @@
 // is the box itself), the narrow phase of ccd.hpp, per-thread lists merged and sorted.
 #include "tethash/continuous.hpp"
 
-#include "../boundary_edges.hpp"
 #include "../team.hpp"
 #include "../triangle_bvh.hpp"
+#include "boundary_edges.hpp"
 #include "tethash/error.hpp"
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // Candidate reuse of the hash detector (the skin, docs/detection.md): whether the kept candidates still hold every
 // contact, keeping them after a full detection, and stage 3 alone over them.
+#include "../team.hpp"
 #include "detector_impl.hpp"
-#include "team.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>

@@ -3,8 +3,8 @@
 // fallback), then a deterministic merge sorted by (vertex, tet).
 #include "tethash/detect.hpp"
 
+#include "../team.hpp"
 #include "detector_impl.hpp"
-#include "team.hpp"
 #include "tethash/error.hpp"
 #include "tethash/predicates.hpp"
 

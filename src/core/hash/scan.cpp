@@ -2,7 +2,7 @@
 // survivors extracted by bit scan), or one at a time. The AVX2 version is compiled with a target attribute
 // and chosen at run time, so one build runs everywhere and uses AVX2 where present.
 #include "scan.hpp"
-#include "simd.hpp"
+#include "../simd.hpp"
 
 #include "tethash/predicates.hpp"
 

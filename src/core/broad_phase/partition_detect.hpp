@@ -1,8 +1,8 @@
 #pragma once
 // The detector's path for the methods other than the hash (private header): a broad phase (broad_phase.hpp) finds
 // the candidates, the exact stage shared by every method tests them and sorts the contacts.
+#include "../hash/detect_checks.hpp"
 #include "broad_phase.hpp"
-#include "detect_checks.hpp"
 
 #include <memory>
 #include <vector>

@@ -2,7 +2,7 @@
 // operations of predicates::orient3d in its order, or one at a time with predicates::inside_tet.
 #include "inside_batch.hpp"
 
-#include "simd.hpp"
+#include "../simd.hpp"
 #include "tethash/predicates.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)

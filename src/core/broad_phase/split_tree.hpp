@@ -11,6 +11,8 @@
 ///
 /// Build is serial and deterministic; `query` is const and may run from several threads at once (each
 /// thread passes its own `SplitTreeScratch`). Buffers are kept across builds.
+///
+/// Internal to tethash (the tree broad phases and the spheres study), not installed.
 
 #include "tethash/error.hpp"
 

@@ -3,10 +3,10 @@
 // merged and sorted.
 #include "tethash/edge_contacts.hpp"
 
+#include "../hash/detect_checks.hpp"
+#include "../hash/hash_grid.hpp"
+#include "../team.hpp"
 #include "boundary_edges.hpp"
-#include "detect_checks.hpp"
-#include "hash_grid.hpp"
-#include "team.hpp"
 #include "tethash/predicates.hpp"
 
 #include <Eigen/Geometry>

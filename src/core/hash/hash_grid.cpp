@@ -1,7 +1,7 @@
 // Stage 1: counting sort of the vertices by bucket into one contiguous structure of arrays.
 #include "hash_grid.hpp"
 
-#include "team.hpp"
+#include "../team.hpp"
 
 #include <algorithm>
 

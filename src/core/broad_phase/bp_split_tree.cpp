@@ -1,7 +1,7 @@
 // The splitting-plane trees as broad phases: a new tree over the vertices per call (as the comparison of octree,
 // k-d and BSP trees builds them), then every tet box queried in parallel, each thread with its own output and stamp.
 #include "bp_common.hpp"
-#include "tethash/split_tree.hpp"
+#include "split_tree.hpp"
 
 namespace tethash::detail {
 

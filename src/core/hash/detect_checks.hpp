@@ -1,7 +1,10 @@
 #pragma once
-// Input checks shared by the Detector (src/core/detect.cpp) and the oracle (src/oracle): private header
-// (defined in detect_checks.cpp; validate_params with the parameter grammar in detect_params.cpp).
+// Input checks shared by the Detector (src/core/hash/detect.cpp) and the oracle (src/oracle): private header
+// (defined in detect_checks.cpp; validate_params with the parameter grammar of detect_grammar.hpp in
+// detect_params.cpp).
+#include "table_size.hpp"
 #include "tethash/detect.hpp"
+#include "tethash/detect_grammar.hpp"
 
 #include <span>
 #include <vector>

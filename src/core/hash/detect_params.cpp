@@ -1,7 +1,7 @@
 // The text grammar of the detector's parameters (detect.hpp): the one parser behind every command's
 // --cell-size, --table-size, --threads and --skin, so that a value means the same thing everywhere.
+#include "../enum_names.hpp"
 #include "detect_checks.hpp"
-#include "enum_names.hpp"
 #include "hash_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"

@@ -1,7 +1,7 @@
 // The splitting-plane tree: octree, k-d tree and BSP tree as one structure (split_tree.hpp, docs/partitions.md).
-#include "tethash/split_tree.hpp"
+#include "split_tree.hpp"
 
-#include "enum_names.hpp"
+#include "../enum_names.hpp"
 #include "tethash/error.hpp"
 
 #include <algorithm>

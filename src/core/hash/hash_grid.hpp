@@ -13,6 +13,7 @@
 /// - column: (mix(x, y) + z) mod n: the cells of one (x, y) column land in consecutive buckets, so a
 ///   tet looks up a whole z-run of cells as one (or, wrapping around, two) contiguous bucket ranges.
 
+#include "table_size.hpp"
 #include "tethash/detect.hpp"
 
 #include <cstdint>
@@ -85,8 +86,6 @@ struct TableModulus {
         return (h % n + zm) % n;
     }
 };
-
-// auto_table_size() and next_prime() are declared in detect.hpp (the table-size grammar uses them).
 
 /// Stage 1: the vertex table. Keeps its buffers across builds.
 class VertexTable {

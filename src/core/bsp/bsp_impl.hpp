@@ -2,9 +2,9 @@
 // The solid-leaf BSP tree behind Bsp (private header): its nodes, plane groups and fragments, and the exact
 // triangle tests that both the surface check (bsp_check.cpp) and the closed query (bsp.cpp) use
 // (bsp_geometry.cpp).
+#include "../triangle_bvh.hpp"
 #include "tethash/bsp.hpp"
 #include "tethash/predicates.hpp"
-#include "triangle_bvh.hpp"
 
 #include <Eigen/Geometry>
 

@@ -3,11 +3,11 @@
 // kept for reuse and the class that holds them. detect.cpp runs the pipeline (set-up, stage 1, the parallel region,
 // the merge, the statistics); detect_stages.cpp holds stages 2 and 3 of one tet; detect_reuse.cpp candidate reuse
 // (the skin); the other methods' path is partition_detect.cpp.
+#include "../broad_phase/partition_detect.hpp"
+#include "../timing.hpp"
 #include "detect_checks.hpp"
 #include "hash_grid.hpp"
-#include "partition_detect.hpp"
 #include "tethash/detect.hpp"
-#include "timing.hpp"
 
 #include <algorithm>
 #include <cstdint>

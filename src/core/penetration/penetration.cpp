@@ -1,6 +1,7 @@
 #include "tethash/penetration.hpp"
 
-#include "triangle_bvh.hpp"
+#include "../timing.hpp"
+#include "../triangle_bvh.hpp"
 
 #include "tethash/geometry.hpp"
 
@@ -10,7 +11,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -397,7 +397,7 @@ void Penetration::set_topology(const TetMesh& mesh)
 
 void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, PenetrationStats* stats)
 {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = detail::Clock::now();
     PenetrationImpl& s = *m_impl;
     if (!s.ready) throw Error("penetration: set_topology was not called");
     if (x.rows() != s.n)
@@ -515,7 +515,7 @@ void Penetration::compute(const PositionsRef& x, std::span<Contact> contacts, Pe
         for (int k = 0; k < 3; ++k)
             contacts[c].direction[k] = p.dir[k];
     }
-    st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    st.ms = detail::ms_since(t0);
     if (stats) *stats = st;
 }
 

@@ -6,9 +6,9 @@
 #include "partition_detect.hpp"
 
 #include "inside_batch.hpp"
-#include "team.hpp"
+#include "../team.hpp"
+#include "../timing.hpp"
 #include "tethash/predicates.hpp"
-#include "timing.hpp"
 
 #include <algorithm>
 #include <cassert>

@@ -13,6 +13,7 @@
 //
 // Query: exact orient3d against the node's original vertices; a zero follows both children, IN if either says
 // IN (the closed polyhedron is the union of the closed IN cells).
+#include "../timing.hpp"
 #include "bsp_impl.hpp"
 
 #include "tethash/error.hpp"
@@ -22,7 +23,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -229,7 +229,7 @@ Index BspImpl::nearest(const Vec3& p, Vec3& q, double& d2) const
 Bsp::Bsp(const PositionsRef& vertices, const Eigen::Ref<const Triangles>& triangles, const std::string& what)
     : m_impl(std::make_unique<BspImpl>())
 {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = detail::Clock::now();
     BspImpl& b = *m_impl;
     b.vertices = vertices;
     b.triangles = triangles;
@@ -272,7 +272,7 @@ Bsp::Bsp(const PositionsRef& vertices, const Eigen::Ref<const Triangles>& triang
                                         b.triangle_group.size() * sizeof(Index) +
                                         b.tree.nodes().size() * sizeof(detail::TriangleBvh::Node) +
                                         static_cast<std::size_t>(m) * (sizeof(Index) + sizeof(Vec3)));
-    s.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    s.build_ms = detail::ms_since(start);
 }
 
 Bsp::~Bsp() = default;

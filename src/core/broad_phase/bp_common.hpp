@@ -2,9 +2,10 @@
 // Pieces shared by the broad phases (private header): tet boxes of a whole scene, the cell coordinate every grid uses
 // for points and box corners alike, per-vertex static flags, the vertices sorted by x, the parallel loops over
 // vertices and tets that feed the threads' sinks, a timer.
+#include "../hash/table_size.hpp"
+#include "../team.hpp"
+#include "../timing.hpp"
 #include "broad_phase.hpp"
-#include "team.hpp"
-#include "timing.hpp"
 
 #include <chrono>
 #include <cmath>
