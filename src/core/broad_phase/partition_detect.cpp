@@ -5,9 +5,9 @@
 // sort fixes the order, so the output is bit for bit the same for every method and thread count.
 #include "partition_detect.hpp"
 
-#include "inside_batch.hpp"
 #include "../team.hpp"
 #include "../timing.hpp"
+#include "inside_batch.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>
