@@ -673,8 +673,8 @@ std::vector<std::string> RunHealth::problems() const
                       " substeps stopped at max_iterations unconverged: raise max_iterations or lower dt");
     if (refined_steps > 0)
         out.push_back(std::to_string(refined_steps) + " of " + std::to_string(steps) +
-                      " steps were taken again in more substeps (tets inverted, a blow-up or iterations unconverged at "
-                      "dt): dt is large for the material or the impacts");
+                      " steps were taken again in more substeps (tets inverted, a blow-up, iterations unconverged or "
+                      "energy gained at dt): dt is large for the material or the impacts");
     if (tets > 0 && inverted_end * 1000 > tets)
         out.push_back(std::to_string(inverted_end) + " of " + std::to_string(tets) + " tets (" +
                       percent(static_cast<double>(inverted_end) / static_cast<double>(tets)) + ") end inverted");
