@@ -7,8 +7,20 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
 
 namespace tethash::test {
 
@@ -152,6 +164,26 @@ inline GifFile parse_gif(const std::string& d)
         }
     }
     return fail("no trailer");
+}
+
+/// A PNG file's pixels (stb_image's decoder, a reader of its own): `ok` false when it does not decode.
+struct Png {
+    bool ok = false;
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgb; ///< 3 bytes a pixel, rows from the top
+};
+
+inline Png decode_png(const std::string& bytes)
+{
+    Png r;
+    int n = 0;
+    unsigned char* px = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                              static_cast<int>(bytes.size()), &r.width, &r.height, &n, 3);
+    if (!px) return r;
+    r.ok = true;
+    r.rgb.assign(px, px + 3 * static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height));
+    stbi_image_free(px);
+    return r;
 }
 
 } // namespace tethash::test

@@ -6,17 +6,6 @@
 
 #include <filesystem>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#endif
-#include <stb/stb_image.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
 using namespace tethash::test;
 namespace fs = std::filesystem;
 
@@ -61,21 +50,6 @@ f 3 8 7
 f 4 1 5
 f 4 5 8
 )";
-
-struct Png {
-    int width = 0, height = 0;
-    bool ok = false;
-};
-
-Png read_png(const fs::path& p)
-{
-    Png r;
-    int n = 0;
-    unsigned char* px = stbi_load(p.string().c_str(), &r.width, &r.height, &n, 3);
-    r.ok = px != nullptr;
-    stbi_image_free(px);
-    return r;
-}
 
 fs::path run_scene(const fs::path& dir, const std::string& extra = "")
 {
@@ -124,7 +98,7 @@ TEST(CliRender, DrawsAPngOfARunAndAGifWithOneImagePerFrame)
         const auto r = run_tethash("render " + quote(input) + " -o " + quote(dir / "a.png") + " --size 320x200");
         ASSERT_EQ(r.status, 0) << r.err;
         EXPECT_NE(r.out.find("wrote"), std::string::npos);
-        const Png png = read_png(dir / "a.png");
+        const Png png = decode_png(read_text(dir / "a.png"));
         EXPECT_TRUE(png.ok);
         EXPECT_EQ(png.width, 320);
         EXPECT_EQ(png.height, 200);
@@ -133,7 +107,7 @@ TEST(CliRender, DrawsAPngOfARunAndAGifWithOneImagePerFrame)
     const auto strip =
         run_tethash("render " + quote(out) + " -o " + quote(dir / "s.png") + " --size 100x80 --times 0,0.004,0.012");
     ASSERT_EQ(strip.status, 0) << strip.err;
-    const Png s = read_png(dir / "s.png");
+    const Png s = decode_png(read_text(dir / "s.png"));
     EXPECT_EQ(s.width, 300);
     EXPECT_EQ(s.height, 80);
     const auto r = run_tethash("render " + quote(out) + " -o " + quote(dir / "a.gif") +

@@ -14,17 +14,6 @@
 
 #include <random>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#endif
-#include <stb/stb_image.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
 using namespace tethash;
 using namespace tethash::test;
 using render::Rgb;
@@ -203,14 +192,11 @@ TEST(RenderPictures, PngDecodesToTheImageDrawn)
     for (auto& v : image.rgb)
         v = static_cast<std::uint8_t>(rng());
     const std::string png = render::encode_png(image);
-    int w = 0, h = 0, n = 0;
-    unsigned char* px = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(png.data()),
-                                              static_cast<int>(png.size()), &w, &h, &n, 3);
-    ASSERT_NE(px, nullptr);
-    EXPECT_EQ(w, 37);
-    EXPECT_EQ(h, 21);
-    EXPECT_TRUE(std::equal(image.rgb.begin(), image.rgb.end(), px));
-    stbi_image_free(px);
+    const Png decoded = decode_png(png);
+    ASSERT_TRUE(decoded.ok);
+    EXPECT_EQ(decoded.width, 37);
+    EXPECT_EQ(decoded.height, 21);
+    EXPECT_TRUE(decoded.rgb == image.rgb);
 }
 
 TEST(RenderPictures, GifHasOneImagePerFrameThatDecodesToThePalettesColours)

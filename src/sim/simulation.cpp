@@ -254,7 +254,7 @@ int SimulationImpl::approach_substeps(int most) const
     int substeps = scene.substeps;
     while (substeps < most && closing > substeps)
         substeps *= 2;
-    return std::min(substeps, std::max(most, scene.substeps));
+    return std::min(substeps, most);
 }
 
 void SimulationImpl::check_time_step()
