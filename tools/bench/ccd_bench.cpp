@@ -2,6 +2,7 @@
 // ../shared/ccd (handcrafted degenerate motions, ground truth) and on random queries that a broad phase would pass
 // on (the swept boxes overlap), with small and large motions. Times are CPU time of the thread, the median of
 // --repeat runs over the same queries.
+#include "machine.hpp"
 #include "tethash/ccd.hpp"
 #include "tethash/io/ccd_queries.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -191,15 +192,7 @@ int main(int argc, char** argv)
     std::printf("tethash_ccd_bench: %s, flags '%s', %u hardware threads, 1 thread, load %.2f %.2f %.2f\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), load[0], load[1],
                 load[2]);
-    {
-        std::ifstream cpu("/proc/cpuinfo");
-        std::string line;
-        while (std::getline(cpu, line))
-            if (line.rfind("model name", 0) == 0) {
-                std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
-                break;
-            }
-    }
+    std::printf("machine: %s\n", tethash::bench::machine_name().c_str());
     const tethash::ccd::CcdParams defaults;
     std::printf("tolerance %g, at most %lld boxes per query; CPU time of one thread, median of %d runs\n\n",
                 defaults.tolerance, static_cast<long long>(defaults.max_iterations), repeat);

@@ -2,6 +2,7 @@
 // file, or of the generator's torus, side by side, one object each), at 800x600 by default: the drawing alone
 // (rasterising a frame read before) and a frame read and drawn (the .vtu read, its boundary faces from the topology,
 // kept across frames). Medians of the repeats; the machine and the compiler flags printed with them.
+#include "machine.hpp"
 #include "tethash/io/mesh_io.hpp"
 #include "tethash/io/pvd.hpp"
 #include "tethash/io/vtu.hpp"
@@ -46,14 +47,7 @@ int main(int argc, char** argv)
     CLI11_PARSE(app, argc, argv);
 
     std::printf("tethash_render_bench: %s, flags '%s'\n", TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS);
-    {
-        std::ifstream cpu("/proc/cpuinfo");
-        for (std::string line; std::getline(cpu, line);)
-            if (line.rfind("model name", 0) == 0) {
-                std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
-                break;
-            }
-    }
+    std::printf("machine: %s\n", tethash::bench::machine_name().c_str());
     // Copies of one body side by side along x (each an object), falling a little from frame to frame.
     TetMesh body;
     if (mesh.empty()) {

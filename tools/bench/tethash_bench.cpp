@@ -13,6 +13,7 @@
 //   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building and the hall with every
 //   object
 //                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
+#include "machine.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/detect_grammar.hpp"
 #include "tethash/edge_contacts.hpp"
@@ -522,13 +523,7 @@ void print_header(const BenchOptions& o, int threads_all)
     std::printf("tethash_bench: %s, flags '%s', %d hardware threads, repeat %d (median), cell %.3g x mean edge, "
                 "table auto, hash %s\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, threads_all, o.repeat, o.cell_factor, o.hash.c_str());
-    std::ifstream cpu("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(cpu, line))
-        if (line.rfind("model name", 0) == 0) {
-            std::printf("machine: %s\n", line.substr(line.find(':') + 2).c_str());
-            break;
-        }
+    std::printf("machine: %s\n", bench::machine_name().c_str());
     const char* simd = std::getenv("TETHASH_SIMD");
     std::printf("scan kernel: %s\n\n",
                 simd && std::strcmp(simd, "scalar") == 0 ? "scalar (TETHASH_SIMD)" : "avx2 if supported");
