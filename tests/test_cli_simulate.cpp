@@ -108,14 +108,24 @@ TEST(CliSimulate, DefaultSceneRuns)
         double sum = 0;
         int stages = 0;
         for (const char* stage :
-             {"detection ", "depth ", "proximity ", "response ", "integration ", "checks and output "}) {
+             {"detection ", "depth ", "proximity ", "response ", "integration ", "checks ", "output and progress "}) {
             const size_t k = r.out.find(stage, at);
             ASSERT_NE(k, std::string::npos) << stage << "\n" << r.out;
             sum += std::stod(r.out.substr(k + std::strlen(stage)));
             ++stages;
         }
-        EXPECT_EQ(stages, 6);
+        EXPECT_EQ(stages, 7);
         EXPECT_NEAR(sum, ms_step, 0.005 + 0.0005 * stages) << r.out;
+    }
+    // A scene file's default thread count is every core, fewer in the steps where they do not pay: the summary
+    // says how many steps ran at each count (all ten in all).
+    if (r.out.find(" steps, up to ") != std::string::npos) {
+        const size_t at = r.out.find("threads: ");
+        ASSERT_NE(at, std::string::npos) << r.out;
+        const size_t every = r.out.find("(every core) for ", at), one = r.out.find(", 1 for ", at);
+        ASSERT_NE(every, std::string::npos) << r.out;
+        ASSERT_NE(one, std::string::npos) << r.out;
+        EXPECT_EQ(std::stoi(r.out.substr(every + 17)) + std::stoi(r.out.substr(one + 8)), 10) << r.out;
     }
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00000.vtu"));
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "frame_00010.vtu"));

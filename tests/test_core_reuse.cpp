@@ -408,3 +408,40 @@ TEST(CoreReuse, BadSkinIsAnErrorNamingTheParameter)
         EXPECT_THROW(det.set_params(p), Error);
     }
 }
+
+TEST(CoreReuse, ThreadCountChangedBetweenCallsKeepsTheAnswer)
+{
+    // Detector::set_threads between calls (the simulator's count chosen step by step): every call equals a
+    // from-scratch detection; a call on another count than the last runs a full detection (its kept candidates
+    // were sorted by the old team), a call on the same count may reuse them; the set-up is kept (no ms_setup).
+    const Motion mo{.angle = 0.002, .speed = 0.001, .jitter = 0.0002, .jump = 0.0, .period = 8, .jump_every = 0};
+    Scene s = test::random_scene(11, 4, 3, 0.3);
+    DetectParams p;
+    p.skin = 0.06;
+    p.threads = 1;
+    Detector d(p);
+    set_topology(d, s);
+    DetectParams fresh_params = p;
+    fresh_params.skin = 0;
+    std::mt19937 rng(11);
+    const int counts[] = {1, 1, 2, 2, 2, 1, 1, 2, 2, 1, 1, 1};
+    int last = 1, reused_after_change = 0, reused_same = 0;
+    for (int step = 0; step < 12; ++step) {
+        if (step > 0) step_scene(s, step, rng, mo);
+        d.set_threads(counts[step]);
+        DetectStats st;
+        const std::vector<Contact> got = d.detect(s.positions, &st);
+        Detector fresh(fresh_params);
+        set_topology(fresh, s);
+        EXPECT_TRUE(identical(got, fresh.detect(s.positions))) << "step " << step;
+        if (step > 0) {
+            EXPECT_EQ(st.ms_setup, 0.0) << "step " << step << ": a new thread count must not redo the set-up";
+            (counts[step] != last ? reused_after_change : reused_same) += st.reused;
+        }
+        last = counts[step];
+    }
+    EXPECT_EQ(reused_after_change, 0);
+    EXPECT_GT(reused_same, 0);
+    EXPECT_THROW(d.set_threads(-1), Error);
+    EXPECT_EQ(d.params().threads, 1) << "a refused count leaves the last one";
+}

@@ -2,6 +2,7 @@
 // the material does not depend on the mesh's slivers (the same body meshed twice sags the same), and real
 // meshes from ../shared/meshes drop and collide at dt 1/240 and 1/60 without blow-up, crumpling or far
 // self-penetration. Skips cleanly where ../shared/meshes is absent.
+#include "../src/sim/thread_choice.hpp"
 #include "support.hpp"
 
 #include "tethash/detect.hpp"
@@ -16,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <set>
 
 using namespace tethash;
 using tethash::test::expect_error;
@@ -165,17 +167,29 @@ TEST(SimBlockDescent, BitIdenticalAtOneAndTwoThreads)
         s.output.every = 0;
         return s;
     };
-    Simulation one(scene(1)), two(scene(2));
+    // threads = 0: every core, with steps on one thread now and then (thread_choice.hpp), changing the count
+    // between steps: the same bits again.
+    Simulation one(scene(1)), two(scene(2)), chosen(scene(0));
     ASSERT_GT(one.mesh().num_vertices(), 6000);
     std::int64_t contacts = 0;
+    std::set<int> counts;
     for (int i = 0; i < 40; ++i) {
         one.step();
         two.step();
+        chosen.step();
         contacts += one.last_stats().contacts;
+        counts.insert(chosen.last_stats().threads);
+        EXPECT_EQ(one.last_stats().threads, 1);
+        EXPECT_EQ(two.last_stats().threads, 2);
         ASSERT_TRUE((one.positions().array() == two.positions().array()).all()) << "step " << i + 1;
         ASSERT_TRUE((one.velocities().array() == two.velocities().array()).all()) << "step " << i + 1;
+        ASSERT_TRUE((one.positions().array() == chosen.positions().array()).all()) << "step " << i + 1;
+        ASSERT_TRUE((one.velocities().array() == chosen.velocities().array()).all()) << "step " << i + 1;
     }
     EXPECT_GT(contacts, 0);
+    if (tethash::sim::detail::ThreadChoice::every_core() > 1) {
+        EXPECT_EQ(counts.size(), 2U) << "the run with threads = 0 should have taken steps at both counts";
+    }
 }
 
 TEST(SimBlockDescent, AutomaticSweepsFollowConvergenceAndReportTheCap)

@@ -166,6 +166,10 @@ class Detector {
     /// Sets parameters; validated (throws Error naming the parameter and value).
     void set_params(const DetectParams& params);
     const DetectParams& params() const;
+    /// Changes the thread count alone (0 = every hardware thread), keeping the set-up and the kept candidates (a
+    /// call with another count than the last runs a full detection): for a caller that adapts its count between
+    /// calls. The contacts do not depend on it. Throws Error outside 0..max(256, hardware threads).
+    void set_threads(int threads);
 
     /// Sets the topology once. `tets` is m × 4; `vertex_object`/`tet_object` give object ids (empty: all 0);
     /// `objects[k]` gives the options of object k (missing: defaults). The number of vertices is fixed here.

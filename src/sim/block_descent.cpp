@@ -126,6 +126,14 @@ class BlockDescent final : public StepIntegrator {
         return true;
     }
     void relax() override { m_tighter = 0; }
+    void set_threads(int threads) override
+    {
+#ifdef TETHASH_HAVE_OPENMP
+        m_threads = std::max(1, threads);
+#else
+        (void)threads;
+#endif
+    }
 
   private:
     void setup();

@@ -32,6 +32,11 @@ class ContactResponse {
     void setup(const Scene& scene, const TetMesh& mesh, const Model& model, const std::vector<ObjectOptions>& options,
                const SceneObstacles* obstacles = nullptr);
     bool enabled() const { return m_enabled; }
+    /// The detector's thread count from the next update on (0 = every core); the contacts do not depend on it.
+    void set_threads(int threads)
+    {
+        if (m_enabled) m_detector.set_threads(threads);
+    }
 
     /// Detects at `x`, drops the local self-contacts, fills depth/direction, adds the margin contacts for a
     /// substep h at velocities v (proximity.hpp), and the coefficients. Adds its times

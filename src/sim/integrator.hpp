@@ -41,6 +41,8 @@ class StepIntegrator {
     /// integrator cannot (a direct or explicit method, or already at its tightest); `relax` when the step is taken.
     virtual bool tighten() { return false; }
     virtual void relax() {}
+    /// The thread count of the next substeps (≥ 1); the result does not depend on it. Ignored by default.
+    virtual void set_threads(int /*threads*/) {}
 };
 
 std::unique_ptr<StepIntegrator> make_symplectic_euler(const StepContext& ctx);

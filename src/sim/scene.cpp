@@ -659,6 +659,10 @@ Scene parse_scene(const std::string& text, const std::string& source_name, const
                         std::to_string(s.pins[i].object) + " does not exist (" + std::to_string(s.objects.size()) +
                         " objects)");
     if (s.objects.empty()) throw Error(source_name + ": the scene has no [[object]]");
+    // A scene file runs on every core unless it says otherwise: fewer in the steps where they do not pay
+    // (simulation.hpp; the C++ Scene's own default stays one thread).
+    const toml::table* detector = root["detector"].as_table();
+    if (!detector || !detector->contains("threads")) s.detect.threads = 0;
     if (up) {
         if (!root.contains("gravity")) s.gravity = -9.81 * *up;
         const toml::table* ground = root["ground"].as_table();

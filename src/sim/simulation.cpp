@@ -7,6 +7,7 @@
 #include "integrator.hpp"
 #include "objects.hpp"
 #include "obstacles.hpp"
+#include "thread_choice.hpp"
 
 #include "core/timing.hpp"
 
@@ -87,6 +88,10 @@ class SimulationImpl {
     double volume0 = 0;        // volume of the dynamic tets at the start
     std::vector<double> sizes; // per object: the longest extent of its box at the start
     const volatile std::sig_atomic_t* interrupt = nullptr;
+    // threads = 0: the count chosen step by step (thread_choice.hpp); `threads_now` the count set in the stages.
+    detail::ThreadChoice thread_choice;
+    bool choose_threads = false;
+    int threads_now = 1;
 
     explicit SimulationImpl(const Scene& s);
     std::string object_name(size_t k) const
@@ -156,6 +161,9 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     start_health();
     check_time_step();
     set_auto_max_substeps();
+    threads_now = scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core();
+    choose_threads = scene.detect.threads == 0 && threads_now > 1;
+    if (choose_threads) thread_choice = detail::ThreadChoice(threads_now);
 }
 
 void SimulationImpl::set_auto_max_substeps()
@@ -380,6 +388,13 @@ Simulation& Simulation::operator=(Simulation&&) noexcept = default;
 void Simulation::step()
 {
     SimulationImpl& s = *m_impl;
+    const auto t_step = Clock::now();
+    if (s.choose_threads && s.thread_choice.threads() != s.threads_now) {
+        s.threads_now = s.thread_choice.threads();
+        // Every core as the scene asked (0: the detector keeps one thread for small scenes), or one.
+        s.contacts.set_threads(s.threads_now == detail::ThreadChoice::every_core() ? 0 : s.threads_now);
+        s.integrator->set_threads(s.threads_now);
+    }
     Positions& x = s.mesh().positions;
     s.x_save = x;
     s.v_save = s.v;
@@ -510,6 +525,9 @@ void Simulation::step()
         sum += d;
     }
     st.mean_depth = st.contacts == 0 ? 0.0 : sum / static_cast<double>(st.contacts);
+    st.threads = s.threads_now;
+    st.ms_step = ms_since(t_step);
+    if (s.choose_threads) s.thread_choice.record(st.ms_step / substeps);
     s.stats = st;
     RunHealth& hl = s.health;
     ++hl.steps;

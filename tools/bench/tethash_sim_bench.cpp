@@ -5,10 +5,13 @@
 // most at any frame of 1/60 s), and
 // the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step. When built
 // with Bullet (libbullet-dev found), each scene and dt also runs with Bullet's soft bodies in the same process
-// (rows "bullet"), so the ratio to the peer comes from one run.
+// (rows "bullet"), so the ratio to the peer comes from one run. With --bodies, generated spheres of about that
+// many tets instead, each at one thread and at --threads: ms per step, ns per tet, bytes per tet and the speed-up
+// of the threads (how the step scales from 10 k to 1 M tets).
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
+#include "tethash/meshing/generate.hpp"
 #include "tethash/sim/quality.hpp"
 #include "tethash/sim/simulation.hpp"
 
@@ -26,6 +29,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <malloc.h>
 #include <map>
 #include <thread>
 
@@ -38,8 +42,11 @@ struct Row {
     double dt = 0;
     Index vertices = 0, tets = 0;
     double ms = 0, detect = 0, depth = 0, proximity = 0, response = 0, integrate = 0, sweeps = 0, contacts = 0;
-    double ms_mean = 0;  ///< mean ms per step: the cost that counts where some steps were refined
-    double substeps = 1; ///< mean substeps per step (more than the scene's where steps were refined)
+    double other = 0;         ///< median over the steps of the step less its stages: checks, copies of retaken steps
+    double threads = 1;       ///< mean threads per step (--threads 0: chosen step by step)
+    double bytes_per_tet = 0; ///< resident memory the run added (set-up, state, detector), per tet
+    double ms_mean = 0;       ///< mean ms per step: the cost that counts where some steps were refined
+    double substeps = 1;      ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
     std::int64_t unconverged = 0;  ///< substeps whose sweeps reached their cap
     std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
@@ -80,19 +87,30 @@ sim::ObjectSpec placed(const TetMesh& mesh, double lift, double size)
     return o;
 }
 
+/// Resident memory of the process (bytes), after giving freed memory back.
+double resident_bytes()
+{
+    malloc_trim(0);
+    std::ifstream statm("/proc/self/statm");
+    double pages = 0, resident = 0;
+    statm >> pages >> resident;
+    return resident * 4096.0;
+}
+
 Row run(const std::string& name, const sim::Scene& scene, int steps)
 {
     Row r;
     r.scene = name;
     r.integrator = sim::to_string(scene.integrator);
     r.dt = scene.dt;
+    const double rss0 = resident_bytes();
     sim::Simulation s(scene);
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
     sim::FarSelfPenetrations far(s.mesh(), start);
     const double energy0 = s.energy().total(), volume0 = sim::total_volume(s.model(), start);
-    std::vector<double> ms, det, dep, prox, resp, integ, sw, con, sub;
+    std::vector<double> ms, det, dep, prox, resp, integ, other, threads, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
     try {
@@ -107,6 +125,9 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
             prox.push_back(st.ms_proximity);
             resp.push_back(st.ms_response);
             integ.push_back(st.ms_integrate);
+            other.push_back(st.ms_step - st.ms_detect - st.ms_depth - st.ms_proximity - st.ms_response -
+                            st.ms_integrate);
+            threads.push_back(st.threads);
             sw.push_back(st.solver_iterations);
             con.push_back(static_cast<double>(st.contacts));
             sub.push_back(st.substeps);
@@ -122,6 +143,8 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.proximity = median(prox);
     r.response = median(resp);
     r.integrate = median(integ);
+    r.other = median(other);
+    r.threads = mean(threads);
     r.sweeps = median(sw);
     r.ms_mean = mean(ms);
     r.substeps = sub.empty() ? 1 : mean(sub);
@@ -133,6 +156,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.energy_ratio = s.energy().total() / energy0;
     r.volume_ratio = sim::total_volume(s.model(), s.positions()) / volume0;
     r.stable = r.failure.empty() && r.inverted <= r.tets / 100;
+    r.bytes_per_tet = std::max(0.0, resident_bytes() - rss0) / static_cast<double>(std::max<Index>(1, r.tets));
     return r;
 }
 
@@ -180,12 +204,13 @@ Row run_peer(const std::string& name, const sim::Scene& scene, int steps, int it
 void print(const Row& r)
 {
     std::printf(
-        "%-36s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %6.1f %5.2f %8.1f %7lld %5lld %5lld %8.4g "
-        "%7.3g %6.3f %6lld %10.3g  %s\n",
+        "%-36s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %4.2g %6.1f %5.2f %8.1f %7lld %5lld "
+        "%5lld %8.4g %7.3g %6.3f %6lld %10.3g  %s\n",
         r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
-        r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, static_cast<long long>(r.inverted),
-        static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max), r.mean_z, r.energy_ratio,
-        r.volume_ratio, static_cast<long long>(r.unconverged), r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
+        r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps, r.contacts,
+        static_cast<long long>(r.inverted), static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max),
+        r.mean_z, r.energy_ratio, r.volume_ratio, static_cast<long long>(r.unconverged),
+        r.stable ? r.dt / r.ms_mean : 0.0, r.failure.c_str());
     std::fflush(stdout);
 }
 
@@ -204,7 +229,7 @@ double parse_dt(const std::string& v)
 struct SimBenchOptions {
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
-    std::vector<double> sizes{1.0}, youngs;
+    std::vector<double> sizes{1.0}, youngs, bodies;
     double seconds = 0.5;
     int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
     double convergence = -1;
@@ -233,8 +258,17 @@ void add_options(CLI::App& app, SimBenchOptions& o)
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
     runs->add_option("--seconds", o.seconds, "simulated time per run")->capture_default_str();
-    runs->add_option("--threads", o.threads, "detector and solver threads")->capture_default_str();
+    runs->add_option("--threads", o.threads,
+                     "detector and solver threads; 0: every core, fewer in the steps where they do not pay (chosen "
+                     "as the run goes, as `tethash simulate` does)")
+        ->capture_default_str();
     runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
+    runs->add_option("--bodies", o.bodies,
+                     "instead of the shared meshes: generated spheres of about these many tets (comma-separated, "
+                     "e.g. 1e4,1e5,1e6; 1 m, dropped 0.2 m), each at one thread and at --threads, with a table of "
+                     "ms per step, ns per tet, bytes per tet and the threads' speed-up")
+        ->delimiter(',')
+        ->check(CLI::Range(1e3, 2e7));
     CLI::Option_group* overrides = app.add_option_group("Scene overrides", "each defaults to the scene's own value");
     overrides->add_option("--iterations", o.iterations, "solver iterations (sweeps) per step; 0 = the scene default");
     overrides->add_option("--max-substeps", o.max_substeps,
@@ -278,9 +312,28 @@ void print_header(SimBenchOptions& o)
 }
 
 /// The scenes: each shared mesh dropped at each size and modulus, and the two armadillos thrown at each other.
+/// --bodies: a sphere of about `tets` tets (the lattice's 6.5 tets per cell cubed), 1 m, dropped 0.2 m.
+std::pair<std::string, sim::Scene> body_scene(double tets)
+{
+    meshing::GenerateParams g;
+    g.shape = "sphere";
+    g.resolution = std::max(2, static_cast<int>(std::lround(std::cbrt(tets / 6.5))));
+    const TetMesh mesh = meshing::generate(g);
+    sim::Scene s;
+    s.objects.push_back(placed(mesh, 0.2, 1.0));
+    s.ground.enabled = true;
+    s.output.every = 0;
+    return {fmt::format("drop sphere {}k", (mesh.num_tets() + 500) / 1000), s};
+}
+
 std::vector<std::pair<std::string, sim::Scene>> make_scenes(const SimBenchOptions& o)
 {
     std::vector<std::pair<std::string, sim::Scene>> scenes;
+    if (!o.bodies.empty()) {
+        for (double tets : o.bodies)
+            scenes.push_back(body_scene(tets));
+        return scenes;
+    }
     const std::vector<std::string> files = {"octopus-low.mesh", "armadillo_4k.node",    "screw.msh",
                                             "P1.msh",           "raptorTetra_8418.vtu", "32770_octocat.msh",
                                             "hand.mesh",        "mat100x100t40.msh",    "quintupleTorus.veg"};
@@ -370,17 +423,34 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         std::ofstream out(tmp);
         if (!out) throw Error("--csv: cannot write '" + tmp + "'");
         out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
-               "ms_response,ms_integrate,iterations,substeps,contacts,inverted,far_self,far_self_max,mean_z,"
-               "energy_ratio,volume_ratio,unconverged,stable,failure\n";
+               "ms_response,ms_integrate,ms_other,threads,iterations,substeps,contacts,inverted,far_self,"
+               "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,failure\n";
         for (const Row& r : rows)
-            out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},"
-                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},\"{}\"\n",
+            out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
+                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},\"{}\"\n",
                                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
-                               r.proximity, r.response, r.integrate, r.sweeps, r.substeps, r.contacts, r.inverted,
-                               r.far_self, r.far_self_max, r.mean_z, r.energy_ratio, r.volume_ratio, r.unconverged,
-                               r.stable ? 1 : 0, r.failure);
+                               r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
+                               r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
+                               r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.failure);
     }
     std::filesystem::rename(tmp, csv);
+}
+
+/// --bodies: per body and time step, the cost per step and per tet, the memory per tet and the threads' speed-up
+/// (rows in pairs: one thread, then --threads, as run).
+void print_bodies(const std::vector<Row>& rows, int threads)
+{
+    std::printf("\nbodies (ns/tet: median ms per step / tets at one thread; B/tet: resident memory the run added):\n");
+    std::printf("%-24s %9s %9s %10s %10s %8s %8s\n", "body", "dt", "tets", "ms 1 thr", "ms more", "speedup", "ns/tet");
+    const size_t stride = threads != 1 ? 2 : 1;
+    for (size_t i = 0; i + stride <= rows.size(); i += stride) {
+        const Row& one = rows[i];
+        const Row& more = rows[i + stride - 1];
+        std::printf("%-24s %9.5f %9lld %10.2f %10.2f %8.2f %8.1f  %.0f B/tet\n", one.scene.c_str(), one.dt,
+                    static_cast<long long>(one.tets), one.ms, stride == 2 ? more.ms : 0.0,
+                    stride == 2 && more.ms > 0 ? one.ms / more.ms : 1.0, 1e6 * one.ms / static_cast<double>(one.tets),
+                    one.bytes_per_tet);
+    }
 }
 
 } // namespace
@@ -406,31 +476,37 @@ int main(int argc, char** argv)
         for (const std::string& i : o.integrators)
             integ.push_back(sim::parse_integrator(i));
         if (!(o.seconds > 0)) throw Error("--seconds must be positive");
-        if (o.threads < 1 || o.threads > 256) throw Error("--threads must be in 1..256");
-        if (!std::filesystem::is_directory(o.meshes_dir)) {
+        if (o.threads < 0 || o.threads > 256) throw Error("--threads must be in 0..256 (0: chosen step by step)");
+        if (o.bodies.empty() && !std::filesystem::is_directory(o.meshes_dir)) {
             std::printf("shared meshes not found at %s: nothing to run\n", o.meshes_dir.c_str());
             return 0;
         }
         print_header(o);
         std::vector<std::pair<std::string, sim::Scene>> scenes = make_scenes(o);
         std::printf(
-            "%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  %s\n",
+            "%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %7s %4s %6s %5s %8s %7s %5s %5s %8s %7s %6s %6s %10s  "
+            "%s\n",
             "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
-            "integr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "E1/E0", "V1/V0", "unconv",
-            "dt/ms", "failure");
+            "integr", "other", "thr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "E1/E0", "V1/V0",
+            "unconv", "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!o.filter.empty() && name.find(o.filter) == std::string::npos) continue;
+            // --bodies: one thread, then --threads (the speed-up of the summary).
+            std::vector<int> thread_counts{o.threads};
+            if (!o.bodies.empty() && o.threads != 1) thread_counts.insert(thread_counts.begin(), 1);
             for (sim::Integrator i : integ)
-                for (double dt : steps_dt) {
-                    apply_overrides(scene, o, i, dt);
-                    const int steps = std::max(1, static_cast<int>(std::lround(o.seconds / dt)));
-                    const Row r = run(name, scene, steps);
-                    print(r);
-                    rows.push_back(r);
-                }
+                for (double dt : steps_dt)
+                    for (int threads : thread_counts) {
+                        apply_overrides(scene, o, i, dt);
+                        scene.detect.threads = threads;
+                        const int steps = std::max(1, static_cast<int>(std::lround(o.seconds / dt)));
+                        const Row r = run(name, scene, steps);
+                        print(r);
+                        rows.push_back(r);
+                    }
 #ifdef TETHASH_HAVE_BULLET
-            if (!o.no_peer)
+            if (!o.no_peer && o.bodies.empty())
                 for (double dt : steps_dt) {
                     scene.dt = dt;
                     const Row r = run_peer(name, scene, std::max(1, static_cast<int>(std::lround(o.seconds / dt))),
@@ -441,6 +517,7 @@ int main(int argc, char** argv)
 #endif
         }
         print_stable_dt(rows);
+        if (!o.bodies.empty()) print_bodies(rows, o.threads);
         if (!o.csv.empty()) write_csv(o.csv, rows);
     } catch (const Error& e) {
         std::fprintf(stderr, "tethash_sim_bench: %s\n", e.what());

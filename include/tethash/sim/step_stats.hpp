@@ -14,6 +14,9 @@ struct StepStats {
     double ms_proximity = 0;        ///< margin and speculative contacts (near pairs of far surfaces)
     double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
     double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
+    double ms_step = 0;             ///< the whole step; less the stages above: its checks (energy, inverted tets,
+                                    ///< blow-up) and the copies of steps taken again
+    int threads = 1;                ///< threads the step ran on (threads = 0: chosen step by step)
     std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
     std::int64_t near_contacts = 0; ///< margin contacts at the last substep: vertices near a far surface
     std::int64_t ignored_local = 0; ///< self-contacts at the last substep left to the elastic terms: the tet lies

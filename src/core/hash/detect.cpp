@@ -355,6 +355,14 @@ const DetectParams& Detector::params() const
     return m_impl->params;
 }
 
+void Detector::set_threads(int threads)
+{
+    DetectParams p = m_impl->params;
+    p.threads = threads;
+    detail::validate_params(p);
+    m_impl->params.threads = threads;
+}
+
 void Detector::set_topology(const TetsRef& tets, Index num_vertices, std::span<const Index> vertex_object,
                             std::span<const Index> tet_object, std::span<const ObjectOptions> objects)
 {
