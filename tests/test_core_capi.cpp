@@ -2,6 +2,7 @@
 // penetration as Penetration, parameters and object options passed through, and every error path answered by a
 // status and a message naming the function (never a crash).
 #include "core_scenes.hpp"
+#include "tethash/continuous.hpp"
 
 #include "tethash/edge_contacts.hpp"
 #include "tethash/oracle.hpp"
@@ -10,8 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <regex>
 #include <string>
 #include <thread>
@@ -117,6 +120,65 @@ TEST(CoreCapi, SameContactsAsDetectorAndOracle)
         expect_same(c, brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object), what.c_str());
         for (const tethash_contact& x : c)
             EXPECT_TRUE(std::isnan(x.depth));
+    }
+}
+
+TEST(CoreCapi, ContinuousContactsAsTheBruteForceOverAStep)
+{
+    // A step of a random scene (each object moved by its own translation and a jitter) through the C API at 1 and 2
+    // threads: the brute force's contacts over all pairs, as vertex ids (the vertex and its face's corners, or the two
+    // edges' ends), kinds and times of impact; too small a capacity, a missing `end` and a wrong vertex count are
+    // refused with a status and the function's name; set_topology forgets the contacts.
+    const test::Scene s = test::random_scene(13, 4, 3, 0.3);
+    Positions x1 = s.positions;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.15, 0.15);
+    for (Eigen::Index v = 0; v < x1.rows(); ++v)
+        x1.row(v) += Eigen::RowVector3d(0.3 * (s.vertex_object[static_cast<size_t>(v)] % 2 ? 1 : -1), 0, 0) +
+                     Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    const ccd::ContinuousResult want = ccd::detect_continuous_brute_force(s.tets, s.positions, x1);
+    ASSERT_GT(want.contacts.size(), 0u);
+    for (int threads : {1, 2}) {
+        Handle h;
+        set_topology(h.d, s);
+        ASSERT_EQ(tethash_detector_set_threads(h.d, threads), TETHASH_OK);
+        int64_t count = -1;
+        ASSERT_EQ(
+            tethash_detector_detect_continuous(h.d, s.positions.data(), x1.data(), x1.rows(), 1e-6, 1000000, &count),
+            TETHASH_OK)
+            << tethash_last_error();
+        ASSERT_EQ(count, static_cast<int64_t>(want.contacts.size()));
+        std::vector<int32_t> kind(static_cast<size_t>(count)), vertices(4 * static_cast<size_t>(count));
+        std::vector<double> toi(static_cast<size_t>(count));
+        ASSERT_EQ(tethash_detector_get_continuous_contacts(h.d, count, kind.data(), vertices.data(), toi.data()),
+                  TETHASH_OK);
+        for (size_t i = 0; i < want.contacts.size(); ++i) {
+            const ccd::ContinuousContact& c = want.contacts[i];
+            const bool vf = c.kind == ccd::ContinuousKind::vertex_face;
+            EXPECT_EQ(kind[i], vf ? 0 : 1) << i;
+            EXPECT_EQ(toi[i], c.toi) << i;
+            const std::array<Index, 4> ids =
+                vf ? std::array<Index, 4>{c.a, want.faces(c.b, 0), want.faces(c.b, 1), want.faces(c.b, 2)}
+                   : std::array<Index, 4>{want.edges(c.a, 0), want.edges(c.a, 1), want.edges(c.b, 0),
+                                          want.edges(c.b, 1)};
+            for (size_t k = 0; k < 4; ++k)
+                EXPECT_EQ(vertices[4 * i + k], ids[k]) << "contact " << i << " vertex " << k;
+        }
+        expect_error(tethash_detector_get_continuous_contacts(h.d, count - 1, nullptr, nullptr, nullptr),
+                     TETHASH_ERROR_INVALID_ARGUMENT, "tethash_detector_get_continuous_contacts");
+        expect_error(
+            tethash_detector_detect_continuous(h.d, s.positions.data(), nullptr, x1.rows(), 1e-6, 1000000, &count),
+            TETHASH_ERROR_NULL_ARGUMENT, "tethash_detector_detect_continuous");
+        expect_error(tethash_detector_detect_continuous(h.d, s.positions.data(), x1.data(), x1.rows() - 1, 1e-6,
+                                                        1000000, &count),
+                     TETHASH_ERROR_INVALID_ARGUMENT, "tethash_detector_detect_continuous");
+        expect_error(
+            tethash_detector_detect_continuous(h.d, s.positions.data(), x1.data(), x1.rows(), -1.0, 1000000, &count),
+            TETHASH_ERROR_INVALID_ARGUMENT, "tethash_detector_detect_continuous");
+        EXPECT_EQ(count, 0) << "a refused call reports no contacts";
+        set_topology(h.d, s);
+        EXPECT_EQ(tethash_detector_get_continuous_contacts(h.d, 0, nullptr, nullptr, nullptr), TETHASH_OK)
+            << "set_topology forgets the last continuous contacts";
     }
 }
 

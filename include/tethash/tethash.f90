@@ -149,6 +149,28 @@ module tethash
       real(c_double), intent(out), optional :: t(*), face_bary(*), normal(*)
       integer(c_int) :: status
     end function
+    function tethash_detector_detect_continuous(detector, start, end, num_vertices, tolerance, max_iterations, &
+                                                count) bind(C, name="tethash_detector_detect_continuous") result(status)
+      import :: c_ptr, c_int, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      real(c_double), intent(in) :: start(*), end(*)
+      integer(c_int64_t), value :: num_vertices
+      real(c_double), value :: tolerance
+      integer(c_int64_t), value :: max_iterations
+      integer(c_int64_t), intent(out) :: count
+      integer(c_int) :: status
+    end function
+    ! Absent optional arrays are not filled: kind(capacity) (0 vertex-face, 1 edge-edge), vertices(4, capacity)
+    ! (0-based vertex ids: the vertex and the face's corners, or the two edges' ends), toi(capacity).
+    function tethash_detector_get_continuous_contacts(detector, capacity, kind, vertices, toi) &
+        bind(C, name="tethash_detector_get_continuous_contacts") result(status)
+      import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      integer(c_int64_t), value :: capacity
+      integer(c_int32_t), intent(out), optional :: kind(*), vertices(*)
+      real(c_double), intent(out), optional :: toi(*)
+      integer(c_int) :: status
+    end function
     function tethash_detector_compute_penetration(detector, positions, num_vertices) &
         bind(C, name="tethash_detector_compute_penetration") result(status)
       import :: c_ptr, c_int, c_int64_t, c_double

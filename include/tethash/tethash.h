@@ -153,6 +153,24 @@ tethash_status tethash_ccd_vertex_face(const double* start, const double* end, d
 tethash_status tethash_ccd_edge_edge(const double* start, const double* end, double tolerance, int64_t max_iterations,
                                      int32_t* out_hit, double* out_toi);
 
+/** Continuous detection over a step (continuous.hpp): every boundary vertex against every boundary face and every
+ *  boundary edge against every boundary edge of the detector's topology, moving linearly from `start` (t = 0) to
+ *  `end` (t = 1), each num_vertices x 3 and read in place; pairs that share a vertex are left out, every other pair
+ *  is tested, within an object and between objects (the object options do not apply: the contacts carry vertex ids,
+ *  the caller keeps what its rules allow). `tolerance` and `max_iterations` as in tethash_ccd_vertex_face; the
+ *  detector's threads. Nothing that meets within the step is missed. Writes the number of contacts to `out_count`
+ *  (may be NULL); they stay readable until the next call or set_topology. Independent of tethash_detector_detect. */
+tethash_status tethash_detector_detect_continuous(tethash_detector* detector, const double* start, const double* end,
+                                                  int64_t num_vertices, double tolerance, int64_t max_iterations,
+                                                  int64_t* out_count);
+/** Copies the contacts of the last tethash_detector_detect_continuous, vertex-face first, each sorted, into caller
+ *  arrays of `capacity` rows, each may be NULL: kind (capacity: 0 vertex-face, 1 edge-edge), vertices (capacity x 4
+ *  vertex ids: the vertex then the face's corners in outward order, or the first edge's two ends then the second's),
+ *  toi (capacity: a time in [0, 1] no later than the pair's first contact). `capacity` must be at least their
+ *  count. */
+tethash_status tethash_detector_get_continuous_contacts(const tethash_detector* detector, int64_t capacity,
+                                                        int32_t* kind, int32_t* vertices, double* toi);
+
 #ifdef __cplusplus
 } /* extern "C" */
 #endif

@@ -5,6 +5,7 @@
 #include "tethash/tethash.h"
 
 #include "tethash/ccd.hpp"
+#include "tethash/continuous.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/edge_contacts.hpp"
 #include "tethash/error.hpp"
@@ -36,6 +37,7 @@ struct tethash_detector {
     tethash::EdgeFaceDetector edges;
     bool edges_ready = false;                             ///< edges has the current topology and object options
     const tethash::EdgeFaceResult* edge_result = nullptr; ///< the last edge-face contacts of the current topology
+    tethash::ccd::ContinuousResult continuous;            ///< the last continuous detection of the current topology
 };
 
 namespace {
@@ -89,6 +91,7 @@ void apply_topology(tethash_detector& d)
     d.has_topology = false;
     d.edges_ready = false;
     d.edge_result = nullptr;
+    d.continuous = {};
     d.detector.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object, d.objects);
     d.has_topology = true;
 }
@@ -468,6 +471,64 @@ tethash_status tethash_detector_get_edge_contacts(const tethash_detector* detect
         }
         if (t) t[i] = c.edge_t;
         if (inner_end) inner_end[i] = c.inner_end;
+    }
+    return TETHASH_OK;
+}
+
+tethash_status tethash_detector_detect_continuous(tethash_detector* detector, const double* start, const double* end,
+                                                  int64_t num_vertices, double tolerance, int64_t max_iterations,
+                                                  int64_t* out_count)
+{
+    const char* where = "tethash_detector_detect_continuous";
+    if (out_count) *out_count = 0;
+    if (const tethash_status s =
+            check_positions(where, detector, &tethash_detector::has_topology, "no topology set", start, num_vertices);
+        s != TETHASH_OK)
+        return s;
+    if (!end && num_vertices > 0) return null_argument(where, "end");
+    return guard(where, [&] {
+        tethash_detector& d = *detector;
+        d.continuous = {};
+        const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+        const Eigen::Map<const tethash::Positions> x0(start, static_cast<Eigen::Index>(num_vertices), 3);
+        const Eigen::Map<const tethash::Positions> x1(end, static_cast<Eigen::Index>(num_vertices), 3);
+        tethash::ccd::ContinuousParams params;
+        params.query.tolerance = tolerance;
+        params.query.max_iterations = max_iterations;
+        params.threads = d.detector.params().threads;
+        d.continuous = tethash::ccd::detect_continuous(tets, x0, x1, params);
+        if (out_count) *out_count = static_cast<int64_t>(d.continuous.contacts.size());
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_get_continuous_contacts(const tethash_detector* detector, int64_t capacity,
+                                                        int32_t* kind, int32_t* vertices, double* toi)
+{
+    const char* where = "tethash_detector_get_continuous_contacts";
+    if (!detector) return null_argument(where, "detector");
+    const tethash::ccd::ContinuousResult& r = detector->continuous;
+    const std::size_t count = r.contacts.size();
+    if (capacity < 0 || static_cast<std::size_t>(capacity) < count)
+        return invalid(where, "capacity " + std::to_string(capacity) + " is less than the " + std::to_string(count) +
+                                  " continuous contacts");
+    for (std::size_t i = 0; i < count; ++i) {
+        const tethash::ccd::ContinuousContact& c = r.contacts[i];
+        const bool vf = c.kind == tethash::ccd::ContinuousKind::vertex_face;
+        if (kind) kind[i] = vf ? 0 : 1;
+        if (toi) toi[i] = c.toi;
+        if (!vertices) continue;
+        std::int32_t* row = vertices + 4 * i;
+        if (vf) {
+            row[0] = static_cast<std::int32_t>(c.a);
+            for (Eigen::Index k = 0; k < 3; ++k)
+                row[1 + k] = static_cast<std::int32_t>(r.faces(c.b, k));
+        } else {
+            for (Eigen::Index k = 0; k < 2; ++k) {
+                row[k] = static_cast<std::int32_t>(r.edges(c.a, k));
+                row[2 + k] = static_cast<std::int32_t>(r.edges(c.b, k));
+            }
+        }
     }
     return TETHASH_OK;
 }

@@ -6,7 +6,8 @@
  * is 0.1 and the direction (0, 0, -1). Moving vertex 7 to z = -0.1 in the caller's array (no new registration)
  * leaves no contact. The edges from the base to vertex 7 (4-7, 5-7, 6-7) cross tet 0's face z = 0 at t = 1 / 1.1 of
  * the way, their inner end (vertex 7) above it, the triangle's normal (0, 0, -1): three edge-face contacts, none
- * after the move. Exit status 0 when everything holds, 1 otherwise. */
+ * after the move. Moving vertex 7 back up over a step, continuous detection finds it passing through tet 0's base at
+ * t = 0.5. Exit status 0 when everything holds, 1 otherwise. */
 #include <tethash/tethash.h>
 
 #include <math.h>
@@ -106,6 +107,30 @@ int main(void)
     check(count == 0, "no contact after the move");
     check(tethash_detector_find_edge_contacts(d, xyz, 8, &count) == TETHASH_OK && count == 0,
           "no edge-face contact after the move");
+
+    /* Continuous detection over a step: vertex 7 back from z = -0.1 to 0.1 passes through tet 0's base face (0 1 2)
+     * at t = 0.5; its edges cross that face inside it, meeting no edge: one vertex-face contact. */
+    {
+        double back[8 * 3];
+        memcpy(back, xyz, sizeof back);
+        back[7 * 3 + 2] = 0.1;
+        check(tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK,
+              "detect_continuous");
+        check(count == 1, "one continuous contact");
+        int32_t kind = -1, ids[4] = {-1, -1, -1, -1};
+        double toi = -1;
+        if (count == 1) {
+            check(tethash_detector_get_continuous_contacts(d, 1, &kind, ids, &toi) == TETHASH_OK,
+                  "get_continuous_contacts");
+            check(kind == 0 && ids[0] == 7, "vertex 7 against a face");
+            check(ids[1] + ids[2] + ids[3] == 3 && ids[1] * ids[2] * ids[3] == 0 && ids[1] != ids[2] &&
+                      ids[1] != ids[3] && ids[2] != ids[3],
+                  "the face 0 1 2");
+            check(toi <= 0.5 && toi > 0.4999, "at t = 0.5");
+        }
+        check(tethash_detector_detect_continuous(d, xyz, xyz, 8, 1e-6, 1000000, &count) == TETHASH_OK && count == 0,
+              "no continuous contact without motion");
+    }
 
     tethash_detector_destroy(d);
 

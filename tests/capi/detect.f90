@@ -1,7 +1,8 @@
 ! A Fortran program using the detector through the `tethash` module, on the scene of detect.c, checked against the
 ! result worked out by hand there: vertex 8 (0-based 7) at (0.2, 0.2, 0.1) inside tet 1 (0-based 0), barycentric
 ! (0.5, 0.2, 0.2, 0.1), penetration depth 0.1 along -z, and the three edge-face contacts of the edges into it; no
-! contact after the caller moves it to z = -0.1.
+! contact after the caller moves it to z = -0.1; moved back up over a step, continuous detection finds it passing
+! through tet 1's base at t = 0.5.
 ! Stops with status 1 on any failure.
 program detect_fortran
   use, intrinsic :: iso_c_binding
@@ -21,6 +22,8 @@ program detect_fortran
   integer(c_int32_t) :: hit
   integer(c_int32_t) :: edge(2, 3), inner_end(3)
   real(c_double) :: t(3), normal(3, 3)
+  real(c_double) :: x_end(3, 8), cont_toi(1)
+  integer(c_int32_t) :: kind(1), ids(4, 1)
 
   failures = 0
   x = reshape([0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, &
@@ -76,6 +79,20 @@ program detect_fortran
   x(3, 8) = -0.1d0
   call ok(tethash_detector_detect(d, x, 8_c_int64_t, count), "detect after the move")
   call expect(count == 0, "no contact after the move")
+
+  ! Continuous detection over a step: vertex 8 back from z = -0.1 to 0.1 passes through tet 1's base at t = 0.5.
+  x_end = x
+  x_end(3, 8) = 0.1d0
+  call ok(tethash_detector_detect_continuous(d, x, x_end, 8_c_int64_t, 1d-6, 1000000_c_int64_t, count), &
+          "detect_continuous")
+  call expect(count == 1, "one continuous contact")
+  if (count == 1) then
+    call ok(tethash_detector_get_continuous_contacts(d, 1_c_int64_t, kind=kind, vertices=ids, toi=cont_toi), &
+            "get_continuous_contacts")
+    call expect(kind(1) == 0 .and. ids(1, 1) == 7, "vertex 7 (0-based) against a face")
+    call expect(sum(ids(2:4, 1)) == 3 .and. product(ids(2:4, 1)) == 0, "the face 0 1 2")
+    call expect(cont_toi(1) <= 0.5d0 .and. cont_toi(1) > 0.4999d0, "at t = 0.5")
+  end if
 
   call tethash_detector_destroy(d)
 
