@@ -171,7 +171,7 @@ TEST(SimProximity, BoxFilterKernelsAgree)
     // box meets the query's, in order, as the direct test does.
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.0f, 0.6f);
-    const auto kernels = detail::box_filters();
+    const auto kernels = tethash::detail::box_filters();
     ASSERT_FALSE(kernels.empty());
     int met = 0, missed = 0;
     for (int trial = 0; trial < 400; ++trial) {
@@ -222,5 +222,5 @@ TEST(SimProximity, BoxFilterKernelsAgree)
 
 TEST(SimProximity, BoxFilterFollowsTethashSimd)
 {
-    expect_kernel_follows_tethash_simd(detail::box_filter_name());
+    expect_kernel_follows_tethash_simd(tethash::detail::box_filter_name());
 }
