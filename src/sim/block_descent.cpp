@@ -10,14 +10,14 @@
 // as a corner of the penetrated tet). Damping is relative: springs on their rate of length change, volume terms
 // on the rate of volume change, contacts on the relative normal velocity; rigid motion is never damped.
 //
-// What makes it robust on real meshes (measured on hand.mesh; docs/simulator.md): each local Newton step is clamped
-// to a fifth of the object's mean edge (without it the same settings gave 0 or ~1,700 inverted tets depending on
+// What makes it robust on real meshes (docs/simulator.md): each local Newton step is clamped to a fifth of the
+// object's mean edge (without it the same settings gave no inverted tets or a crumpled body depending on
 // round-off); contact terms use the contacts' relative displacement taken at the start of each iteration (Jacobi
 // across the contact's five nodes), so no two threads ever read a position another one writes.
 //
 // What makes it right at every size (docs/simulator.md, "Convergence"): the sweeps needed grow with ω h (ω the
 // material's frequency at the mean edge, which grows as the body shrinks), so a fixed count left small bodies
-// unconverged: they sagged flat and ended drops with up to 230 times their start energy. Now
+// unconverged: they sagged flat and ended drops with many times their start energy. Now
 // - every third sweep a coarse space (a lattice over each object, coarse_space.hpp) corrects the long waves that
 //   sweeps carry one ring of vertices at a time, its length chosen by a line search;
 // - sweeps run until converged: the last sweep's moves, measured in the local Hessians' norm (twice the energy
@@ -33,9 +33,9 @@
 // After each step (finish_step), the tets it left inverted are turned back corner by corner, positions only, in
 // moves of at most a twentieth of the mean edge that press no other tet of the corner towards inversion
 // (inversion_guard.hpp): slivers pressed flat on the ground, the odd tet of an impact. The refinement of steps and
-// the crumple check read the count before it, so a crumpling body is still refined or stopped. Without it, the
-// hand's drop at 1/240 ends with 3 inverted tets (slivers on the ground), P1's with 36, the raptor's 45 and the
-// crumpling mat's 518 (docs/simulator.md has what it leaves).
+// the crumple check read the count before it, so a crumpling body is still refined or stopped. Without it, drops
+// end with inverted slivers on the ground, and a crumpling sheet with hundreds (docs/simulator.md, "Figures behind
+// the code's constants", has the counts and what it leaves).
 //
 // With `inversion_guard`, no tet ends a substep inverted where it can be helped: a vertex's step never lowers one of
 // its tets (slivers aside) below a tenth of its rest volume, or further once there (the inversion guard, exact since
@@ -95,19 +95,21 @@ struct Sym3 {
     }
 };
 
-/// Sweeps between two corrections of the coarse space (coarse_space.hpp): on the hand at 15 cm and 1 m, every second
-/// sweep cost more than it saved (two residual passes per correction), every fourth converged in more sweeps.
+/// Sweeps between two corrections of the coarse space (coarse_space.hpp): every second sweep cost more than it saved
+/// (two residual passes per correction), every fourth converged in more sweeps (docs/simulator.md, "Figures behind
+/// the code's constants").
 constexpr int sweeps_per_correction = 3;
 /// An automatic substep has converged when, besides `convergence`, its last sweep took out less than this fraction of
-/// the energy the scene has to spend (energy_scale). At 5 cm the relative test alone stopped the hand, octocat and the
-/// raptor with 1.9×, 4.5× and 7× their start energy at the end of a drop (the sweeps' remaining error is stiff: it
-/// stores (ω h)² times the energy its length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much.
+/// the energy the scene has to spend (energy_scale). On small bodies the relative test alone stopped drops that ended
+/// with several times their start energy (the sweeps' remaining error is stiff: it stores (ω h)² times the energy its
+/// length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much (docs/simulator.md, "Figures behind
+/// the code's constants").
 constexpr double energy_tolerance = 1e-3;
 /// The coarse correction moves no vertex further than this many times its sweep clamp (a fifth of its object's mean
 /// edge), the whole correction shortened alike; its length along that direction is then the line search's.
 constexpr double coarse_reach = 1.0;
 /// Sweeps an automatic substep takes at least: one, so that a body in free fall (its start is the answer) pays one
-/// sweep, not three (the hand's drop: 1.08× Bullet's mean step with three, 1.01× with one, the same end state).
+/// sweep, not three (the same end state at a lower cost; docs/simulator.md, "Figures behind the code's constants").
 constexpr int min_sweeps_automatic = 1;
 /// Times a step that gained energy is taken again, each with the convergence tests ten times tighter.
 constexpr int max_tighter = 2;
@@ -817,8 +819,8 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     // vertex; g at the first substep): y in free fall, x + h v for a body at rest. Starting from y, a resting body
     // began every substep g h² lower, pressed into the ground (at 1/60 that is 2.7 mm: an edge of a 5 cm body), and
     // the sweeps spent themselves lifting it back. The clamp matters: the whole last acceleration extrapolated an
-    // impact's rebound into the next start, and where the sweeps stopped short that bias put energy in (a 5 cm
-    // octopus ended a drop with 47 times its start energy).
+    // impact's rebound into the next start, and where the sweeps stopped short that bias put energy in (small bodies
+    // ended drops with tens of times their start energy; docs/simulator.md, "Figures behind the code's constants").
     const Eigen::Vector3d& g = model.gravity;
     const double g_norm = g.norm();
     const Eigen::Vector3d down = g_norm > 0 ? Eigen::Vector3d(g / g_norm) : Eigen::Vector3d::Zero();
@@ -857,8 +859,9 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     // Stop when no vertex moved more than this fraction of its clamp length (a fifth of its object's mean edge).
     const double stop = 5 * m_ctx.scene.sweep_tolerance;
     // A step refined into k times the scene's substeps gives each a k-th of the energy tolerance, so that what a
-    // step may leave unconverged does not grow with its refinement (a 5 cm octocat of young 1e9 took 100 substeps a
-    // step and ended its drop with 5.6 times its start energy, every substep converged).
+    // step may leave unconverged does not grow with its refinement (a small stiff body taken in a hundred substeps a
+    // step ended its drop with several times its start energy, every substep converged; docs/simulator.md, "Figures
+    // behind the code's constants").
     const double refined_share = tighter * std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
     int sweeps = 0;
     double omega = 1, moved_max = 0;
