@@ -1,8 +1,7 @@
 // Contact before penetration (src/sim/proximity.hpp): margin contacts and speculative contacts. A thin plate
 // thrown at another faster than its thickness per step does not tunnel; bodies that start touching are not pushed
 // apart by the margin; a margin contact names the nearest face's tet with the closest point's coordinates; the
-// scene keys are read and checked; the grid's box filter kernels agree.
-#include "../src/sim/proximity.hpp"
+// scene keys are read and checked (the grid's box filter: test_core_box_grid.cpp).
 #include "sim_support.hpp"
 #include "support.hpp"
 
@@ -11,8 +10,6 @@
 #include "tethash/sim/simulation.hpp"
 
 #include <cmath>
-#include <limits>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -162,65 +159,4 @@ TEST(SimProximity, SceneKeys)
     expect_error([&] { load_scene((dir / "bad.toml").string()); }, {"contact.margin", "bad.toml"});
     write_text(dir / "bad2.toml", "[contact]\nspeculative = 3\n[[object]]\ngenerate = { shape = \"box\" }\n");
     expect_error([&] { load_scene((dir / "bad2.toml").string()); }, {"contact.speculative", "bad2.toml"});
-}
-
-TEST(SimProximity, BoxFilterKernelsAgree)
-{
-    // Random buckets of 0-40 boxes (touching the query exactly, NaN corners, every tail length of the eight-wide
-    // kernel, boxes that meet the query right after the range): each kernel gives the entries of the range whose
-    // box meets the query's, in order, as the direct test does.
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.0f, 0.6f);
-    const auto kernels = detail::box_filters();
-    ASSERT_FALSE(kernels.empty());
-    int met = 0, missed = 0;
-    for (int trial = 0; trial < 400; ++trial) {
-        const int n = static_cast<int>(rng() % 41), begin = static_cast<int>(rng() % 5);
-        std::vector<float> col[6];
-        for (auto& c : col)
-            c.assign(static_cast<size_t>(begin + n + 8), 0.0f);
-        float q[6];
-        for (int k = 0; k < 3; ++k) {
-            q[k] = u(rng);
-            q[3 + k] = q[k] + size(rng);
-        }
-        // Boxes before and after the range too (a bucket's neighbours in the grid's columns), the ones after
-        // all meeting the query.
-        for (int e = 0; e < begin + n + 8; ++e)
-            for (int k = 0; k < 3; ++k) {
-                if (e >= begin + n) {
-                    col[k][static_cast<size_t>(e)] = q[k];
-                    col[3 + k][static_cast<size_t>(e)] = q[3 + k];
-                    continue;
-                }
-                const float lo = u(rng);
-                col[k][static_cast<size_t>(e)] = rng() % 16 == 0 ? q[3 + k] : lo; // touching the query's hi
-                col[3 + k][static_cast<size_t>(e)] = rng() % 16 == 0 ? q[k] : lo + size(rng);
-                if (rng() % 64 == 0) col[k][static_cast<size_t>(e)] = std::numeric_limits<float>::quiet_NaN();
-            }
-        std::vector<std::int32_t> expected;
-        for (int e = begin; e < begin + n; ++e) {
-            bool miss = false;
-            for (int k = 0; k < 3; ++k)
-                miss = miss || q[3 + k] < col[k][static_cast<size_t>(e)] || q[k] > col[3 + k][static_cast<size_t>(e)];
-            if (!miss) expected.push_back(e);
-        }
-        met += static_cast<int>(expected.size());
-        missed += n - static_cast<int>(expected.size());
-        const float* const columns[6] = {col[0].data(), col[1].data(), col[2].data(),
-                                         col[3].data(), col[4].data(), col[5].data()};
-        for (const auto& [name, filter] : kernels) {
-            std::vector<std::int32_t> hits(static_cast<size_t>(n) + 1, -1);
-            const std::int32_t count = filter(columns, begin, begin + n, q, hits.data());
-            hits.resize(static_cast<size_t>(count));
-            EXPECT_EQ(hits, expected) << name << " trial " << trial;
-        }
-    }
-    EXPECT_GT(met, 100);
-    EXPECT_GT(missed, 100);
-}
-
-TEST(SimProximity, BoxFilterFollowsTethashSimd)
-{
-    expect_kernel_follows_tethash_simd(detail::box_filter_name());
 }

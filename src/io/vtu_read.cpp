@@ -33,6 +33,29 @@ class VtuReader : FileReaderBase {
     void set_contents(VtuContents* extra) { m_extra = extra; }
 
   private:
+    /// What the pieces gave, piece after piece (ids already offset by the points of the pieces before).
+    struct Pieces {
+        std::vector<double> coords;
+        std::vector<std::int64_t> tet_cells;
+        std::vector<Index> tet_ids, triangle_ids;
+        std::map<std::int64_t, std::int64_t> skipped;
+        std::map<std::string, Field> point_fields, cell_fields; // read_vtu_contents: every array of 1 or 3 components
+        std::map<std::string, NamedArray> point_arrays, cell_arrays;
+        std::int64_t total_points = 0, total_cells = 0;
+    };
+    /// <VTKFile>'s attributes (byte order, header type, compressor) and the appended data's encoding checked and
+    /// kept; returns the <UnstructuredGrid>.
+    const XmlElement& read_header();
+    /// A piece's points, checked finite.
+    void read_points(const XmlElement& piece, std::int64_t np, Pieces& all);
+    /// A piece's cells: its tets (its triangles too for read_vtu_contents), the other types counted as skipped.
+    void read_cells(const XmlElement& piece, std::int64_t np, std::int64_t nc, Pieces& all);
+    /// A piece's point or cell arrays (`section` PointData or CellData, `count` values each): those that may hold
+    /// object ids or labels, and for read_vtu_contents every array of 1 or 3 components.
+    void read_data_arrays(const XmlElement& piece, const char* section, bool cell, std::size_t count, Pieces& all);
+    /// The mesh (and the contents) of all pieces, their label arrays applied.
+    TetMesh assemble(Pieces& all);
+
     std::string attr(const XmlElement& el, const char* key, bool required = true) const
     {
         const std::string* v = el.attr(key);
@@ -342,6 +365,30 @@ std::vector<T> VtuReader::read_array(const XmlElement& da, std::size_t expected,
 
 TetMesh VtuReader::read()
 {
+    const XmlElement& grid = read_header();
+    Pieces all;
+    for (const XmlElement& piece : grid.children) {
+        if (piece.name != "Piece") continue;
+        const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
+        const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
+        if (nc > (std::int64_t(1) << 40))
+            fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
+        if (np > 2147483647 - all.total_points)
+            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(all.total_points) + " + " +
+                                          std::to_string(np) + ", at most 2147483647)");
+        read_points(piece, np, all);
+        read_cells(piece, np, nc, all);
+        // Point and cell arrays that may hold object ids or labels.
+        read_data_arrays(piece, "PointData", false, static_cast<std::size_t>(np), all);
+        read_data_arrays(piece, "CellData", true, static_cast<std::size_t>(nc), all);
+        all.total_points += np;
+        all.total_cells += nc;
+    }
+    return assemble(all);
+}
+
+const XmlElement& VtuReader::read_header()
+{
     m_data = read_file(m_path);
     m_doc = detail::parse_xml(m_path, m_data);
     const XmlElement& root = m_doc.root;
@@ -383,171 +430,152 @@ TetMesh VtuReader::read()
     }
     const XmlElement* grid = root.child("UnstructuredGrid");
     if (!grid) fail(at_line(root.line), "expected <UnstructuredGrid> in <VTKFile>, found none");
+    return *grid;
+}
 
-    std::vector<double> coords;
-    std::vector<std::int64_t> tet_cells;
-    std::vector<Index> tet_ids, triangle_ids;
-    std::map<std::int64_t, std::int64_t> skipped;
-    std::map<std::string, Field> point_fields, cell_fields; // read_vtu_contents: every array of 1 or 3 components
-    std::map<std::string, NamedArray> point_arrays, cell_arrays;
-    std::int64_t total_points = 0, total_cells = 0;
+void VtuReader::read_points(const XmlElement& piece, std::int64_t np, Pieces& all)
+{
+    const std::size_t npz = static_cast<std::size_t>(np);
+    const XmlElement* points = piece.child("Points");
+    if (!points) fail(at_line(piece.line), "expected <Points> in <Piece>, found none");
+    const XmlElement* pda = points->child("DataArray");
+    if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
+    const std::string comps = attr(*pda, "NumberOfComponents", false);
+    if (comps != "3")
+        fail(at_line(pda->line),
+             "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
+    const std::vector<double> pc =
+        read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
+    for (std::size_t i = 0; i < npz; ++i)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(pc[3 * i + k]))
+                fail(at_value(*pda, 3 * i + k), "point " +
+                                                    std::to_string(all.total_points + static_cast<std::int64_t>(i)) +
+                                                    " has a non-finite coordinate");
+    all.coords.insert(all.coords.end(), pc.begin(), pc.end());
+}
 
-    for (const XmlElement& piece : grid->children) {
-        if (piece.name != "Piece") continue;
-        const std::int64_t np = int_attr(piece, "NumberOfPoints", 0);
-        const std::int64_t nc = int_attr(piece, "NumberOfCells", 0);
-        if (nc > (std::int64_t(1) << 40))
-            fail(at_line(piece.line), "implausible NumberOfCells=\"" + std::to_string(nc) + "\"");
-        if (np > 2147483647 - total_points)
-            fail(at_line(piece.line), "too many points for tethash (" + std::to_string(total_points) + " + " +
-                                          std::to_string(np) + ", at most 2147483647)");
-        const std::size_t npz = static_cast<std::size_t>(np), ncz = static_cast<std::size_t>(nc);
-
-        // Points
-        const XmlElement* points = piece.child("Points");
-        if (!points) fail(at_line(piece.line), "expected <Points> in <Piece>, found none");
-        const XmlElement* pda = points->child("DataArray");
-        if (!pda) fail(at_line(points->line), "expected a <DataArray> in <Points>, found none");
-        const std::string comps = attr(*pda, "NumberOfComponents", false);
-        if (comps != "3")
-            fail(at_line(pda->line),
-                 "expected NumberOfComponents=\"3\" for the points, found \"" + (comps.empty() ? "1" : comps) + "\"");
-        const std::vector<double> pc =
-            read_array<double>(*pda, 3 * npz, "the points (" + std::to_string(np) + " × 3 values)");
-        for (std::size_t i = 0; i < npz; ++i)
-            for (int k = 0; k < 3; ++k)
-                if (!std::isfinite(pc[3 * i + k]))
-                    fail(at_value(*pda, 3 * i + k), "point " +
-                                                        std::to_string(total_points + static_cast<std::int64_t>(i)) +
-                                                        " has a non-finite coordinate");
-        coords.insert(coords.end(), pc.begin(), pc.end());
-
-        // Cells
-        const XmlElement* cells = piece.child("Cells");
-        if (!cells && nc > 0) fail(at_line(piece.line), "expected <Cells> in <Piece>, found none");
-        if (cells) {
-            const auto find = [&](const char* name) -> const XmlElement& {
-                for (const auto& c : cells->children)
-                    if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
-                fail(at_line(cells->line),
-                     "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
-            };
-            const XmlElement& oda = find("offsets");
-            const XmlElement& cda = find("connectivity");
-            const XmlElement& tda = find("types");
-            const auto offsets =
-                read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
-            const auto types =
-                read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
-            std::int64_t prev = 0;
-            for (std::size_t c = 0; c < ncz; ++c) {
-                if (offsets[c] < prev)
-                    fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
-                                               ", expected at least " + std::to_string(prev) +
-                                               " (offsets must not decrease)");
-                prev = offsets[c];
-            }
-            const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
-            if (conn_size > (std::int64_t(1) << 40))
-                fail(at_value(oda, ncz - 1), "last offset " + std::to_string(conn_size) + " is implausibly large");
-            const auto conn = read_array<std::int64_t>(cda, static_cast<std::size_t>(conn_size),
-                                                       "DataArray 'connectivity' (" + std::to_string(conn_size) +
-                                                           " values, the last offset)");
-            for (std::size_t c = 0; c < ncz; ++c) {
-                const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
-                if (types[c] == 5 && m_extra) {
-                    const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
-                    if (offsets[c] - first != 3)
-                        fail(at_value(tda, c), "cell " + std::to_string(c) + " has type 5 (triangle) but " +
-                                                   std::to_string(offsets[c] - first) + " points, expected 3");
-                    for (int k = 0; k < 3; ++k) {
-                        const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
-                        if (v < 0 || v >= np)
-                            fail(at_value(cda, static_cast<std::size_t>(first + k)),
-                                 "triangle (cell " + std::to_string(c) + ") refers to point " + std::to_string(v) +
-                                     ", but the piece has only " + std::to_string(np) + " points (0-based ids)");
-                        triangle_ids.push_back(static_cast<Index>(v + total_points));
-                    }
-                    m_extra->triangle_cells.push_back(total_cells + static_cast<std::int64_t>(c));
-                }
-                if (types[c] != 10 && !quadratic) {
-                    ++skipped[types[c]];
-                    continue;
-                }
-                const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
-                if (offsets[c] - first != (quadratic ? 10 : 4))
-                    fail(at_value(tda, c), "cell " + std::to_string(c) + " has type " +
-                                               (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") + " but " +
-                                               std::to_string(offsets[c] - first) + " points, expected " +
-                                               (quadratic ? "10" : "4"));
-                for (int k = 0; k < 4; ++k) {
-                    const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
-                    if (v < 0 || v >= np)
-                        fail(at_value(cda, static_cast<std::size_t>(first + k)),
-                             "tet " + std::to_string(tet_cells.size()) + " (cell " + std::to_string(c) +
-                                 ") refers to point " + std::to_string(v) + ", but the piece has only " +
-                                 std::to_string(np) + " points (0-based ids)");
-                    tet_ids.push_back(static_cast<Index>(v + total_points));
-                }
-                tet_cells.push_back(total_cells + static_cast<std::int64_t>(c));
-            }
-        }
-
-        // Point and cell arrays that may hold object ids or labels.
-        const auto gather = [&](const char* section, bool cell, std::size_t count,
-                                std::map<std::string, NamedArray>& into) {
-            const XmlElement* s = piece.child(section);
-            if (!s) return;
-            for (const auto& da : s->children) {
-                if (da.name != "DataArray" || !da.attr("Name")) continue;
-                const std::string& name = *da.attr("Name");
-                const std::string* nc_attr = da.attr("NumberOfComponents");
-                if (m_extra && (!nc_attr || *nc_attr == "1" || *nc_attr == "3")) {
-                    const int comps = nc_attr && *nc_attr == "3" ? 3 : 1;
-                    auto values =
-                        read_array<double>(da, count * static_cast<std::size_t>(comps), "DataArray '" + name + "'");
-                    Field& f = (cell ? cell_fields : point_fields)[name];
-                    if (f.name.empty()) f = Field{name, comps, {}};
-                    // A piece without the array (or with other components) leaves it short: dropped below.
-                    if (f.components == comps) f.values.insert(f.values.end(), values.begin(), values.end());
-                }
-                if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
-                auto values = read_array<double>(da, count, "DataArray '" + name + "'");
-                NamedArray& a = into[name];
-                if (a.name.empty()) a = {name, {}, at_line(da.line)};
-                // Pieces missing the array leave it short; apply_label_arrays then ignores it.
-                a.values.insert(a.values.end(), values.begin(), values.end());
-            }
-        };
-        gather("PointData", false, npz, point_arrays);
-        gather("CellData", true, ncz, cell_arrays);
-        total_points += np;
-        total_cells += nc;
+void VtuReader::read_cells(const XmlElement& piece, std::int64_t np, std::int64_t nc, Pieces& all)
+{
+    const std::size_t ncz = static_cast<std::size_t>(nc);
+    const XmlElement* cells = piece.child("Cells");
+    if (!cells) {
+        if (nc > 0) fail(at_line(piece.line), "expected <Cells> in <Piece>, found none");
+        return;
     }
+    const auto find = [&](const char* name) -> const XmlElement& {
+        for (const auto& c : cells->children)
+            if (c.name == "DataArray" && c.attr("Name") && *c.attr("Name") == name) return c;
+        fail(at_line(cells->line), "expected a DataArray Name=\"" + std::string(name) + "\" in <Cells>, found none");
+    };
+    const XmlElement& oda = find("offsets");
+    const XmlElement& cda = find("connectivity");
+    const XmlElement& tda = find("types");
+    const auto offsets = read_array<std::int64_t>(oda, ncz, "DataArray 'offsets' (" + std::to_string(nc) + " cells)");
+    const auto types = read_array<std::int64_t>(tda, ncz, "DataArray 'types' (" + std::to_string(nc) + " cells)");
+    std::int64_t prev = 0;
+    for (std::size_t c = 0; c < ncz; ++c) {
+        if (offsets[c] < prev)
+            fail(at_value(oda, c), "offset of cell " + std::to_string(c) + " is " + std::to_string(offsets[c]) +
+                                       ", expected at least " + std::to_string(prev) + " (offsets must not decrease)");
+        prev = offsets[c];
+    }
+    const std::int64_t conn_size = nc > 0 ? offsets[ncz - 1] : 0;
+    if (conn_size > (std::int64_t(1) << 40))
+        fail(at_value(oda, ncz - 1), "last offset " + std::to_string(conn_size) + " is implausibly large");
+    const auto conn = read_array<std::int64_t>(cda, static_cast<std::size_t>(conn_size),
+                                               "DataArray 'connectivity' (" + std::to_string(conn_size) +
+                                                   " values, the last offset)");
+    for (std::size_t c = 0; c < ncz; ++c) {
+        const bool quadratic = types[c] == 24 && m_options.linearize; // corners first, then mid-edge nodes
+        if (types[c] == 5 && m_extra) {
+            const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
+            if (offsets[c] - first != 3)
+                fail(at_value(tda, c), "cell " + std::to_string(c) + " has type 5 (triangle) but " +
+                                           std::to_string(offsets[c] - first) + " points, expected 3");
+            for (int k = 0; k < 3; ++k) {
+                const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
+                if (v < 0 || v >= np)
+                    fail(at_value(cda, static_cast<std::size_t>(first + k)),
+                         "triangle (cell " + std::to_string(c) + ") refers to point " + std::to_string(v) +
+                             ", but the piece has only " + std::to_string(np) + " points (0-based ids)");
+                all.triangle_ids.push_back(static_cast<Index>(v + all.total_points));
+            }
+            m_extra->triangle_cells.push_back(all.total_cells + static_cast<std::int64_t>(c));
+        }
+        if (types[c] != 10 && !quadratic) {
+            ++all.skipped[types[c]];
+            continue;
+        }
+        const std::int64_t first = c == 0 ? 0 : offsets[c - 1];
+        if (offsets[c] - first != (quadratic ? 10 : 4))
+            fail(at_value(tda, c),
+                 "cell " + std::to_string(c) + " has type " + (quadratic ? "24 (quadratic tetra)" : "10 (tetra)") +
+                     " but " + std::to_string(offsets[c] - first) + " points, expected " + (quadratic ? "10" : "4"));
+        for (int k = 0; k < 4; ++k) {
+            const std::int64_t v = conn[static_cast<std::size_t>(first + k)];
+            if (v < 0 || v >= np)
+                fail(at_value(cda, static_cast<std::size_t>(first + k)),
+                     "tet " + std::to_string(all.tet_cells.size()) + " (cell " + std::to_string(c) +
+                         ") refers to point " + std::to_string(v) + ", but the piece has only " + std::to_string(np) +
+                         " points (0-based ids)");
+            all.tet_ids.push_back(static_cast<Index>(v + all.total_points));
+        }
+        all.tet_cells.push_back(all.total_cells + static_cast<std::int64_t>(c));
+    }
+}
 
+void VtuReader::read_data_arrays(const XmlElement& piece, const char* section, bool cell, std::size_t count,
+                                 Pieces& all)
+{
+    const XmlElement* s = piece.child(section);
+    if (!s) return;
+    for (const auto& da : s->children) {
+        if (da.name != "DataArray" || !da.attr("Name")) continue;
+        const std::string& name = *da.attr("Name");
+        const std::string* nc_attr = da.attr("NumberOfComponents");
+        if (m_extra && (!nc_attr || *nc_attr == "1" || *nc_attr == "3")) {
+            const int comps = nc_attr && *nc_attr == "3" ? 3 : 1;
+            auto values = read_array<double>(da, count * static_cast<std::size_t>(comps), "DataArray '" + name + "'");
+            Field& f = (cell ? all.cell_fields : all.point_fields)[name];
+            if (f.name.empty()) f = Field{name, comps, {}};
+            // A piece without the array (or with other components) leaves it short: dropped below.
+            if (f.components == comps) f.values.insert(f.values.end(), values.begin(), values.end());
+        }
+        if ((nc_attr && *nc_attr != "1") || !is_label_array_name(name, cell)) continue;
+        auto values = read_array<double>(da, count, "DataArray '" + name + "'");
+        NamedArray& a = (cell ? all.cell_arrays : all.point_arrays)[name];
+        if (a.name.empty()) a = {name, {}, at_line(da.line)};
+        // Pieces missing the array leave it short; apply_label_arrays then ignores it.
+        a.values.insert(a.values.end(), values.begin(), values.end());
+    }
+}
+
+TetMesh VtuReader::assemble(Pieces& all)
+{
     TetMesh mesh;
-    mesh.positions.resize(total_points, 3);
-    std::copy(coords.begin(), coords.end(), mesh.positions.data());
-    mesh.tets.resize(static_cast<Eigen::Index>(tet_cells.size()), 4);
-    std::copy(tet_ids.begin(), tet_ids.end(), mesh.tets.data());
-    note_skipped_cells(skipped);
+    mesh.positions.resize(all.total_points, 3);
+    std::copy(all.coords.begin(), all.coords.end(), mesh.positions.data());
+    mesh.tets.resize(static_cast<Eigen::Index>(all.tet_cells.size()), 4);
+    std::copy(all.tet_ids.begin(), all.tet_ids.end(), mesh.tets.data());
+    note_skipped_cells(all.skipped);
     if (m_extra) {
-        m_extra->triangles.resize(static_cast<Eigen::Index>(triangle_ids.size() / 3), 3);
-        std::copy(triangle_ids.begin(), triangle_ids.end(), m_extra->triangles.data());
-        m_extra->tet_cells = tet_cells;
-        for (auto& [k, f] : point_fields)
-            if (f.values.size() == static_cast<std::size_t>(total_points) * static_cast<std::size_t>(f.components))
+        m_extra->triangles.resize(static_cast<Eigen::Index>(all.triangle_ids.size() / 3), 3);
+        std::copy(all.triangle_ids.begin(), all.triangle_ids.end(), m_extra->triangles.data());
+        m_extra->tet_cells = all.tet_cells;
+        for (auto& [k, f] : all.point_fields)
+            if (f.values.size() == static_cast<std::size_t>(all.total_points) * static_cast<std::size_t>(f.components))
                 m_extra->fields.point.push_back(std::move(f));
-        for (auto& [k, f] : cell_fields)
-            if (f.values.size() == static_cast<std::size_t>(total_cells) * static_cast<std::size_t>(f.components))
+        for (auto& [k, f] : all.cell_fields)
+            if (f.values.size() == static_cast<std::size_t>(all.total_cells) * static_cast<std::size_t>(f.components))
                 m_extra->fields.cell.push_back(std::move(f));
     }
     std::vector<NamedArray> pa, ca;
-    for (auto& [k, a] : point_arrays)
+    for (auto& [k, a] : all.point_arrays)
         pa.push_back(std::move(a));
-    for (auto& [k, a] : cell_arrays)
+    for (auto& [k, a] : all.cell_arrays)
         ca.push_back(std::move(a));
-    apply_label_arrays(mesh, pa, ca, tet_cells, static_cast<std::size_t>(total_cells), m_notes);
+    apply_label_arrays(mesh, pa, ca, all.tet_cells, static_cast<std::size_t>(all.total_cells), m_notes);
     return mesh;
 }
 

@@ -10,14 +10,14 @@
 // as a corner of the penetrated tet). Damping is relative: springs on their rate of length change, volume terms
 // on the rate of volume change, contacts on the relative normal velocity; rigid motion is never damped.
 //
-// What makes it robust on real meshes (measured on hand.mesh; docs/simulator.md): each local Newton step is clamped
-// to a fifth of the object's mean edge (without it the same settings gave 0 or ~1,700 inverted tets depending on
+// What makes it robust on real meshes (docs/simulator.md): each local Newton step is clamped to a fifth of the
+// object's mean edge (without it the same settings gave no inverted tets or a crumpled body depending on
 // round-off); contact terms use the contacts' relative displacement taken at the start of each iteration (Jacobi
 // across the contact's five nodes), so no two threads ever read a position another one writes.
 //
 // What makes it right at every size (docs/simulator.md, "Convergence"): the sweeps needed grow with ω h (ω the
 // material's frequency at the mean edge, which grows as the body shrinks), so a fixed count left small bodies
-// unconverged: they sagged flat and ended drops with up to 230 times their start energy. Now
+// unconverged: they sagged flat and ended drops with many times their start energy. Now
 // - every third sweep a coarse space (a lattice over each object, coarse_space.hpp) corrects the long waves that
 //   sweeps carry one ring of vertices at a time, its length chosen by a line search;
 // - sweeps run until converged: the last sweep's moves, measured in the local Hessians' norm (twice the energy
@@ -33,9 +33,9 @@
 // After each step (finish_step), the tets it left inverted are turned back corner by corner, positions only, in
 // moves of at most a twentieth of the mean edge that press no other tet of the corner towards inversion
 // (inversion_guard.hpp): slivers pressed flat on the ground, the odd tet of an impact. The refinement of steps and
-// the crumple check read the count before it, so a crumpling body is still refined or stopped. Without it, the
-// hand's drop at 1/240 ends with 3 inverted tets (slivers on the ground), P1's with 36, the raptor's 45 and the
-// crumpling mat's 518 (docs/simulator.md has what it leaves).
+// the crumple check read the count before it, so a crumpling body is still refined or stopped. Without it, drops
+// end with inverted slivers on the ground, and a crumpling sheet with hundreds (docs/simulator.md, "Figures behind
+// the code's constants", has the counts and what it leaves).
 //
 // With `inversion_guard`, no tet ends a substep inverted where it can be helped: a vertex's step never lowers one of
 // its tets (slivers aside) below a tenth of its rest volume, or further once there (the inversion guard, exact since
@@ -95,19 +95,21 @@ struct Sym3 {
     }
 };
 
-/// Sweeps between two corrections of the coarse space (coarse_space.hpp): on the hand at 15 cm and 1 m, every second
-/// sweep cost more than it saved (two residual passes per correction), every fourth converged in more sweeps.
+/// Sweeps between two corrections of the coarse space (coarse_space.hpp): every second sweep cost more than it saved
+/// (two residual passes per correction), every fourth converged in more sweeps (docs/simulator.md, "Figures behind
+/// the code's constants").
 constexpr int sweeps_per_correction = 3;
 /// An automatic substep has converged when, besides `convergence`, its last sweep took out less than this fraction of
-/// the energy the scene has to spend (energy_scale). At 5 cm the relative test alone stopped the hand, octocat and the
-/// raptor with 1.9×, 4.5× and 7× their start energy at the end of a drop (the sweeps' remaining error is stiff: it
-/// stores (ω h)² times the energy its length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much.
+/// the energy the scene has to spend (energy_scale). On small bodies the relative test alone stopped drops that ended
+/// with several times their start energy (the sweeps' remaining error is stiff: it stores (ω h)² times the energy its
+/// length suggests); 1e-3 ends them below their start, 1e-4 costs twice as much (docs/simulator.md, "Figures behind
+/// the code's constants").
 constexpr double energy_tolerance = 1e-3;
 /// The coarse correction moves no vertex further than this many times its sweep clamp (a fifth of its object's mean
 /// edge), the whole correction shortened alike; its length along that direction is then the line search's.
 constexpr double coarse_reach = 1.0;
 /// Sweeps an automatic substep takes at least: one, so that a body in free fall (its start is the answer) pays one
-/// sweep, not three (the hand's drop: 1.08× Bullet's mean step with three, 1.01× with one, the same end state).
+/// sweep, not three (the same end state at a lower cost; docs/simulator.md, "Figures behind the code's constants").
 constexpr int min_sweeps_automatic = 1;
 /// Times a step that gained energy is taken again, each with the convergence tests ten times tighter.
 constexpr int max_tighter = 2;
@@ -137,6 +139,16 @@ class BlockDescent final : public StepIntegrator {
 
   private:
     void setup();
+    /// A greedy colouring of the free vertices over the edge graph (every pair of vertices of a tet is an edge, so one
+    /// colour shares no spring and no tet): m_order the free vertices colour by colour; returns each colour's
+    /// start in m_order (and the end).
+    std::vector<std::int32_t> colour_vertices(const detail::Incidences& springs_at);
+    /// Each colour's vertices in groups of four lanes, their springs and tets lane-interleaved (m_groups, m_springs,
+    /// m_tets, m_colour_start), and each vertex's clamp length (m_max_step).
+    void pack_lanes(const std::vector<std::int32_t>& colour_start, const detail::Incidences& springs_at,
+                    const detail::Incidences& tets_at);
+    /// Lane l of group g: its vertex's springs and tets into the group's entries (padding beyond them).
+    void pack_lane(LaneGroup& g, int l, const detail::Incidences& springs_at, const detail::Incidences& tets_at);
     void start_substep(const double* x4);
     void gather_contacts();
     /// One Newton step on each real lane of group g (its elastic terms gathered four lanes at a time, then
@@ -217,22 +229,57 @@ class BlockDescent final : public StepIntegrator {
     InversionGuard m_inversions; ///< whole-state checks of the inversion guard (inversion_guard.hpp)
 };
 
+/// The number of entries of vertex i in `at`.
+std::int32_t count_of(const detail::Incidences& at, std::int32_t i)
+{
+    return at.start[static_cast<size_t>(i) + 1] - at.start[static_cast<size_t>(i)];
+}
+
 void BlockDescent::setup()
 {
     const Model& model = m_ctx.model;
     const Index n = model.num_vertices();
     const size_t un = static_cast<size_t>(n);
 
-    // Vertex → springs (by id), then a greedy colouring of the free vertices over the edge graph (every pair of
-    // vertices of a tet is an edge, so one colour shares no spring and no tet).
+    // Vertex → springs (by id) and tets (by id and corner): the colouring and the lanes' entries.
     const detail::Incidences springs_at = detail::incidences(model.springs.edges, un, false);
     const detail::Incidences tets_at = detail::incidences(model.volumes.tets, un, true);
+    pack_lanes(colour_vertices(springs_at), springs_at, tets_at);
+
+    std::vector<double> damping;
+    for (const ObjectSpec& o : m_ctx.scene.objects)
+        damping.push_back(o.material.damping);
+    if (m_ctx.scene.coarse_space) {
+        const double h = m_ctx.scene.dt / std::max(1, m_ctx.scene.substeps);
+        m_coarse.build(model, m_ctx.mesh.positions, damping, h);
+        m_coarse.set_up_for(h);
+    }
+    m_gather = detail::choose_gather(m_ctx.scene.inversion_guard);
+    m_start = detail::choose_start(m_gather);
+    m_solve = detail::choose_solve(m_gather);
+    if (model.ground.enabled) {
+        m_ground_k.resize(un);
+        m_ground_c.resize(un);
+        for (Index i = 0; i < n; ++i) {
+            m_ground_k[static_cast<size_t>(i)] = model.ground_k_at(i);
+            m_ground_c[static_cast<size_t>(i)] = model.ground_c_at(i);
+        }
+    }
+    m_threads = m_ctx.scene.detect.threads;
+#ifdef TETHASH_HAVE_OPENMP
+    if (m_threads <= 0) m_threads = omp_get_max_threads();
+#else
+    m_threads = 1;
+#endif
+}
+
+std::vector<std::int32_t> BlockDescent::colour_vertices(const detail::Incidences& springs_at)
+{
+    const Model& model = m_ctx.model;
+    const Index n = model.num_vertices();
     const std::vector<std::int32_t>& adj_start = springs_at.start;
     const std::vector<std::int32_t>& adj_spring = springs_at.entries;
-    const std::vector<std::int32_t>& tet_adj_start = tets_at.start;
-    const std::vector<std::int32_t>& tet_adj = tets_at.entries;
-
-    std::vector<int> colour(un, -1);
+    std::vector<int> colour(static_cast<size_t>(n), -1);
     int colours = 0;
     std::vector<char> used;
     for (Index i = 0; i < n; ++i) {
@@ -262,27 +309,28 @@ void BlockDescent::setup()
         if (colour[static_cast<size_t>(i)] >= 0)
             m_order[static_cast<size_t>(fill[static_cast<size_t>(colour[static_cast<size_t>(i)])]++)] =
                 static_cast<std::int32_t>(i);
+    return colour_start;
+}
 
-    // Groups of four lanes: within a colour the order does not change the result (its vertices are independent),
-    // so each colour's vertices are sorted by their number of tets and springs and grouped by four, which keeps
-    // the padding of the lane-interleaved entries small. Volume terms: the other three corners in an order that
-    // keeps the orientation (even permutations of (0, 1, 2, 3) starting with the corner).
-    static constexpr int others[4][3] = {{1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}};
-    auto count_of = [](const std::vector<std::int32_t>& start, std::int32_t i) {
-        return start[static_cast<size_t>(i) + 1] - start[static_cast<size_t>(i)];
-    };
+void BlockDescent::pack_lanes(const std::vector<std::int32_t>& colour_start, const detail::Incidences& springs_at,
+                              const detail::Incidences& tets_at)
+{
+    // Within a colour the order does not change the result (its vertices are independent), so each colour's
+    // vertices are sorted by their number of tets and springs and grouped by four, which keeps the padding of the
+    // lane-interleaved entries small.
+    const int colours = static_cast<int>(colour_start.size()) - 1;
     m_colour_start.assign(1, 0);
     m_groups.clear();
     m_springs.clear();
     m_tets.clear();
-    m_max_step.assign(un, std::numeric_limits<double>::infinity());
+    m_max_step.assign(static_cast<size_t>(m_ctx.model.num_vertices()), std::numeric_limits<double>::infinity());
     for (int c = 0; c < colours; ++c) {
         std::vector<std::int32_t> members(m_order.begin() + colour_start[static_cast<size_t>(c)],
                                           m_order.begin() + colour_start[static_cast<size_t>(c) + 1]);
         std::stable_sort(members.begin(), members.end(), [&](std::int32_t p, std::int32_t q) {
-            const std::int32_t tp = count_of(tet_adj_start, p), tq = count_of(tet_adj_start, q);
+            const std::int32_t tp = count_of(tets_at, p), tq = count_of(tets_at, q);
             if (tp != tq) return tp > tq;
-            return count_of(adj_start, p) > count_of(adj_start, q);
+            return count_of(springs_at, p) > count_of(springs_at, q);
         });
         for (size_t first = 0; first < members.size(); first += 4) {
             LaneGroup g{};
@@ -291,8 +339,8 @@ void BlockDescent::setup()
             for (int l = 0; l < 4; ++l) {
                 const std::int32_t i = members[first + static_cast<size_t>(std::min(l, g.lanes - 1))];
                 g.vertex[l] = l < g.lanes ? i : members[first];
-                springs = std::max(springs, count_of(adj_start, i));
-                tets = std::max(tets, count_of(tet_adj_start, i));
+                springs = std::max(springs, count_of(springs_at, i));
+                tets = std::max(tets, count_of(tets_at, i));
             }
             g.spring_begin = static_cast<std::int32_t>(m_springs.size());
             g.spring_end = g.spring_begin + springs;
@@ -300,76 +348,60 @@ void BlockDescent::setup()
             g.tet_end = g.tet_begin + tets;
             m_springs.resize(static_cast<size_t>(g.spring_end));
             m_tets.resize(static_cast<size_t>(g.tet_end));
-            for (int l = 0; l < 4; ++l) {
-                const std::int32_t i = g.vertex[l];
-                const bool real = l < g.lanes;
-                const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
-                g.damping[l] = o < m_ctx.scene.objects.size() ? m_ctx.scene.objects[o].material.damping : 0.0;
-                const double edge = o < model.object_mean_edge.size() ? model.object_mean_edge[o] : 0.0;
-                if (edge > 0) m_max_step[static_cast<size_t>(i)] = 0.2 * edge;
-                // Padding (a padding lane, or a lane's entries beyond its own): zero stiffness on the lane's own
-                // vertex, which contributes nothing.
-                for (std::int32_t e = 0; e < springs; ++e) {
-                    SpringLanes& sl = m_springs[static_cast<size_t>(g.spring_begin + e)];
-                    sl.other[l] = i;
-                    sl.k[l] = sl.rest[l] = sl.length_t[l] = 0;
-                    if (!real || e >= count_of(adj_start, i)) continue;
-                    const Index edge_id = adj_spring[static_cast<size_t>(adj_start[static_cast<size_t>(i)] + e)];
-                    const Index j = model.springs.edges(edge_id, 0) == i ? model.springs.edges(edge_id, 1)
-                                                                         : model.springs.edges(edge_id, 0);
-                    sl.other[l] = static_cast<std::int32_t>(j);
-                    sl.k[l] = model.springs.k[static_cast<size_t>(edge_id)];
-                    sl.rest[l] = model.springs.rest[static_cast<size_t>(edge_id)];
-                }
-                for (std::int32_t e = 0; e < tets; ++e) {
-                    TetLanes& tl = m_tets[static_cast<size_t>(g.tet_begin + e)];
-                    tl.a[l] = tl.b[l] = tl.c[l] = i;
-                    tl.k36[l] = tl.w0[l] = tl.wt[l] = 0;
-                    tl.guard[l] = 0;
-                    if (!real || e >= count_of(tet_adj_start, i)) continue;
-                    const std::int32_t entry = tet_adj[static_cast<size_t>(tet_adj_start[static_cast<size_t>(i)] + e)];
-                    const Index t = entry / 4;
-                    const int a = entry % 4;
-                    const double v0 = model.volumes.rest[static_cast<size_t>(t)];
-                    tl.a[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][0]));
-                    tl.b[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][1]));
-                    tl.c[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][2]));
-                    tl.k36[l] = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
-                    tl.w0[l] = tl.wt[l] = 6.0 * v0;
-                    tl.guard[l] = !m_ctx.scene.inversion_guard || model.volumes.sliver[static_cast<size_t>(t)]
-                                      ? 0.0F
-                                      : static_cast<float>(detail::guard_fraction * 6.0 * v0);
-                }
-            }
+            for (int l = 0; l < 4; ++l)
+                pack_lane(g, l, springs_at, tets_at);
             m_groups.push_back(g);
         }
         m_colour_start.push_back(static_cast<std::int32_t>(m_groups.size()));
     }
-    std::vector<double> damping;
-    for (const ObjectSpec& o : m_ctx.scene.objects)
-        damping.push_back(o.material.damping);
-    if (m_ctx.scene.coarse_space) {
-        const double h = m_ctx.scene.dt / std::max(1, m_ctx.scene.substeps);
-        m_coarse.build(model, m_ctx.mesh.positions, damping, h);
-        m_coarse.set_up_for(h);
+}
+
+void BlockDescent::pack_lane(LaneGroup& g, int l, const detail::Incidences& springs_at,
+                             const detail::Incidences& tets_at)
+{
+    // Volume terms: the other three corners in an order that keeps the orientation (even permutations of
+    // (0, 1, 2, 3) starting with the corner).
+    static constexpr int others[4][3] = {{1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}};
+    const Model& model = m_ctx.model;
+    const std::int32_t i = g.vertex[l];
+    const bool real = l < g.lanes;
+    const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(i)]);
+    g.damping[l] = o < m_ctx.scene.objects.size() ? m_ctx.scene.objects[o].material.damping : 0.0;
+    const double edge = o < model.object_mean_edge.size() ? model.object_mean_edge[o] : 0.0;
+    if (edge > 0) m_max_step[static_cast<size_t>(i)] = 0.2 * edge;
+    // Padding (a padding lane, or a lane's entries beyond its own): zero stiffness on the lane's own vertex, which
+    // contributes nothing.
+    for (std::int32_t e = 0; e < g.spring_end - g.spring_begin; ++e) {
+        SpringLanes& sl = m_springs[static_cast<size_t>(g.spring_begin + e)];
+        sl.other[l] = i;
+        sl.k[l] = sl.rest[l] = sl.length_t[l] = 0;
+        if (!real || e >= count_of(springs_at, i)) continue;
+        const Index edge_id = springs_at.entries[static_cast<size_t>(springs_at.start[static_cast<size_t>(i)] + e)];
+        const Index j =
+            model.springs.edges(edge_id, 0) == i ? model.springs.edges(edge_id, 1) : model.springs.edges(edge_id, 0);
+        sl.other[l] = static_cast<std::int32_t>(j);
+        sl.k[l] = model.springs.k[static_cast<size_t>(edge_id)];
+        sl.rest[l] = model.springs.rest[static_cast<size_t>(edge_id)];
     }
-    m_gather = detail::choose_gather(m_ctx.scene.inversion_guard);
-    m_start = detail::choose_start(m_gather);
-    m_solve = detail::choose_solve(m_gather);
-    if (model.ground.enabled) {
-        m_ground_k.resize(un);
-        m_ground_c.resize(un);
-        for (Index i = 0; i < n; ++i) {
-            m_ground_k[static_cast<size_t>(i)] = model.ground_k_at(i);
-            m_ground_c[static_cast<size_t>(i)] = model.ground_c_at(i);
-        }
+    for (std::int32_t e = 0; e < g.tet_end - g.tet_begin; ++e) {
+        TetLanes& tl = m_tets[static_cast<size_t>(g.tet_begin + e)];
+        tl.a[l] = tl.b[l] = tl.c[l] = i;
+        tl.k36[l] = tl.w0[l] = tl.wt[l] = 0;
+        tl.guard[l] = 0;
+        if (!real || e >= count_of(tets_at, i)) continue;
+        const std::int32_t entry = tets_at.entries[static_cast<size_t>(tets_at.start[static_cast<size_t>(i)] + e)];
+        const Index t = entry / 4;
+        const int a = entry % 4;
+        const double v0 = model.volumes.rest[static_cast<size_t>(t)];
+        tl.a[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][0]));
+        tl.b[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][1]));
+        tl.c[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][2]));
+        tl.k36[l] = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
+        tl.w0[l] = tl.wt[l] = 6.0 * v0;
+        tl.guard[l] = !m_ctx.scene.inversion_guard || model.volumes.sliver[static_cast<size_t>(t)]
+                          ? 0.0F
+                          : static_cast<float>(detail::guard_fraction * 6.0 * v0);
     }
-    m_threads = m_ctx.scene.detect.threads;
-#ifdef TETHASH_HAVE_OPENMP
-    if (m_threads <= 0) m_threads = omp_get_max_threads();
-#else
-    m_threads = 1;
-#endif
 }
 
 void BlockDescent::start_substep(const double* x4)
@@ -795,8 +827,8 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     // vertex; g at the first substep): y in free fall, x + h v for a body at rest. Starting from y, a resting body
     // began every substep g h² lower, pressed into the ground (at 1/60 that is 2.7 mm: an edge of a 5 cm body), and
     // the sweeps spent themselves lifting it back. The clamp matters: the whole last acceleration extrapolated an
-    // impact's rebound into the next start, and where the sweeps stopped short that bias put energy in (a 5 cm
-    // octopus ended a drop with 47 times its start energy).
+    // impact's rebound into the next start, and where the sweeps stopped short that bias put energy in (small bodies
+    // ended drops with tens of times their start energy; docs/simulator.md, "Figures behind the code's constants").
     const Eigen::Vector3d& g = model.gravity;
     const double g_norm = g.norm();
     const Eigen::Vector3d down = g_norm > 0 ? Eigen::Vector3d(g / g_norm) : Eigen::Vector3d::Zero();
@@ -835,8 +867,9 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     // Stop when no vertex moved more than this fraction of its clamp length (a fifth of its object's mean edge).
     const double stop = 5 * m_ctx.scene.sweep_tolerance;
     // A step refined into k times the scene's substeps gives each a k-th of the energy tolerance, so that what a
-    // step may leave unconverged does not grow with its refinement (a 5 cm octocat of young 1e9 took 100 substeps a
-    // step and ended its drop with 5.6 times its start energy, every substep converged).
+    // step may leave unconverged does not grow with its refinement (a small stiff body taken in a hundred substeps a
+    // step ended its drop with several times its start energy, every substep converged; docs/simulator.md, "Figures
+    // behind the code's constants").
     const double refined_share = tighter * std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
     int sweeps = 0;
     double omega = 1, moved_max = 0;

@@ -4,12 +4,12 @@
 //
 // Why: a Gauss–Seidel sweep moves information by about one ring of neighbours, while a backward-Euler step of an
 // elastic body is a global problem whose stiffness relative to its inertia grows as (ω h)², ω = c / L̄ the
-// material's frequency at the mean edge. At a fixed mesh ω grows as the body shrinks (6.7× from 1 m to 15 cm):
-// on a 5 cm body the sweeps needed to carry an impact through the body grew past a hundred, and a fixed count
-// left the step unconverged (bodies sagging flat, energy growing tenfold). The lattice carries the long waves the
-// sweeps cannot: between sweeps the step's residual is projected on the lattice, the lattice's Newton step solved
-// directly (the Galerkin matrix Pᵀ A P) and interpolated back (a two-level cycle: the sweeps smooth, the lattice
-// corrects).
+// material's frequency at the mean edge. At a fixed mesh ω grows as 1 / size: on small bodies the sweeps needed
+// to carry an impact through the body grow far past a fixed count, which leaves the step unconverged (bodies
+// sagging flat, energy growing; docs/simulator.md, "Convergence at every size", has the figures). The lattice carries
+// the long waves the sweeps cannot: between sweeps the step's residual is projected on the lattice, the lattice's
+// Newton step solved directly (the Galerkin matrix Pᵀ A P) and interpolated back (a two-level cycle: the sweeps smooth,
+// the lattice corrects).
 //
 // The factorisation is kept from one substep to the next while the vertices touching the ground or a contact are
 // nine tenths the same, no object turned by more than 0.05 rad since, and for at most 8 substeps: the line search along

@@ -1,6 +1,6 @@
 #include "proximity.hpp"
 
-#include "core/simd.hpp"
+#include "core/hash/box_grid.hpp"
 
 #include "tethash/geometry.hpp"
 
@@ -9,84 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define TETHASH_X86 1
-#endif
-
-namespace tethash::sim::detail {
-
-namespace {
-
-std::int32_t box_filter_scalar(const float* const box[6], std::int32_t begin, std::int32_t end, const float q[6],
-                               std::int32_t* hits)
-{
-    std::int32_t n = 0;
-    for (std::int32_t e = begin; e < end; ++e) {
-        const size_t u = static_cast<size_t>(e);
-        if ((q[3] < box[0][u]) | (q[0] > box[3][u]) | (q[4] < box[1][u]) | (q[1] > box[4][u]) | (q[5] < box[2][u]) |
-            (q[2] > box[5][u]))
-            continue;
-        hits[n++] = e;
-    }
-    return n;
-}
-
-#ifdef TETHASH_X86
-/// Eight entries at a time (the columns are padded by eight, so the last group's loads stay inside).
-__attribute__((target("avx2"))) std::int32_t box_filter_avx2(const float* const box[6], std::int32_t begin,
-                                                             std::int32_t end, const float q[6], std::int32_t* hits)
-{
-    const __m256 qlo0 = _mm256_set1_ps(q[0]), qlo1 = _mm256_set1_ps(q[1]), qlo2 = _mm256_set1_ps(q[2]);
-    const __m256 qhi0 = _mm256_set1_ps(q[3]), qhi1 = _mm256_set1_ps(q[4]), qhi2 = _mm256_set1_ps(q[5]);
-    std::int32_t n = 0;
-    for (std::int32_t e = begin; e < end; e += 8) {
-        const size_t u = static_cast<size_t>(e);
-        __m256 miss = _mm256_cmp_ps(qhi0, _mm256_loadu_ps(box[0] + u), _CMP_LT_OQ);
-        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo0, _mm256_loadu_ps(box[3] + u), _CMP_GT_OQ));
-        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qhi1, _mm256_loadu_ps(box[1] + u), _CMP_LT_OQ));
-        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo1, _mm256_loadu_ps(box[4] + u), _CMP_GT_OQ));
-        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qhi2, _mm256_loadu_ps(box[2] + u), _CMP_LT_OQ));
-        miss = _mm256_or_ps(miss, _mm256_cmp_ps(qlo2, _mm256_loadu_ps(box[5] + u), _CMP_GT_OQ));
-        unsigned meet = ~static_cast<unsigned>(_mm256_movemask_ps(miss)) & 0xffu;
-        if (end - e < 8) meet &= (1u << (end - e)) - 1;
-        while (meet) {
-            hits[n++] = e + __builtin_ctz(meet);
-            meet &= meet - 1;
-        }
-    }
-    return n;
-}
-#endif
-
-BoxFilter choose_box_filter()
-{
-#ifdef TETHASH_X86
-    if (tethash::detail::avx2_kernels()) return box_filter_avx2;
-#endif
-    return box_filter_scalar;
-}
-
-const BoxFilter chosen_box_filter = choose_box_filter();
-
-} // namespace
-
-std::vector<std::pair<const char*, BoxFilter>> box_filters()
-{
-    std::vector<std::pair<const char*, BoxFilter>> all{{"scalar", box_filter_scalar}};
-#ifdef TETHASH_X86
-    if (tethash::detail::cpu_has_avx2()) all.emplace_back("avx2", box_filter_avx2);
-#endif
-    return all;
-}
-
-const char* box_filter_name()
-{
-    return chosen_box_filter == box_filter_scalar ? "scalar" : "avx2";
-}
-
-} // namespace tethash::sim::detail
 
 namespace tethash::sim {
 
@@ -107,24 +29,6 @@ constexpr double cell_edges = 2.0;
 /// Two objects thrown at each other: their whole surfaces close at once, so the cap is wider (it costs only while
 /// they approach fast).
 constexpr double pair_edges = 2.0;
-
-/// Single precision rounded down / up: a filter's box that contains the double one (float's relative rounding
-/// error is at most 2⁻²⁴; the margin taken is 4 × that).
-float round_down(double v)
-{
-    const float f = static_cast<float>(v);
-    return f - (std::abs(f) * 2.4e-7f + 1e-30f);
-}
-float round_up(double v)
-{
-    const float f = static_cast<float>(v);
-    return f + (std::abs(f) * 2.4e-7f + 1e-30f);
-}
-
-std::uint32_t cell_hash(std::int64_t x, std::int64_t y, std::int64_t z)
-{
-    return static_cast<std::uint32_t>((x * 73856093) ^ (y * 19349663) ^ (z * 83492791));
-}
 
 } // namespace
 
@@ -288,58 +192,21 @@ double Proximity::face_reach(const std::vector<double>& reach, const Face& f)
 
 void Proximity::hash_faces(const Positions& x)
 {
-    const double inv_cell = 1.0 / (cell_edges * m_edge);
     const size_t nf = m_faces.size();
-    m_box.resize(nf);
-    m_entries.clear();
     size_t buckets = 1;
     while (buckets < 2 * nf)
         buckets <<= 1;
-    m_mask = static_cast<std::uint32_t>(buckets - 1);
-    for (size_t f = 0; f < nf; ++f) {
-        const Face& fc = m_faces[f];
-        const double reach = face_reach(m_reach, fc);
-        const double grow = reach + m_margin_max;
-        Cell& box = m_box[f];
-        std::int64_t lo[3], hi[3];
+    m_grid.begin(cell_edges * m_edge, buckets, nf);
+    for (const Face& fc : m_faces) {
+        const double grow = face_reach(m_reach, fc) + m_margin_max;
+        double lo[3], hi[3];
         for (int k = 0; k < 3; ++k) {
-            const double l = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
-            const double u = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
-            // Single precision, rounded outwards: a filter only (the closest point decides).
-            box.lo[k] = round_down(l);
-            box.hi[k] = round_up(u);
-            lo[k] = static_cast<std::int64_t>(std::floor(l * inv_cell));
-            hi[k] = static_cast<std::int64_t>(std::floor(u * inv_cell));
+            lo[k] = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
+            hi[k] = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
         }
-        box.face = static_cast<std::int32_t>(f);
-
-        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
-            for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
-                for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz)
-                    m_entries.emplace_back(cell_hash(cx, cy, cz) & m_mask, static_cast<std::int32_t>(f));
+        m_grid.add(lo, hi);
     }
-    m_bucket_start.assign(buckets + 1, 0);
-    for (const auto& e : m_entries)
-        ++m_bucket_start[e.first + 1];
-    for (size_t b = 0; b < buckets; ++b)
-        m_bucket_start[b + 1] += m_bucket_start[b];
-    // Each bucket holds its faces' boxes in a row: a query reads them in order.
-    const size_t ne = m_entries.size();
-    for (int k = 0; k < 3; ++k) {
-        m_cell_box[k].assign(ne + 8, std::numeric_limits<float>::infinity());
-        m_cell_box[3 + k].assign(ne + 8, -std::numeric_limits<float>::infinity());
-    }
-    m_cell_face.resize(ne);
-    m_stamp.assign(m_bucket_start.begin(), m_bucket_start.end() - 1); // the fill cursor first
-    for (const auto& e : m_entries) {
-        const size_t at = static_cast<size_t>(m_stamp[e.first]++);
-        const Cell& b = m_box[static_cast<size_t>(e.second)];
-        for (int k = 0; k < 3; ++k) {
-            m_cell_box[k][at] = b.lo[k];
-            m_cell_box[3 + k][at] = b.hi[k];
-        }
-        m_cell_face[at] = b.face;
-    }
+    m_grid.finish();
     m_stamp.assign(nf, -1);
 }
 
@@ -358,10 +225,6 @@ __attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::
         near_rest = dr2 < outer * outer;
     } else if (m_static[static_cast<size_t>(op)] && m_static[static_cast<size_t>(fc.object)]) {
         return;
-    }
-    if (!q.one_cell) {
-        if (m_stamp[static_cast<size_t>(f)] == p) return;
-        m_stamp[static_cast<size_t>(f)] = static_cast<std::int32_t>(p);
     }
     if (fc.v[0] == p || fc.v[1] == p || fc.v[2] == p) return;
     const std::vector<char>& fixed = m_model->fixed;
@@ -398,32 +261,16 @@ __attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::
 
 void Proximity::query_cells(Query& q, const Positions& x)
 {
-    const double inv_cell = 1.0 / (cell_edges * m_edge);
     const double rq = q.r + m_object_reach[static_cast<size_t>(q.op)]; // the query box: any partner object
-    std::int64_t lo[3], hi[3];
+    double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
-        lo[k] = static_cast<std::int64_t>(std::floor((q.xp[k] - rq) * inv_cell));
-        hi[k] = static_cast<std::int64_t>(std::floor((q.xp[k] + rq) * inv_cell));
+        lo[k] = q.xp[k] - rq;
+        hi[k] = q.xp[k] + rq;
     }
-    q.one_cell = lo[0] == hi[0] && lo[1] == hi[1] && lo[2] == hi[2]; // each face once: no stamps
-    // The query box in single precision, rounded outwards like the faces' boxes: lo x, y, z, hi x, y, z.
-    float qbox[6];
-    for (int k = 0; k < 3; ++k) {
-        qbox[k] = round_down(q.xp[k] - rq);
-        qbox[3 + k] = round_up(q.xp[k] + rq);
-    }
-    const float* const columns[6] = {m_cell_box[0].data(), m_cell_box[1].data(), m_cell_box[2].data(),
-                                     m_cell_box[3].data(), m_cell_box[4].data(), m_cell_box[5].data()};
-    for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx)
-        for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
-            for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
-                const std::uint32_t bk = cell_hash(cx, cy, cz) & m_mask;
-                const std::int32_t begin = m_bucket_start[bk], end = m_bucket_start[bk + 1];
-                if (m_hits.size() < static_cast<size_t>(end - begin)) m_hits.resize(static_cast<size_t>(end - begin));
-                const std::int32_t hits = detail::chosen_box_filter(columns, begin, end, qbox, m_hits.data());
-                for (std::int32_t hit = 0; hit < hits; ++hit)
-                    visit_face(q, m_cell_face[static_cast<size_t>(m_hits[static_cast<size_t>(hit)])], x);
-            }
+    // A face met twice changes neither the nearest face per object nor the clearance: a query of one cell takes no
+    // stamps.
+    m_grid.query(lo, hi, m_stamp.data(), static_cast<std::int32_t>(q.p), m_hits, true,
+                 [&](std::int32_t f) { visit_face(q, f, x); });
 }
 
 void Proximity::keep_contacts(const Query& q, const Positions& x, const std::vector<Contact>& inside,

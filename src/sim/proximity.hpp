@@ -8,9 +8,11 @@
 // (1.5 × their travel relative to their objects' mean motion, plus the objects' relative travel): such a contact
 // starts with a negative depth and pushes only if the gap closes below δ within the substep (a speculative contact;
 // vbd sees it close in its iterations, the other integrators push positive depths only).
-// Faces are hashed into a uniform grid of two mean edges; each vertex looks at the cells its reach covers (one cell
-// when nothing moves relative to its object). Deterministic: one thread, fixed order.
+// Faces are hashed into the core's grid of boxes (core/hash/box_grid.hpp), cells of two mean edges; each vertex looks
+// at the cells its reach covers (one cell when nothing moves relative to its object). Deterministic: one thread, fixed
+// order.
 
+#include "core/hash/box_grid.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/sim/model.hpp"
 
@@ -21,18 +23,6 @@
 #include <vector>
 
 namespace tethash::sim {
-
-namespace detail {
-/// The grid's box filter: the entries [begin, end) of a bucket (columns lo x, y, z, hi x, y, z, padded by eight
-/// entries) whose box meets the query box q (lo x, y, z, hi x, y, z), in order, into `hits`; returns their count.
-/// A comparison with NaN meets (the closest point decides).
-using BoxFilter = std::int32_t (*)(const float* const box[6], std::int32_t begin, std::int32_t end, const float q[6],
-                                   std::int32_t* hits);
-/// Every kernel this machine runs, scalar first (AVX2: eight entries at a time, chosen at run time).
-std::vector<std::pair<const char*, BoxFilter>> box_filters();
-/// The kernel Proximity uses: "avx2" where the processor has it, unless TETHASH_SIMD=scalar.
-const char* box_filter_name();
-} // namespace detail
 
 class Proximity {
   public:
@@ -70,7 +60,7 @@ class Proximity {
     };
     /// Mean velocities per object, each boundary vertex's reach, the object pairs' reach.
     void motion(const Positions& v, double h);
-    /// Faces' boxes grown by their reach and the largest margin, counting-sorted into the grid's buckets.
+    /// Faces' boxes grown by their reach and the largest margin, into the grid.
     void hash_faces(const Positions& x);
     static double face_reach(const std::vector<double>& reach, const Face& f);
     /// One boundary vertex's query: where it is, what it reaches, what is local to it, its nearest far face so far.
@@ -79,7 +69,6 @@ class Proximity {
         Eigen::Vector3d xp, rp;
         double r = 0;                                      ///< its reach in the substep
         double reach2 = 0, local_reach = 0, far_reach = 0; ///< its object's local reach (squared), with slack
-        bool one_cell = false;                             ///< the query box lies in one cell: each face met once
         double clearance = 0;                              ///< squared distance to the nearest far face
     };
     /// The faces in the cells of q's box: for each far face within watch on its outer side, the nearest per object
@@ -111,21 +100,10 @@ class Proximity {
     std::vector<double> m_object_mass;     ///< per object (scratch of motion)
     std::vector<double> m_pair_now;        ///< objects²: how far two objects may close on each other in h
     std::vector<double> m_object_reach;    ///< per object: its widest m_pair_now, for its vertices' query boxes
-    // Scratch kept between calls: face boxes, the grid (counting-sorted by bucket), per-face stamps.
-    struct Cell {
-        float lo[3], hi[3]; ///< the face's box grown by its reach and the largest margin
-        std::int32_t face;
-    };
-
-    std::vector<Cell> m_box; ///< per face
-    /// Per bucket entry, in bucket order, column by column (lo x, y, z, hi x, y, z: a query tests eight at once),
-    /// and padded by eight entries that no box meets.
-    std::vector<float> m_cell_box[6];
-    std::vector<std::int32_t> m_cell_face;
+    // Scratch kept between calls: the grid of the faces' boxes (detail::BoxGrid), per-face stamps.
+    tethash::detail::BoxGrid m_grid;  ///< faces' boxes grown by their reach and the largest margin
     std::vector<std::int32_t> m_hits; ///< entries of one bucket whose box meets the query's
-    std::vector<std::int32_t> m_bucket_start, m_stamp;
-    std::uint32_t m_mask = 0;
-    std::vector<std::pair<std::uint32_t, std::int32_t>> m_entries;
+    std::vector<std::int32_t> m_stamp;
     std::vector<Best> m_best;
 };
 

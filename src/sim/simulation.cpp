@@ -193,8 +193,9 @@ int SimulationImpl::approach_substeps(int most) const
 {
     // Contacts are found at the start of each substep, and margin and speculative contacts reach a quarter of a
     // mean edge ahead: two objects that close by more than that within a substep can enter each other deeply before
-    // a contact sees them, and a penalty pushing out of a deep penetration puts energy in (two stiff 5 cm armadillos
-    // thrown into each other at 1/60 entered 1.3 cm in one step and flew apart with 640 times the scene's energy).
+    // a contact sees them, and a penalty pushing out of a deep penetration puts energy in (small stiff bodies thrown
+    // into each other flew apart with hundreds of times the scene's energy; docs/simulator.md, "At the sizes users
+    // have").
     // Per object: its box and its rigid motion (the velocity of its centre of mass, and its rotation times its
     // radius); objects whose boxes, grown by what they may move in the step, meet get substeps in which their rigid
     // motions close by at most the reach. (Their vibrations are left out: counted as a speed of approach, a soft

@@ -220,12 +220,10 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
     io::write_text_file((std::filesystem::path(dir) / "run.json").string(), j.str() + "\n");
 }
 
-void run_simulate(SimulateOptions o)
+/// The scene the options ask for: a scene file, the mesh of --mesh (its scene text into `mesh_scene`) or the
+/// built-in default, with the command line's overrides.
+sim::Scene simulate_scene(SimulateOptions& o, std::string& mesh_scene)
 {
-    if (o.template_scene) {
-        std::fputs(template_text(), stdout);
-        return;
-    }
     if (!o.scene.empty() && !o.mesh.empty())
         throw Error("give a scene file or --mesh FILE, not both (found '" + o.scene + "' and --mesh '" + o.mesh + "')");
     if (!o.scene.empty() && looks_like_a_mesh(o.scene)) {
@@ -238,7 +236,6 @@ void run_simulate(SimulateOptions o)
     }
     if (o.mesh.empty() && (o.scale != 1 || o.up != "z" || o.young != 1e5 || o.density != 1000))
         throw Error("--scale, --up, --young and --density go with --mesh FILE (a scene file says them itself)");
-    std::string mesh_scene;
     if (!o.mesh.empty()) mesh_scene = mesh_scene_text(o);
     sim::Scene scene = !mesh_scene.empty() ? sim::parse_scene(mesh_scene, "--mesh " + o.mesh)
                        : o.scene.empty()   ? sim::default_scene()
@@ -269,6 +266,264 @@ void run_simulate(SimulateOptions o)
         scene.detect.threads = parse_threads(o.threads);
     else
         check_threads(scene.detect.threads, scene.source + ": [detector] threads");
+    return scene;
+}
+
+/// The output folder made, a previous run's files removed from it (with a note), the --mesh scene written to it.
+void prepare_out_folder(const std::string& out, const std::string& mesh_scene)
+{
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    if (ec) {
+        // A file on the way is a bad --out; anything else is the file system refusing (exit 1).
+        const std::string msg = "--out: cannot create folder '" + out + "': " + ec.message();
+        if (ec == std::errc::not_a_directory || ec == std::errc::file_exists) throw Error(msg);
+        throw WriteError(msg);
+    }
+    // A previous run's frames would join this run's in ParaView's file group: they go first (only the files this
+    // command writes: frame_NNNNN.vtu and scene.pvd), and the run says so.
+    const int removed = remove_previous_frames(out);
+    if (removed > 0)
+        std::fprintf(stderr, "tethash: note: removed %d file%s of a previous run from %s\n", removed,
+                     removed == 1 ? "" : "s", out.c_str());
+    if (!mesh_scene.empty()) {
+        const std::string path = (std::filesystem::path(out) / "scene.toml").string();
+        io::write_text_file(path, mesh_scene);
+        std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n", path.c_str());
+    }
+}
+
+/// The frames of the run and their series, scene.pvd. What does not move (the bsp obstacles, the ground) is written
+/// once, static.vtu, and listed at every time as part 1 of the series: ParaView and `tethash render` show it beside
+/// the frames (part 0).
+class FrameWriter {
+  public:
+    explicit FrameWriter(std::string out) : m_out(std::move(out)), m_pvd((m_out / "scene.pvd").string()) {}
+    void write(const sim::Simulation& sim)
+    {
+        const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
+        io::write_vtu((m_out / name).string(), sim.mesh(), sim.output_fields());
+        // After the first frame (a folder that takes no frame gets no static surface either).
+        if (m_series.empty()) {
+            const sim::StaticSurface st = sim.static_surface();
+            if (st.surface.triangles.rows() > 0) {
+                m_static = "static.vtu";
+                io::write_vtu_surface((m_out / m_static).string(), st.surface, st.triangle_object);
+            }
+        }
+        m_series.push_back({sim.time(), name, 0});
+        if (!m_static.empty()) m_series.push_back({sim.time(), m_static, 1});
+        io::write_pvd_parts(m_pvd, m_series);
+    }
+    std::size_t frames() const
+    {
+        return static_cast<std::size_t>(
+            std::count_if(m_series.begin(), m_series.end(), [](const io::PvdEntry& e) { return e.part == 0; }));
+    }
+    const std::string& pvd() const { return m_pvd; }
+
+  private:
+    std::filesystem::path m_out;
+    std::string m_pvd;
+    std::vector<io::PvdEntry> m_series;
+    std::string m_static;
+};
+
+/// What the run is: the scene, its size, integrator and threads, each object's size.
+void print_run_header(const sim::Scene& scene, const sim::Simulation& sim, int threads)
+{
+    std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
+    std::fprintf(
+        stdout,
+        "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %s%d thread%s\n",
+        static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
+        static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
+        scene.steps, scene.detect.threads == 0 && threads > 1 ? "up to " : "", threads, threads == 1 ? "" : "s");
+    std::string sizes;
+    const std::vector<double> size = sim.object_sizes();
+    for (size_t k = 0; k < size.size(); ++k)
+        sizes +=
+            fmt::format("{}{} {:.4g} m", k ? ", " : "",
+                        scene.objects[k].name.empty() ? fmt::format("object {}", k) : scene.objects[k].name, size[k]);
+    std::fprintf(stdout, "object sizes (longest extent): %s\n", sizes.c_str());
+    if (scene.integrator == sim::Integrator::symplectic_euler)
+        std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
+    std::fflush(stdout);
+}
+
+/// The steps' statistics summed over the run, for its summary.
+struct RunTotals {
+    double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, ms_checks = 0,
+           max_depth = 0, depth_sum = 0;
+    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0, tightened = 0;
+    std::int64_t steps = 0, one_thread_steps = 0; // threads = 0: steps taken on one thread, more not paying
+
+    void add(const sim::StepStats& st, int scene_substeps)
+    {
+        ++steps;
+        if (st.threads == 1) ++one_thread_steps;
+        ms_checks +=
+            std::max(0.0, st.ms_step - st.ms_detect - st.ms_depth - st.ms_proximity - st.ms_response - st.ms_integrate);
+        ms_detect += st.ms_detect;
+        ms_depth += st.ms_depth;
+        ms_proximity += st.ms_proximity;
+        ms_response += st.ms_response;
+        ignored += st.ignored_local;
+        ms_integrate += st.ms_integrate;
+        contacts += st.contacts;
+        iterations += st.solver_iterations;
+        tightened += st.tightened > 0 ? 1 : 0;
+        if (st.substeps > scene_substeps) {
+            ++refined;
+            refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
+        }
+        max_depth = std::max(max_depth, st.max_depth);
+        depth_sum += st.mean_depth * static_cast<double>(st.contacts);
+    }
+};
+
+/// The progress line after each step: a bar redrawn at most ten times a second on a terminal, a line every tenth of
+/// the run otherwise.
+class Progress {
+  public:
+    explicit Progress(int steps)
+        : m_tty(stderr_is_terminal()), m_start(std::chrono::steady_clock::now()), m_last_print(m_start),
+          m_plain_every(std::max(1, steps / 10))
+    {
+    }
+    bool tty() const { return m_tty; }
+    /// Seconds since the run started.
+    double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count(); }
+    void step(int s, int steps, const sim::Simulation& sim)
+    {
+        const sim::StepStats& st = sim.last_stats();
+        const auto now = std::chrono::steady_clock::now();
+        const double secs = std::chrono::duration<double>(now - m_start).count();
+        const double rate = secs > 0 ? (s + 1) / secs : 0.0;
+        const double eta = rate > 0 ? (steps - s - 1) / rate : 0.0;
+        const std::string times = fmt::format("  {:.1f} s elapsed, {:.1f} s left", secs, eta);
+        // What the run should not hide, as it happens: energy gained, substeps unconverged, steps refined.
+        std::string note;
+        const sim::RunHealth& hl = sim.health();
+        if (hl.energy_growth > sim::RunHealth::energy_slack)
+            note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
+        if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
+        if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
+        if (m_tty) {
+            if (std::chrono::duration<double>(now - m_last_print).count() > 0.1 || s + 1 == steps) {
+                const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, steps));
+                std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s   ",
+                             std::string(static_cast<size_t>(filled), '#').c_str(),
+                             std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, steps, rate,
+                             times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
+                m_last_print = now;
+            }
+        } else if ((s + 1) % m_plain_every == 0 || s + 1 == steps) {
+            std::fprintf(stderr, "step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s\n", s + 1, steps, rate,
+                         times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
+        }
+    }
+
+  private:
+    bool m_tty;
+    std::chrono::steady_clock::time_point m_start, m_last_print;
+    int m_plain_every;
+};
+
+/// The run's steps until the end or an interruption (Ctrl-C ends the run after the current step, which is rolled back
+/// when it is in progress): frames every `every` steps, continuous queries recorded, statistics summed. A run that
+/// fails writes run.json and its queries so far before the failure goes on. Returns the steps done.
+int run_steps(sim::Simulation& sim, const sim::Scene& scene, const std::string& out, int every,
+              CcdQueryRecorder& ccd_queries, FrameWriter& frames, RunTotals& totals, Progress& progress)
+{
+    int done = 0;
+    Positions step_start;
+    try {
+        for (int s = 0; s < scene.steps; ++s) {
+            if (g_interrupted) break;
+            const bool record = ccd_queries.wants(s + 1);
+            if (record) step_start = sim.positions();
+            try {
+                sim.step();
+            } catch (const sim::Interrupted&) {
+                break; // rolled back to the last complete step
+            }
+            done = s + 1;
+            if (record) ccd_queries.record(s + 1, sim.mesh().tets, step_start, sim.positions());
+            totals.add(sim.last_stats(), scene.substeps);
+            if (every > 0 && sim.step_index() % every == 0) frames.write(sim);
+            progress.step(s, scene.steps, sim);
+        }
+    } catch (const RunFailure&) {
+        if (progress.tty()) std::fprintf(stderr, "\n");
+        write_run_json(out, sim, "failed", progress.seconds());
+        ccd_queries.write(); // the queries of the steps completed
+        throw;
+    }
+    if (progress.tty()) std::fprintf(stderr, "\n");
+    return done;
+}
+
+/// The run's summary on stdout: the stages' times per step, contacts, solver, refined and retaken steps, depth,
+/// energy and health.
+void print_summary(const sim::Scene& scene, const sim::Simulation& sim, const RunTotals& t, double wall,
+                   const sim::Energy& e0, int threads)
+{
+    const int n = std::max(1, scene.steps);
+    const sim::Energy e1 = sim.energy();
+    // The stages add up to the step's wall time: the step's own checks (energy, inverted tets, blow-up, the
+    // copies of steps taken again), then what the loop adds (frames written, progress lines).
+    const double ms_step = 1e3 * wall / n;
+    const double ms_stages =
+        (t.ms_detect + t.ms_depth + t.ms_proximity + t.ms_response + t.ms_integrate + t.ms_checks) / n;
+    std::fprintf(stdout,
+                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, proximity %.3f, response %.3f, "
+                 "integration %.3f, checks %.3f, output and progress %.3f)\n",
+                 scene.steps, wall, ms_step, t.ms_detect / n, t.ms_depth / n, t.ms_proximity / n, t.ms_response / n,
+                 t.ms_integrate / n, t.ms_checks / n, std::max(0.0, ms_step - ms_stages));
+    if (scene.detect.threads == 0 && threads > 1)
+        std::fprintf(stdout,
+                     "threads: %d (every core) for %lld steps, 1 for %lld steps where %d did not pay (measured as the "
+                     "run went; the result is the same at any count)\n",
+                     threads, static_cast<long long>(t.steps - t.one_thread_steps),
+                     static_cast<long long>(t.one_thread_steps), threads);
+    std::fprintf(stdout, "contacts per step: %.1f (plus %.1f local self-contacts left to the elastic terms)\n",
+                 static_cast<double>(t.contacts) / n, static_cast<double>(t.ignored) / n);
+    if (t.iterations)
+        std::fprintf(stdout, "solver: %.1f %s per step\n", static_cast<double>(t.iterations) / n,
+                     scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
+    if (t.refined)
+        std::fprintf(stdout,
+                     "steps in more substeps: %lld of %d, up to %lld substeps (objects approaching fast, tets "
+                     "inverted, iterations unconverged or a blow-up at %d; max_substeps bounds it)\n",
+                     static_cast<long long>(t.refined), n, static_cast<long long>(t.refined_substeps), scene.substeps);
+    if (t.tightened)
+        std::fprintf(stdout, "steps taken again with tighter tolerances (they gained energy): %lld of %d\n",
+                     static_cast<long long>(t.tightened), n);
+    std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", t.max_depth,
+                 t.contacts ? t.depth_sum / static_cast<double>(t.contacts) : 0.0);
+    std::fprintf(stdout,
+                 "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
+                 "contact %.4g)\n",
+                 e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
+    const sim::RunHealth& health = sim.health();
+    std::fprintf(stdout,
+                 "health: energy end/start %.4g (most gained %.3g %% of what the scene had to spend), volume end/start "
+                 "%.4f (least %.4f), %lld unconverged of %lld substeps, %lld refined steps, %lld tets inverted\n",
+                 health.energy_start != 0 ? health.energy_end / health.energy_start : 1.0,
+                 100 * std::max(0.0, health.energy_growth), health.volume_end, health.volume_ratio,
+                 static_cast<long long>(health.unconverged_substeps), static_cast<long long>(health.substeps),
+                 static_cast<long long>(health.refined_steps), static_cast<long long>(health.inverted_end));
+}
+
+void run_simulate(SimulateOptions o)
+{
+    if (o.template_scene) {
+        std::fputs(template_text(), stdout);
+        return;
+    }
+    std::string mesh_scene;
+    const sim::Scene scene = simulate_scene(o, mesh_scene);
     // Threads: the scene's ([detector] threads; a scene file's default is 0), --threads overrides; 0 = every core,
     // fewer in the steps where they do not pay.
     const int all = set_threads(scene.detect.threads);
@@ -288,80 +543,18 @@ void run_simulate(SimulateOptions o)
     for (const std::string& w : sim.warnings())
         std::fprintf(stderr, "tethash: warning: %s\n", w.c_str());
 
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec) {
-        // A file on the way is a bad --out; anything else is the file system refusing (exit 1).
-        const std::string msg = "--out: cannot create folder '" + o.out + "': " + ec.message();
-        if (ec == std::errc::not_a_directory || ec == std::errc::file_exists) throw Error(msg);
-        throw WriteError(msg);
-    }
-    // A previous run's frames would join this run's in ParaView's file group: they go first (only the files this
-    // command writes: frame_NNNNN.vtu and scene.pvd), and the run says so.
-    const int removed = remove_previous_frames(o.out);
-    if (removed > 0)
-        std::fprintf(stderr, "tethash: note: removed %d file%s of a previous run from %s\n", removed,
-                     removed == 1 ? "" : "s", o.out.c_str());
-    if (!mesh_scene.empty()) {
-        const std::string path = (std::filesystem::path(o.out) / "scene.toml").string();
-        io::write_text_file(path, mesh_scene);
-        std::fprintf(stderr, "tethash: note: the scene of this run is %s (edit it, run it again)\n", path.c_str());
-    }
-    std::vector<io::PvdEntry> series;
-    const std::string pvd = (std::filesystem::path(o.out) / "scene.pvd").string();
-    // What does not move (the bsp obstacles, the ground) is written once, static.vtu, and listed at every time as
-    // part 1 of the series: ParaView and `tethash render` show it beside the frames (part 0).
-    std::string static_file;
-    auto write_frame = [&]() {
-        const std::string name = fmt::format("frame_{:05d}.vtu", sim.step_index());
-        io::write_vtu((std::filesystem::path(o.out) / name).string(), sim.mesh(), sim.output_fields());
-        // After the first frame (a folder that takes no frame gets no static surface either).
-        if (series.empty()) {
-            const sim::StaticSurface st = sim.static_surface();
-            if (st.surface.triangles.rows() > 0) {
-                static_file = "static.vtu";
-                io::write_vtu_surface((std::filesystem::path(o.out) / static_file).string(), st.surface,
-                                      st.triangle_object);
-            }
-        }
-        series.push_back({sim.time(), name, 0});
-        if (!static_file.empty()) series.push_back({sim.time(), static_file, 1});
-        io::write_pvd_parts(pvd, series);
-    };
+    prepare_out_folder(o.out, mesh_scene);
+    FrameWriter frames(o.out);
     // 60 frames per simulated second unless the scene says (a frame every step of a 55k-tet mesh wrote 2.5 GB).
     const int every = scene.output.every >= 0 ? scene.output.every
                                               : std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
-    if (every > 0) write_frame();
+    if (every > 0) frames.write(sim);
 
     const sim::Energy e0 = sim.energy();
-    std::fprintf(stdout, "scene: %s\n", scene.source.c_str());
-    std::fprintf(
-        stdout,
-        "%d objects, %d vertices, %d tets, %d springs; integrator %s, dt %g s x %d substeps, %d steps, %s%d thread%s\n",
-        static_cast<int>(scene.objects.size()), sim.mesh().num_vertices(), sim.mesh().num_tets(),
-        static_cast<int>(sim.model().springs.edges.rows()), sim::to_string(scene.integrator), scene.dt, scene.substeps,
-        scene.steps, scene.detect.threads == 0 && threads > 1 ? "up to " : "", threads, threads == 1 ? "" : "s");
-    {
-        std::string sizes;
-        const std::vector<double> size = sim.object_sizes();
-        for (size_t k = 0; k < size.size(); ++k)
-            sizes += fmt::format("{}{} {:.4g} m", k ? ", " : "",
-                                 scene.objects[k].name.empty() ? fmt::format("object {}", k) : scene.objects[k].name,
-                                 size[k]);
-        std::fprintf(stdout, "object sizes (longest extent): %s\n", sizes.c_str());
-    }
-    if (scene.integrator == sim::Integrator::symplectic_euler)
-        std::fprintf(stdout, "explicit stability limit ~ %.3g s\n", sim.explicit_dt_limit());
-    std::fflush(stdout);
+    print_run_header(scene, sim, threads);
 
-    const bool tty = stderr_is_terminal();
-    double ms_detect = 0, ms_depth = 0, ms_proximity = 0, ms_response = 0, ms_integrate = 0, ms_checks = 0,
-           max_depth = 0, depth_sum = 0;
-    std::int64_t one_thread_steps = 0; // threads = 0: steps taken on one thread, the others not paying
-    std::int64_t contacts = 0, iterations = 0, ignored = 0, refined = 0, refined_substeps = 0, tightened = 0;
-    const auto start = std::chrono::steady_clock::now();
-    auto last_print = start;
-    const int plain_every = std::max(1, scene.steps / 10);
+    RunTotals totals;
+    Progress progress(scene.steps);
     // Ctrl-C ends the run after the current step with a note of where it stopped; the frames written so far and
     // scene.pvd stay a valid series.
     g_interrupted = 0;
@@ -371,141 +564,29 @@ void run_simulate(SimulateOptions o)
         decltype(old_handler) h;
         ~Restore() { std::signal(SIGINT, h); }
     } restore{old_handler};
-    int done = 0;
-    Positions step_start;
-    try {
-        for (int s = 0; s < scene.steps; ++s) {
-            if (g_interrupted) break;
-            const bool record = ccd_queries.wants(s + 1);
-            if (record) step_start = sim.positions();
-            try {
-                sim.step();
-            } catch (const sim::Interrupted&) {
-                break; // rolled back to the last complete step
-            }
-            done = s + 1;
-            if (record) ccd_queries.record(s + 1, sim.mesh().tets, step_start, sim.positions());
-            const sim::StepStats& st = sim.last_stats();
-            ms_detect += st.ms_detect;
-            ms_depth += st.ms_depth;
-            ms_proximity += st.ms_proximity;
-            ms_response += st.ms_response;
-            ignored += st.ignored_local;
-            ms_integrate += st.ms_integrate;
-            ms_checks += std::max(0.0, st.ms_step - st.ms_detect - st.ms_depth - st.ms_proximity - st.ms_response -
-                                           st.ms_integrate);
-            if (st.threads == 1 && threads > 1) ++one_thread_steps;
-            contacts += st.contacts;
-            iterations += st.solver_iterations;
-            tightened += st.tightened > 0 ? 1 : 0;
-            if (st.substeps > scene.substeps) {
-                ++refined;
-                refined_substeps = std::max<std::int64_t>(refined_substeps, st.substeps);
-            }
-            max_depth = std::max(max_depth, st.max_depth);
-            depth_sum += st.mean_depth * static_cast<double>(st.contacts);
-            if (every > 0 && sim.step_index() % every == 0) write_frame();
-            const auto now = std::chrono::steady_clock::now();
-            const double secs = std::chrono::duration<double>(now - start).count();
-            const double rate = secs > 0 ? (s + 1) / secs : 0.0;
-            const double eta = rate > 0 ? (scene.steps - s - 1) / rate : 0.0;
-            const std::string times = fmt::format("  {:.1f} s elapsed, {:.1f} s left", secs, eta);
-            // What the run should not hide, as it happens: energy gained, substeps unconverged, steps refined.
-            std::string note;
-            const sim::RunHealth& hl = sim.health();
-            if (hl.energy_growth > sim::RunHealth::energy_slack)
-                note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
-            if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
-            if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
-            if (tty) {
-                if (std::chrono::duration<double>(now - last_print).count() > 0.1 || s + 1 == scene.steps) {
-                    const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, scene.steps));
-                    std::fprintf(stderr, "\r[%s%s] step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s   ",
-                                 std::string(static_cast<size_t>(filled), '#').c_str(),
-                                 std::string(static_cast<size_t>(width - filled), '.').c_str(), s + 1, scene.steps,
-                                 rate, times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
-                    last_print = now;
-                }
-            } else if ((s + 1) % plain_every == 0 || s + 1 == scene.steps) {
-                std::fprintf(stderr, "step %d/%d  %.1f steps/s%s  contacts %lld  max pen %.3g%s\n", s + 1, scene.steps,
-                             rate, times.c_str(), static_cast<long long>(st.contacts), st.max_depth, note.c_str());
-            }
-        }
-    } catch (const RunFailure&) {
-        if (tty) std::fprintf(stderr, "\n");
-        write_run_json(o.out, sim, "failed",
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        ccd_queries.write(); // the queries of the steps completed
-        throw;
-    }
-    if (tty) std::fprintf(stderr, "\n");
-    const std::size_t frames = static_cast<std::size_t>(
-        std::count_if(series.begin(), series.end(), [](const io::PvdEntry& e) { return e.part == 0; }));
+    const int done = run_steps(sim, scene, o.out, every, ccd_queries, frames, totals, progress);
     if (g_interrupted) {
-        write_run_json(o.out, sim, "interrupted",
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        write_run_json(o.out, sim, "interrupted", progress.seconds());
         ccd_queries.write();
         std::fprintf(stderr,
                      "tethash: interrupted after step %d of %d (t = %g s); the %zu frame%s written so far form a valid "
                      "series: %s\n",
-                     done, scene.steps, sim.time(), frames, frames == 1 ? "" : "s", pvd.c_str());
+                     done, scene.steps, sim.time(), frames.frames(), frames.frames() == 1 ? "" : "s",
+                     frames.pvd().c_str());
         std::fflush(stderr);
         std::signal(SIGINT, SIG_DFL);
         std::raise(SIGINT); // the conventional status of a run ended by Ctrl-C (130 from a shell)
     }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const int n = std::max(1, scene.steps);
-    const sim::Energy e1 = sim.energy();
-    // The stages add up to the step's wall time: the step's own checks (energy, inverted tets, blow-up, the
-    // copies of steps taken again), then what the loop adds (frames written, progress lines).
-    const double ms_step = 1e3 * wall / n;
-    const double ms_stages = (ms_detect + ms_depth + ms_proximity + ms_response + ms_integrate + ms_checks) / n;
-    std::fprintf(stdout,
-                 "steps: %d in %.3f s (%.2f ms/step: detection %.3f, depth %.3f, proximity %.3f, response %.3f, "
-                 "integration %.3f, checks %.3f, output and progress %.3f)\n",
-                 scene.steps, wall, ms_step, ms_detect / n, ms_depth / n, ms_proximity / n, ms_response / n,
-                 ms_integrate / n, ms_checks / n, std::max(0.0, ms_step - ms_stages));
-    if (scene.detect.threads == 0 && threads > 1)
-        std::fprintf(stdout,
-                     "threads: %d (every core) for %lld steps, 1 for %lld steps where %d did not pay (measured as the "
-                     "run went; the result is the same at any count)\n",
-                     threads, static_cast<long long>(done - one_thread_steps), static_cast<long long>(one_thread_steps),
-                     threads);
-    std::fprintf(stdout, "contacts per step: %.1f (plus %.1f local self-contacts left to the elastic terms)\n",
-                 static_cast<double>(contacts) / n, static_cast<double>(ignored) / n);
-    if (iterations)
-        std::fprintf(stdout, "solver: %.1f %s per step\n", static_cast<double>(iterations) / n,
-                     scene.integrator == sim::Integrator::vbd ? "sweeps" : "CG iterations");
-    if (refined)
-        std::fprintf(stdout,
-                     "steps in more substeps: %lld of %d, up to %lld substeps (objects approaching fast, tets "
-                     "inverted, iterations unconverged or a blow-up at %d; max_substeps bounds it)\n",
-                     static_cast<long long>(refined), n, static_cast<long long>(refined_substeps), scene.substeps);
-    if (tightened)
-        std::fprintf(stdout, "steps taken again with tighter tolerances (they gained energy): %lld of %d\n",
-                     static_cast<long long>(tightened), n);
-    std::fprintf(stdout, "penetration depth: max %.4g, mean %.4g\n", max_depth,
-                 contacts ? depth_sum / static_cast<double>(contacts) : 0.0);
-    std::fprintf(stdout,
-                 "energy: start %.6g, end %.6g (kinetic %.4g, spring %.4g, volume %.4g, gravity %.4g, ground %.4g, "
-                 "contact %.4g)\n",
-                 e0.total(), e1.total(), e1.kinetic, e1.spring, e1.volume, e1.gravity, e1.ground, e1.contact);
-    const sim::RunHealth& health = sim.health();
-    std::fprintf(stdout,
-                 "health: energy end/start %.4g (most gained %.3g %% of what the scene had to spend), volume end/start "
-                 "%.4f (least %.4f), %lld unconverged of %lld substeps, %lld refined steps, %lld tets inverted\n",
-                 health.energy_start != 0 ? health.energy_end / health.energy_start : 1.0,
-                 100 * std::max(0.0, health.energy_growth), health.volume_end, health.volume_ratio,
-                 static_cast<long long>(health.unconverged_substeps), static_cast<long long>(health.substeps),
-                 static_cast<long long>(health.refined_steps), static_cast<long long>(health.inverted_end));
-    const std::vector<std::string> problems = health.problems();
+    const double wall = progress.seconds();
+    print_summary(scene, sim, totals, wall, e0, threads);
+    const std::vector<std::string> problems = sim.health().problems();
     for (const std::string& p : problems)
         std::fprintf(stderr, "tethash: warning: %s\n", p.c_str());
     write_run_json(o.out, sim, problems.empty() ? "ok" : "untrusted", wall);
     ccd_queries.write();
     if (every > 0)
         std::fprintf(stdout, "frames: %zu in %s (open scene.pvd in ParaView; run.json says how far to trust them)\n",
-                     frames, o.out.c_str());
+                     frames.frames(), o.out.c_str());
     if (render_options) render_run(render::open_series(o.out), *render_options, o.render);
     if (o.strict && !problems.empty())
         throw RunFailure("--strict: the run cannot be trusted (" + std::to_string(problems.size()) + " problem" +

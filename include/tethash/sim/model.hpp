@@ -76,8 +76,9 @@ inline constexpr double material_courant = 0.1;
 /// Coulomb friction (on the ground and in contacts) is smoothed below a sliding speed of this many times the object's
 /// size per second (the largest side of its rest bounding box; Model::friction_speed), so that a scene moves the same
 /// whatever the unit of length: 1 mm/s for a body 5 cm across, as the former absolute 1 mm/s, and 2 cm/s at 1 m.
-/// Smaller (1e-3: 50 µm/s at 5 cm) made the friction of small stiff bodies too stiff for the sweeps: a 5 cm octopus
-/// of young 1e9 gained 17 % of its scene's energy at 1/240 (test StiffSmallBodiesNeitherGainEnergyNorBlowUp).
+/// Smaller (1e-3: 50 µm/s at 5 cm) made the friction of small stiff bodies too stiff for the sweeps: their drops
+/// gained energy (test StiffSmallBodiesNeitherGainEnergyNorBlowUp; docs/simulator.md, "Figures behind the code's
+/// constants").
 inline constexpr double friction_smoothing = 0.02;
 
 /// Everything computed once from the rest state.

@@ -109,7 +109,8 @@ struct Scene {
     LinearSolver solver = LinearSolver::cg;
     /// vbd: sweeps over all vertices per substep; 0 = automatic: until they converge (`convergence`), at least 1, at
     /// most `max_iterations`. A fixed count leaves small or stiff bodies unconverged: the sweeps needed grow with
-    /// ω h (ω = c / L̄ the material's frequency at the mean edge), 6.7× from 1 m to 15 cm at a fixed mesh.
+    /// ω h (ω = c / L̄ the material's frequency at the mean edge), which grows as 1 / size at a fixed mesh
+    /// (docs/simulator.md, "Convergence at every size").
     int iterations = 0;
     /// vbd, automatic sweeps: a substep has converged when a sweep's moves (in the local Hessians' norm: the energy
     /// they take out) are below this fraction of the largest sweep's, and below a thousandth of the energy the scene

@@ -1,8 +1,9 @@
-// Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, a hashed cell grid over its
+// Edge-face contacts at one instant (include/tethash/edge_contacts.hpp): the boundary, the grid of boxes over its
 // triangles, each boundary edge's box queried in it, the object rules, the exact crossing test; per-thread lists
 // merged and sorted.
 #include "tethash/edge_contacts.hpp"
 
+#include "../hash/box_grid.hpp"
 #include "../hash/detect_checks.hpp"
 #include "../hash/hash_grid.hpp"
 #include "../team.hpp"
@@ -12,7 +13,6 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -62,43 +62,38 @@ EdgeFaceCrossing edge_face_crossing(const double* p, const double* q, const doub
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using Cell = std::array<std::int32_t, 3>;
 struct Box {
     double lo[3], hi[3];
 };
 
-/// The broad phase: a uniform grid over the boundary triangles' boxes, its cells hashed into a table by columns (the
-/// Detector's column hash, hash_grid.hpp: the cells of one (x, y) column in consecutive buckets) and filled by a
-/// counting sort in face order, so the table depends on the input only. An edge visits the cells of its box and
-/// meets a triangle in the first cell the two cell boxes share, so each pair once. It replaced the core's box tree
-/// (triangle_bvh.hpp), whose node boxes overlap on overlapping bodies: 10-20 % less time per call on the scenes of
-/// `tethash_bench --edges` (docs/ccd.md).
+/// The broad phase: the boundary triangles' boxes in the core's grid of boxes (box_grid.hpp), the table depending on
+/// the input only. An edge queries its box and meets each triangle once, then tests the double boxes exactly. A
+/// hashed grid replaced the core's box tree (triangle_bvh.hpp), whose node boxes overlap on overlapping bodies
+/// (docs/ccd.md has the figures).
 class FaceGrid {
   public:
     /// Cell size: the mean boundary edge length, doubled while the triangles would cover more than 64 cells each on
-    /// average (a few huge triangles), and at least 2^-20 of the extent (cell coordinates below 2^21).
+    /// average (a few huge triangles), and at least 2^-20 of the extent.
     void build(const PositionsRef& x, const Triangles& faces, const Edges& edges)
     {
         const auto nf = static_cast<std::size_t>(faces.rows());
-        m_origin = Vec3::Constant(std::numeric_limits<double>::infinity());
-        Vec3 top = -m_origin;
+        Vec3 origin = Vec3::Constant(std::numeric_limits<double>::infinity());
+        Vec3 top = -origin;
         double length = 0;
         for (Eigen::Index f = 0; f < faces.rows(); ++f)
             for (int k = 0; k < 3; ++k) {
                 const Vec3 p = x.row(faces(f, k)).transpose();
-                m_origin = m_origin.cwiseMin(p);
+                origin = origin.cwiseMin(p);
                 top = top.cwiseMax(p);
             }
         for (Eigen::Index e = 0; e < edges.rows(); ++e)
             length += (x.row(edges(e, 0)) - x.row(edges(e, 1))).norm();
-        if (nf == 0) return;
-        const double extent = (top - m_origin).maxCoeff();
-        m_cell = edges.rows() > 0 ? length / static_cast<double>(edges.rows()) : 0;
-        m_cell = std::max(m_cell, std::ldexp(extent, -20));
-        if (!(m_cell > 0) || !std::isfinite(m_cell)) m_cell = 1;
-        m_lo.resize(nf);
-        m_hi.resize(nf);
         m_box.resize(nf);
+        if (nf == 0) return;
+        const double extent = (top - origin).maxCoeff();
+        double cell = edges.rows() > 0 ? length / static_cast<double>(edges.rows()) : 0;
+        cell = std::max(cell, std::ldexp(extent, -20));
+        if (!(cell > 0) || !std::isfinite(cell)) cell = 1;
         for (std::size_t f = 0; f < nf; ++f) {
             const auto fi = static_cast<Eigen::Index>(f);
             for (int a = 0; a < 3; ++a) {
@@ -109,100 +104,42 @@ class FaceGrid {
         }
         std::int64_t total = 0;
         for (;;) {
-            m_inv = 1 / m_cell;
+            const double inv = 1 / cell;
             total = 0;
-            for (std::size_t f = 0; f < nf; ++f) {
-                for (int a = 0; a < 3; ++a) {
-                    m_lo[f][static_cast<std::size_t>(a)] = cell_of(m_box[f].lo[a], a);
-                    m_hi[f][static_cast<std::size_t>(a)] = cell_of(m_box[f].hi[a], a);
-                }
-                total += cells(m_lo[f], m_hi[f]);
+            for (const Box& b : m_box) {
+                std::int64_t cells = 1;
+                for (int a = 0; a < 3; ++a)
+                    cells *= detail::BoxGrid::cell_of(b.hi[a], inv) - detail::BoxGrid::cell_of(b.lo[a], inv) + 1;
+                total += cells;
             }
             if (total <= 64 * static_cast<std::int64_t>(nf)) break;
-            m_cell *= 2;
+            cell *= 2;
         }
         const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
-        m_mask = static_cast<std::uint64_t>(buckets) - 1;
-        m_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
-        m_entry.resize(static_cast<std::size_t>(total));
-        for (std::size_t f = 0; f < nf; ++f)
-            for_cells(m_lo[f], m_hi[f],
-                      [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) { ++m_start[bucket(cx, cy, cz) + 1]; });
-        for (std::size_t b = 0; b + 1 < m_start.size(); ++b)
-            m_start[b + 1] += m_start[b];
-        std::vector<std::int64_t> next(m_start.begin(), m_start.end() - 1);
-        for (std::size_t f = 0; f < nf; ++f)
-            for_cells(m_lo[f], m_hi[f], [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
-                const auto at = static_cast<std::size_t>(next[bucket(cx, cy, cz)]++);
-                m_entry[at] = {key(cx, cy, cz), static_cast<Index>(f), m_lo[f], m_box[f]};
-            });
+        m_grid.begin(cell, static_cast<std::size_t>(buckets), nf);
+        for (const Box& b : m_box)
+            m_grid.add(b.lo, b.hi);
+        m_grid.finish();
     }
 
-    /// Calls visit(f) once for every triangle whose box meets the box lo..hi.
-    template <class Visit> void for_box(const Vec3& lo, const Vec3& hi, Visit&& visit) const
+    /// Calls visit(f) once for every triangle whose box meets the box lo..hi. `stamp`, `tag` and `hits` as
+    /// BoxGrid::query's.
+    template <class Visit>
+    void for_box(const Vec3& lo, const Vec3& hi, std::int32_t* stamp, std::int32_t tag, std::vector<std::int32_t>& hits,
+                 Visit&& visit) const
     {
-        if (m_entry.empty()) return;
-        const Cell clo = {cell_of(lo[0], 0), cell_of(lo[1], 1), cell_of(lo[2], 2)};
-        const Cell chi = {cell_of(hi[0], 0), cell_of(hi[1], 1), cell_of(hi[2], 2)};
-        for_cells(clo, chi, [&](std::int32_t cx, std::int32_t cy, std::int32_t cz) {
-            const std::uint64_t b = bucket(cx, cy, cz), k = key(cx, cy, cz);
-            for (std::int64_t i = m_start[b]; i < m_start[b + 1]; ++i) {
-                const Entry& en = m_entry[static_cast<std::size_t>(i)];
-                if (en.key != k) continue;
-                // Only in the first cell the two cell boxes share.
-                if (cx != std::max(clo[0], en.lo[0]) || cy != std::max(clo[1], en.lo[1]) ||
-                    cz != std::max(clo[2], en.lo[2]))
-                    continue;
-                if ((lo[0] > en.box.hi[0]) | (lo[1] > en.box.hi[1]) | (lo[2] > en.box.hi[2]) | (hi[0] < en.box.lo[0]) |
-                    (hi[1] < en.box.lo[1]) | (hi[2] < en.box.lo[2]))
-                    continue;
-                visit(en.face);
-            }
+        m_grid.query(lo.data(), hi.data(), stamp, tag, hits, false, [&](std::int32_t f) {
+            const Box& b = m_box[static_cast<std::size_t>(f)];
+            if ((lo[0] > b.hi[0]) | (lo[1] > b.hi[1]) | (lo[2] > b.hi[2]) | (hi[0] < b.lo[0]) | (hi[1] < b.lo[1]) |
+                (hi[2] < b.lo[2]))
+                return;
+            visit(static_cast<Index>(f));
         });
     }
 
   private:
-    std::int32_t cell_of(double v, int a) const
-    {
-        // The origin is the boundary's least corner and the extent is at most 2^20 cells: in [0, 2^21).
-        return std::clamp(floor_to_int((v - m_origin[a]) * m_inv), 0, (1 << 21) - 1);
-    }
-    static std::int64_t cells(const Cell& lo, const Cell& hi)
-    {
-        return std::int64_t{hi[0] - lo[0] + 1} * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
-    }
-    template <class F> static void for_cells(const Cell& lo, const Cell& hi, F&& f)
-    {
-        for (std::int32_t cx = lo[0]; cx <= hi[0]; ++cx)
-            for (std::int32_t cy = lo[1]; cy <= hi[1]; ++cy)
-                for (std::int32_t cz = lo[2]; cz <= hi[2]; ++cz)
-                    f(cx, cy, cz);
-    }
-    static std::uint64_t key(std::int32_t cx, std::int32_t cy, std::int32_t cz)
-    {
-        return static_cast<std::uint64_t>(cx) | static_cast<std::uint64_t>(cy) << 21 |
-               static_cast<std::uint64_t>(cz) << 42;
-    }
-    std::uint64_t bucket(std::int32_t cx, std::int32_t cy, std::int32_t cz) const
-    {
-        return (column_mix(cx, cy) + static_cast<std::uint64_t>(cz)) & m_mask;
-    }
-
-    Vec3 m_origin = Vec3::Zero();
-    double m_cell = 1, m_inv = 1;
-    std::uint64_t m_mask = 0;
-    std::vector<Cell> m_lo, m_hi;      ///< per face: its cell box
-    std::vector<std::int64_t> m_start; ///< per bucket + 1: the bucket's entries m_start[b] .. m_start[b + 1] − 1
-    /// An entry: a triangle in a cell, with what the query tests, so that a bucket is read in one sweep (a dense
-    /// sheet puts tens of triangles in a cell; reading their boxes from the positions cost a cache miss each).
-    struct Entry {
-        std::uint64_t key; ///< the cell
-        Index face;        ///< the triangle
-        Cell lo;           ///< the triangle's first cell
-        Box box;           ///< the triangle's box
-    };
-    std::vector<Box> m_box;     ///< per face
-    std::vector<Entry> m_entry; ///< per entry, by bucket
+    std::vector<Box> m_box; ///< per face
+    detail::BoxGrid m_grid;
 };
 
 } // namespace
@@ -270,13 +207,14 @@ const EdgeFaceResult& EdgeFaceDetector::find(const PositionsRef& positions, int 
         std::int64_t& count = candidates[static_cast<std::size_t>(rank)];
         std::int64_t begin = 0, end = 0;
         detail::team_split(ne, rank, size, begin, end);
+        std::vector<std::int32_t> stamp(static_cast<std::size_t>(faces.rows()), -1), hits;
         for (std::int64_t e = begin; e < end; ++e) {
             const Index ev[2] = {edges(e, 0), edges(e, 1)};
             const Index eo = m_edge_object[static_cast<std::size_t>(e)];
             const bool e_static = m_static[static_cast<std::size_t>(eo)] != 0;
             const Vec3 p = point(ev[0]), q = point(ev[1]);
             const Vec3 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
-            grid.for_box(lo, hi, [&](Index f) {
+            grid.for_box(lo, hi, stamp.data(), static_cast<std::int32_t>(e), hits, [&](Index f) {
                 const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
                 const Index fo = m_face_object[static_cast<std::size_t>(f)];
                 if (e_static && m_static[static_cast<std::size_t>(fo)]) return;
