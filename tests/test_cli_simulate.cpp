@@ -78,10 +78,13 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
     const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
-                               " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --out " + quote(dir / "out"));
+                               " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --crossing-check on --out " +
+                               quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("vbd"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("steps: 3 "), std::string::npos) << r.out;
+    EXPECT_NE(read_text(dir / "out" / "run.json").find("\"crossing_steps\": 0"), std::string::npos)
+        << read_text(dir / "out" / "run.json");
 }
 
 TEST(CliSimulate, DefaultSceneRuns)
@@ -152,6 +155,11 @@ TEST(CliSimulate, BadSceneKeysAndOptionsExit2)
     expect_refused(r, {"--threads"});
     r = run_tethash("simulate " + quote(dir / "missing.toml"));
     expect_refused(r, {"missing.toml"});
+    r = run_tethash("simulate --crossing-check yes --steps 1 --out " + quote(dir / "o"));
+    expect_refused(r, {"--crossing-check", "on or off", "'yes'"});
+    write_text(dir / "bad3.toml", "crossing_check = 1\n[[object]]\ngenerate = { shape = \"box\" }\n");
+    r = run_tethash("simulate " + quote(dir / "bad3.toml") + " --steps 1 --out " + quote(dir / "o"));
+    expect_refused(r, {"bad3.toml:1", "crossing_check"});
 }
 
 TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)

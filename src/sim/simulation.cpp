@@ -92,6 +92,12 @@ class SimulationImpl {
     detail::ThreadChoice thread_choice;
     bool choose_threads = false;
     int threads_now = 1;
+    // Scene::crossing_check: the (vertex, object) pairs the contacts of the last update watched (penetrations and
+    // margin contacts, sorted), and the state of the step's end update, which the next step's first substep reuses.
+    std::vector<std::pair<Index, Index>> watched;
+    bool contacts_at_end = false;
+    Positions x_end, v_end;
+    double h_end = 0;
 
     explicit SimulationImpl(const Scene& s);
     std::string object_name(size_t k) const
@@ -109,6 +115,11 @@ class SimulationImpl {
     /// The substeps (scene.substeps times a power of two, at most `most`) in which no two objects whose swept boxes
     /// meet during the step close by more than approach_reach of their mean edge per substep.
     int approach_substeps(int most) const;
+    /// Contacts at positions x for a substep h; the step's end update is reused when nothing moved since.
+    void update_contacts(const Positions& x, double h, StepStats& st);
+    /// Whether a vertex is inside a tet of an object that the last watch did not watch it against (a far part
+    /// entered within a substep unseen); then sets `watched` to what the current contacts watch.
+    bool entered_unseen();
     TetMesh& mesh() { return objects.mesh; }
     const TetMesh& mesh() const { return objects.mesh; }
     void automatic_ground();
@@ -264,6 +275,33 @@ int SimulationImpl::approach_substeps(int most) const
     while (substeps < most && closing > substeps)
         substeps *= 2;
     return std::min(substeps, most);
+}
+
+void SimulationImpl::update_contacts(const Positions& x, double h, StepStats& st)
+{
+    if (contacts_at_end && h == h_end && (x.array() == x_end.array()).all() && (v.array() == v_end.array()).all()) {
+        contacts_at_end = false;
+        return;
+    }
+    contacts_at_end = false;
+    contacts.update(x, v, h, st);
+}
+
+bool SimulationImpl::entered_unseen()
+{
+    bool unseen = false;
+    for (const Contact& c : contacts.contacts())
+        if (c.tet >= 0 && !std::binary_search(watched.begin(), watched.end(), std::pair(c.vertex, c.tet_object))) {
+            unseen = true;
+            break;
+        }
+    watched.clear();
+    for (const Contact& c : contacts.contacts())
+        if (c.tet >= 0) watched.emplace_back(c.vertex, c.tet_object);
+    for (const Contact& c : contacts.margin_contacts())
+        watched.emplace_back(c.vertex, c.tet_object);
+    std::sort(watched.begin(), watched.end());
+    return unseen;
 }
 
 void SimulationImpl::check_time_step()
@@ -448,13 +486,19 @@ void Simulation::step()
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
+        bool crossed = false;
         for (sub = 0; sub < substeps; ++sub) {
             try {
-                s.contacts.update(x, s.v, h, st);
+                s.update_contacts(x, h, st);
             } catch (const Error& e) {
                 // The input was checked at construction: a detector error now comes from the state (a vertex
                 // flung far away, a tet stretched over millions of cells), i.e. from a diverging run.
                 bad = std::string("collision detection failed (") + e.what() + ")";
+                break;
+            }
+            // A far part entered within the last substep, unseen by its contacts: the step again in more substeps.
+            if (s.scene.crossing_check && s.entered_unseen() && sub > 0 && substeps * 2 <= max_substeps) {
+                crossed = true;
                 break;
             }
             const auto t0 = Clock::now();
@@ -469,6 +513,10 @@ void Simulation::step()
             }
             bad = s.failure.check_substep(s.model, x, s.v, s.t + (sub + 1) * h);
             if (!bad.empty()) break;
+        }
+        if (crossed && refine()) {
+            ++st.crossings;
+            continue;
         }
         if (bad.empty()) {
             const Energy e = s.model.energy(x, s.v);
@@ -503,11 +551,28 @@ void Simulation::step()
         // stiff body, which can gain the scene a tenth of its energy in one such substep; docs/simulator.md): taken
         // again in more substeps, like a blow-up.
         if (st.unconverged > 0 && refine()) continue;
+        // vbd turns back what the step left inverted (positions only); the count above, which the refinement and
+        // the crumple check read, is the step's own.
+        s.integrator->finish_step(x, s.inverted_tets);
+        // The step's end as it stays, detected for the crossing check (and reused by the next step's first substep).
+        if (s.scene.crossing_check) {
+            try {
+                s.contacts.update(x, s.v, h, st);
+            } catch (const Error& e) {
+                if (refine()) continue;
+                fail(std::string("collision detection failed (") + e.what() + ")");
+            }
+            s.contacts_at_end = true;
+            s.x_end = x;
+            s.v_end = s.v;
+            s.h_end = h;
+            if (s.entered_unseen() && refine()) {
+                ++st.crossings;
+                continue;
+            }
+        }
         break;
     }
-    // vbd turns back what the step left inverted (positions only); the count above, which the refinement and the
-    // crumple check read, is the step's own.
-    s.integrator->finish_step(x, s.inverted_tets);
     s.integrator->relax();
     if (substeps > s.refined && substeps > approach) {
         s.refined = substeps;
@@ -534,6 +599,7 @@ void Simulation::step()
     ++hl.steps;
     hl.substeps += substeps;
     if (substeps > std::max(s.scene.substeps, approach)) ++hl.refined_steps;
+    if (st.crossings > 0) ++hl.crossing_steps;
     hl.unconverged_substeps += st.unconverged;
     hl.energy_end = energy_now;
     if (hl.energy_scale > 0)
@@ -633,6 +699,7 @@ std::vector<double> Simulation::exact_depths() const
 void Simulation::refresh_contacts()
 {
     StepStats st;
+    m_impl->contacts_at_end = false;
     m_impl->contacts.update(m_impl->mesh().positions, m_impl->v, m_impl->scene.dt / m_impl->scene.substeps, st);
 }
 
@@ -692,8 +759,10 @@ std::vector<std::string> RunHealth::problems() const
                       " substeps stopped at max_iterations unconverged: raise max_iterations or lower dt");
     if (refined_steps > 0)
         out.push_back(std::to_string(refined_steps) + " of " + std::to_string(steps) +
-                      " steps were taken again in more substeps (tets inverted, a blow-up, iterations unconverged or "
-                      "energy gained at dt): dt is large for the material or the impacts");
+                      " steps were taken again in more substeps (tets inverted, a blow-up, iterations unconverged, "
+                      "energy gained" +
+                      (crossing_steps > 0 ? ", far parts entered unseen in " + std::to_string(crossing_steps) : "") +
+                      " at dt): dt is large for the material or the impacts");
     if (tets > 0 && inverted_end * 1000 > tets)
         out.push_back(std::to_string(inverted_end) + " of " + std::to_string(tets) + " tets (" +
                       percent(static_cast<double>(inverted_end) / static_cast<double>(tets)) + ") end inverted");

@@ -236,6 +236,7 @@ struct SimBenchOptions {
     bool no_coarse = false;
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
     bool no_speculative = false, inversion_guard = false;
+    std::string crossing_check;
     bool no_peer = false;
 };
 
@@ -284,6 +285,10 @@ void add_options(CLI::App& app, SimBenchOptions& o)
         ->check(CLI::NonNegativeNumber);
     overrides->add_flag("--no-speculative", o.no_speculative, "no speculative contacts (proximity.hpp)");
     overrides->add_flag("--inversion-guard", o.inversion_guard, "vbd: keep tets the right way out (inversion_guard)");
+    overrides
+        ->add_option("--crossing-check", o.crossing_check,
+                     "on or off: retake a step in more substeps where a far part was entered unseen (crossing_check)")
+        ->check(CLI::IsMember({"on", "off"}));
     CLI::Option_group* peer = app.add_option_group("Peer", "Bullet's soft bodies, when built with libbullet-dev");
     peer->add_flag("--no-peer", o.no_peer, "do not run the peer even when built with it");
     peer->add_option("--peer-iterations", o.peer_iterations, "the peer's position iterations")->capture_default_str();
@@ -394,6 +399,7 @@ void apply_overrides(sim::Scene& scene, const SimBenchOptions& o, sim::Integrato
     if (o.margin >= 0) scene.contact.margin = o.margin;
     if (o.no_speculative) scene.contact.speculative = false;
     if (o.inversion_guard) scene.inversion_guard = true;
+    if (!o.crossing_check.empty()) scene.crossing_check = o.crossing_check == "on";
     if (o.skin >= 0) {
         scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
         scene.detect.skin = o.skin;

@@ -66,7 +66,8 @@ struct SimulateOptions {
     std::string dt; ///< "" = the scene's
     int substeps = unset;
     std::string integrator;
-    std::string threads; ///< "" = the scene's
+    std::string crossing_check; ///< "" = the scene's; "on" or "off"
+    std::string threads;        ///< "" = the scene's
     std::string out = "out";
     bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
     CcdQueryOptions ccd; ///< --ccd-queries: the steps' continuous queries in the CCD benchmark's format
@@ -146,6 +147,7 @@ dt = "1/240"            # time step (s): a number or a fraction
 steps = 480             # steps to run
 substeps = 1            # substeps per step (each with its own detection)
 integrator = "vbd"      # vbd (default), implicit_euler, symplectic_euler
+# crossing_check = true   # retake a step in more substeps where a far part was entered unseen within a substep
 # iterations = 0        # vbd sweeps per substep; 0: until converged
 # convergence = 0.1     # vbd: relative tolerance of the sweeps
 # max_iterations = 100  # vbd: the most sweeps a substep takes (reaching it is reported)
@@ -196,6 +198,7 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
         .member("steps", h.steps)
         .member("substeps", h.substeps)
         .member("refined_steps", h.refined_steps)
+        .member("crossing_steps", h.crossing_steps)
         .member("unconverged_substeps", h.unconverged_substeps)
         .member("energy_start", h.energy_start)
         .member("energy_end", h.energy_end)
@@ -261,6 +264,11 @@ sim::Scene simulate_scene(SimulateOptions& o, std::string& mesh_scene)
         } catch (const Error& e) {
             throw Error(std::string("--integrator: ") + e.what());
         }
+    }
+    if (!o.crossing_check.empty()) {
+        if (o.crossing_check != "on" && o.crossing_check != "off")
+            throw Error("--crossing-check must be on or off, found '" + o.crossing_check + "'");
+        scene.crossing_check = o.crossing_check == "on";
     }
     if (!o.threads.empty())
         scene.detect.threads = parse_threads(o.threads);
@@ -614,6 +622,9 @@ Registrar reg{
          sub.add_option("--dt", o->dt, "Time step in s, or a fraction such as 1/240 (overrides the scene)");
          sub.add_option("--substeps", o->substeps, "Substeps per step (overrides the scene)");
          sub.add_option("--integrator", o->integrator, "vbd (default), implicit_euler or symplectic_euler");
+         sub.add_option("--crossing-check", o->crossing_check,
+                        "on or off (overrides the scene's crossing_check): take a step again in more substeps where a "
+                        "vertex entered a far part within a substep unseen by the contacts");
          sub.add_option("--threads", o->threads,
                         "Threads of the detector and the solver: 0 = every hardware thread, fewer in the steps "
                         "where they do not pay (measured as the run goes), or a fixed 1..256 (default: the scene's "

@@ -136,6 +136,12 @@ struct Scene {
     /// back, so a crumpling body collapses more slowly than the converged step (docs/simulator.md, "Inversion
     /// guard", has the figures).
     bool inversion_guard = false;
+    /// A step in which a vertex entered a far part (another object, or a part of its own object beyond the local
+    /// reach) within one substep with no contact of the substep's start watching it (no penetration of that object,
+    /// no margin or speculative contact with it) is taken again in twice the substeps, up to max_substeps: thin
+    /// parts that would cross each other within a substep are met by the contacts of shorter substeps instead
+    /// (docs/simulator.md, "Crossings"). The end of each step is detected once more for it.
+    bool crossing_check = true;
     double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean
                                 ///< edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep
                                 ///< and overstated its friction by 36 %); 0 = always `iterations` sweeps

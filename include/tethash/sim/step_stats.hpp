@@ -26,7 +26,9 @@ struct StepStats {
     int solver_iterations = 0;      ///< CG iterations (implicit_euler) or sweeps (vbd) summed over substeps
     int substeps = 1;               ///< substeps the step took (scene substeps, or more where it was refined)
     int unconverged = 0;            ///< substeps whose iterations reached their cap unconverged (vbd: max_iterations)
-    int tightened = 0;              ///< times the step was taken again with tighter tolerances for energy it gained
+    int crossings = 0; ///< times the step was taken again in more substeps for a vertex that entered a far part unseen
+                       ///< (Scene::crossing_check)
+    int tightened = 0; ///< times the step was taken again with tighter tolerances for energy it gained
 };
 
 } // namespace tethash::sim
