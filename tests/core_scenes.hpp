@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <string>
@@ -177,6 +178,18 @@ inline void make_coincident(Scene& s, std::uint32_t seed)
         s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
     for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
         s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+}
+
+/// A detector of the `portals` method with the cell layout `layout` (null: cells of its own making) over scene s.
+inline Detector portal_detector(const Scene& s, std::shared_ptr<const CellLayout> layout, int threads)
+{
+    DetectParams p;
+    p.method = Method::portals;
+    p.threads = threads;
+    p.partition.cells = std::move(layout);
+    Detector det(p);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    return det;
 }
 
 } // namespace tethash::test

@@ -10,8 +10,11 @@
 /// without portals, and for a scene lying wholly outside its cells. The text format that describes them is read by
 /// `tethash/io/cells.hpp`.
 
+#include "tethash/bsp.hpp"
 #include "tethash/mesh.hpp"
 
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,5 +50,53 @@ void check_cell_layout(const CellLayout& layout);
 /// `n[0] × n[1] × n[2]` cells of equal size over the box [lo, hi] with every shared face a portal: the layout the
 /// method makes for itself when it is given none (named "x,y,z" by grid coordinate), and a quick way to write one.
 CellLayout grid_cell_layout(const double lo[3], const double hi[3], const int n[3]);
+
+/// The cells of the free space around static obstacles (closed surfaces: the walls of a building as BSP obstacles),
+/// for the `portals` method when no cell description is given. The box made of `[lo, hi]` (when given) and the
+/// obstacles' boxes is cut on each axis at the obstacles' vertex coordinates (all of them when there are at most
+/// `max_cuts` on the axis, else `max_cuts` of them evenly chosen in their sorted list); each piece of the grid is
+/// "solid" when its centre lies in an obstacle (the first one, by index), else free; the pieces of one kind (free, or
+/// one obstacle's) are merged greedily into boxes, along x, then y, then z. The free boxes (cells "free0", "free1",
+/// ...) are joined by a portal on every face two of them share; the solid ones ("solid0", ...) have no portal. With
+/// axis-aligned obstacles the free cells are exactly the space between them (the rooms, split where a wall's corner
+/// or a door's edge cuts them) and the portals exactly the openings between them (the doors); with other obstacles they
+/// approximate it. The method is exact with any layout: the cells only divide the work. Throws Error when there is
+/// no obstacle or max_cuts < 2.
+CellLayout cells_from_obstacles(const ObstacleSet& obstacles, const double* lo = nullptr, const double* hi = nullptr,
+                                int max_cuts = 48);
+
+/// What a query of CellWalls did.
+struct WallStats {
+    std::int64_t vertices = 0; ///< finite vertices queried
+    std::int64_t tests = 0;    ///< (vertex, obstacle) pairs looked at: the walls of the vertex's cell
+    std::int64_t all = 0;      ///< the pairs a query of every obstacle looks at (vertices × obstacles)
+    std::int64_t outside = 0;  ///< vertices in no cell (tested against the outside's walls)
+};
+
+class CellWallsImpl;
+
+/// The object-world part of cells and portals: each obstacle is a wall of the cells its closed box meets, and each
+/// vertex is tested only against the walls of its cell (the first cell holding it, as the `portals` broad phase
+/// assigns it); a vertex in no cell against the obstacles that do not lie within one cell. A vertex inside an
+/// obstacle lies in that obstacle's box and in its own cell, so the box meets the cell: the answer is
+/// ObstacleSet::query's, exactly.
+class CellWalls {
+  public:
+    /// The layout must pass check_cell_layout; `obstacles` must outlive this object and keep its obstacles.
+    CellWalls(const CellLayout& layout, const ObstacleSet& obstacles);
+    ~CellWalls();
+    CellWalls(CellWalls&&) noexcept;
+    CellWalls& operator=(CellWalls&&) noexcept;
+    CellWalls(const CellWalls&) = delete;
+    CellWalls& operator=(const CellWalls&) = delete;
+
+    /// The walls of cell c, ascending; c == number of cells: the walls of the outside.
+    const std::vector<Index>& walls(Index cell) const;
+    /// obstacles.query(positions): the vertices inside (or on) some obstacle, sorted by (vertex, obstacle).
+    std::vector<ObstacleContact> query(const PositionsRef& positions, WallStats* stats = nullptr) const;
+
+  private:
+    std::unique_ptr<CellWallsImpl> m_impl;
+};
 
 } // namespace tethash

@@ -23,10 +23,9 @@
 // no cell iff one piece is in no cell, and a piece [a, b] (a == b for a point) is in a cell iff lo ≤ a and b ≤ hi on
 // every axis.
 //
-// The locator: a uniform grid of buckets over the cells' union box; a cell is listed in the buckets of the range
-// cell_coord(lo) .. cell_coord(hi) (clamped), the expression the points use, so a point (a box) in a cell finds it
-// in its bucket (range) whatever the rounding (bp_common.hpp).
+// The locator: cell_locator.hpp.
 #include "bp_common.hpp"
+#include "cell_locator.hpp"
 
 #include "tethash/portals.hpp"
 
@@ -46,13 +45,6 @@ bool strictly_inside(const Box& outer, const Box& inner)
 {
     for (int a = 0; a < 3; ++a)
         if (!(outer.lo[a] < inner.lo[a] && inner.hi[a] < outer.hi[a])) return false;
-    return true;
-}
-
-bool intersects(const Box& a, const Box& b)
-{
-    for (int k = 0; k < 3; ++k)
-        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
     return true;
 }
 
@@ -93,9 +85,9 @@ class Portals final : public BroadPhaseBase {
     void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override
     {
-        std::int64_t m =
-            bytes_of(m_cells, m_face_start, m_faces, m_bucket_start, m_bucket_cells, m_vcell, m_vold, m_tcell, m_told,
-                     m_slabs, m_vbucket, m_vstart, m_vids, m_vx, m_vyz, m_boxes, m_reg_start, m_reg_tets);
+        std::int64_t m = bytes_of(m_cells, m_face_start, m_faces, m_vcell, m_vold, m_tcell, m_told, m_slabs, m_vbucket,
+                                  m_vstart, m_vids, m_vx, m_vyz, m_boxes, m_reg_start, m_reg_tets) +
+                         m_locator.bytes();
         for (const auto& r : m_thread_regs)
             m += bytes_of(r);
         return m;
@@ -105,13 +97,12 @@ class Portals final : public BroadPhaseBase {
     /// The cells of the method's own making over the vertices' box (no layout given).
     void make_own_layout(const PartitionScene& s);
     Index outside() const { return static_cast<Index>(m_cells.size()); }
-    /// The locator's bucket coordinate of x on axis a (the monotone cell_coord, clamped to the buckets).
-    std::int64_t bucket_coord(int a, double x) const
-    {
-        return m_dims[a] == 1 ? 0 : std::clamp<std::int64_t>(cell_coord(x, m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
-    }
     /// The first cell (lowest index in its bucket's list) containing p, outside() when none.
-    Index locate(const double* p) const;
+    Index locate(const double* p) const
+    {
+        const Index c = m_locator.locate(m_cells, p);
+        return c < 0 ? outside() : c;
+    }
     /// The cell of a point at p that was in cell `from` at `old`: `from` when it still contains p, else the walk of the
     /// segment old → p through the portals, else locate(). Counts a segment test in `rays`.
     Index follow(Index from, const double* old, const double* p, std::int64_t& rays) const;
@@ -123,11 +114,7 @@ class Portals final : public BroadPhaseBase {
     std::vector<Index> m_face_start; // cells + 1: the portals of cell c are m_faces[m_face_start[c], [c + 1])
     std::vector<PortalFace> m_faces;
     bool m_own = false; // the layout is of our making (rebuilt when too many vertices leave it)
-    // Locator.
-    Box m_union{};
-    double m_inv[3] = {1, 1, 1};
-    std::int64_t m_dims[3] = {1, 1, 1};
-    std::vector<Index> m_bucket_start, m_bucket_cells;
+    CellLocator m_locator;
     // Tracking across calls.
     bool m_tracked = false;
     std::vector<Index> m_vcell, m_tcell; // per vertex, per tet: its cell
@@ -180,62 +167,7 @@ void Portals::set_layout(const CellLayout& layout)
             m_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(from)]++)] = f;
         }
     }
-    // Locator: about 8 buckets per cell, at most 64 per axis, shaped like the cells' union.
-    if (n == 0) {
-        m_bucket_start.assign(2, 0);
-        m_bucket_cells.clear();
-        return;
-    }
-    m_union = m_cells[0];
-    for (const Box& b : m_cells)
-        for (int a = 0; a < 3; ++a) {
-            m_union.lo[a] = std::min(m_union.lo[a], b.lo[a]);
-            m_union.hi[a] = std::max(m_union.hi[a], b.hi[a]);
-        }
-    double ext[3], vol = 1;
-    for (int a = 0; a < 3; ++a) {
-        ext[a] = m_union.hi[a] - m_union.lo[a];
-        vol *= ext[a];
-    }
-    const double edge = std::cbrt(vol / (8.0 * static_cast<double>(n)));
-    std::int64_t buckets = 1;
-    for (int a = 0; a < 3; ++a) {
-        // Extreme extents (overflow, underflow) get one bucket on the axis: every coordinate maps to it.
-        const double k = edge > 0 && std::isfinite(edge) ? std::ceil(ext[a] / edge) : 1;
-        m_dims[a] = std::isfinite(k) ? static_cast<std::int64_t>(std::clamp(k, 1.0, 64.0)) : 1;
-        m_inv[a] = static_cast<double>(m_dims[a]) / ext[a];
-        if (!std::isfinite(m_inv[a])) m_dims[a] = 1;
-        buckets *= m_dims[a];
-    }
-    auto range = [&](const Box& b, std::int64_t lo[3], std::int64_t hi[3]) {
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = bucket_coord(a, b.lo[a]);
-            hi[a] = bucket_coord(a, b.hi[a]);
-        }
-    };
-    m_bucket_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
-    for (int pass = 0; pass < 2; ++pass) {
-        std::vector<Index> fill_b;
-        if (pass == 1) {
-            for (std::int64_t k = 0; k < buckets; ++k)
-                m_bucket_start[static_cast<std::size_t>(k) + 1] += m_bucket_start[static_cast<std::size_t>(k)];
-            m_bucket_cells.resize(static_cast<std::size_t>(m_bucket_start.back()));
-            fill_b.assign(m_bucket_start.begin(), m_bucket_start.end() - 1);
-        }
-        for (std::size_t c = 0; c < n; ++c) {
-            std::int64_t lo[3], hi[3];
-            range(m_cells[c], lo, hi);
-            for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-                for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                    for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                        const auto k = static_cast<std::size_t>((x * m_dims[1] + y) * m_dims[2] + z);
-                        if (pass == 0)
-                            ++m_bucket_start[k + 1];
-                        else
-                            m_bucket_cells[static_cast<std::size_t>(fill_b[k]++)] = static_cast<Index>(c);
-                    }
-        }
-    }
+    m_locator.build(m_cells);
 }
 
 void Portals::make_own_layout(const PartitionScene& s)
@@ -262,20 +194,6 @@ void Portals::make_own_layout(const PartitionScene& s)
         n[a] = static_cast<int>(std::clamp(std::round(ext[a] / edge), 1.0, 16.0));
     set_layout(grid_cell_layout(lo, hi, n));
     m_own = true;
-}
-
-Index Portals::locate(const double* p) const
-{
-    if (m_cells.empty() || !contains_point(m_union, p)) return outside();
-    std::int64_t c[3];
-    for (int a = 0; a < 3; ++a)
-        c[a] = bucket_coord(a, p[a]);
-    const auto k = static_cast<std::size_t>((c[0] * m_dims[1] + c[1]) * m_dims[2] + c[2]);
-    for (Index i = m_bucket_start[k]; i < m_bucket_start[k + 1]; ++i) {
-        const Index cell = m_bucket_cells[static_cast<std::size_t>(i)];
-        if (contains_point(m_cells[static_cast<std::size_t>(cell)], p)) return cell;
-    }
-    return outside();
 }
 
 Index Portals::follow(Index from, const double* old, const double* p, std::int64_t& rays) const
@@ -370,25 +288,7 @@ bool Portals::covered(const Box& b, const std::vector<Index>& cells) const
 
 void Portals::overlapped_cells(const Box& b, std::vector<Index>& out, std::vector<Index>& scratch) const
 {
-    scratch.clear();
-    if (!m_cells.empty() && intersects(m_union, b)) {
-        std::int64_t lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = bucket_coord(a, b.lo[a]);
-            hi[a] = bucket_coord(a, b.hi[a]);
-        }
-        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-            for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                    const auto k = static_cast<std::size_t>((x * m_dims[1] + y) * m_dims[2] + z);
-                    for (Index i = m_bucket_start[k]; i < m_bucket_start[k + 1]; ++i) {
-                        const Index c = m_bucket_cells[static_cast<std::size_t>(i)];
-                        if (intersects(m_cells[static_cast<std::size_t>(c)], b)) scratch.push_back(c);
-                    }
-                }
-        std::sort(scratch.begin(), scratch.end());
-        scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
-    }
+    m_locator.overlapping(m_cells, b, scratch);
     out.insert(out.end(), scratch.begin(), scratch.end());
     if (!covered(b, scratch)) out.push_back(outside());
 }
