@@ -4,6 +4,7 @@
 #include "support.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/oracle.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -190,6 +191,21 @@ inline Detector portal_detector(const Scene& s, std::shared_ptr<const CellLayout
     Detector det(p);
     det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
     return det;
+}
+
+/// One call of two detectors (1 and 2 threads) on s: the first's contacts must equal the oracle's (not empty), the
+/// second's be identical; returns the first's statistics.
+inline DetectStats expect_oracle_at_two_thread_counts(Detector& one, Detector& two, const Scene& s,
+                                                      const std::string& where)
+{
+    DetectStats st;
+    const std::vector<Contact> want =
+        brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects);
+    EXPECT_FALSE(want.empty()) << where;
+    const std::vector<Contact>& a = one.detect(s.positions, &st);
+    EXPECT_TRUE(same_contacts(a, want)) << where;
+    EXPECT_TRUE(identical(a, two.detect(s.positions))) << where;
+    return st;
 }
 
 } // namespace tethash::test

@@ -211,13 +211,8 @@ TEST(CorePortalWalls, DetectionWithCellsFromWallsEqualsTheOracle)
         std::uniform_real_distribution<double> u(-0.02, 0.02);
         std::int64_t rays = 0;
         for (int step = 0; step < 6; ++step) {
-            DetectStats st;
-            const std::vector<Contact> want =
-                brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects);
-            ASSERT_FALSE(want.empty());
-            const std::vector<Contact>& a = one.detect(s.positions, &st);
-            EXPECT_TRUE(same_contacts(a, want)) << "seed " << seed << " step " << step;
-            EXPECT_TRUE(identical(a, two.detect(s.positions))) << "seed " << seed << " step " << step;
+            const DetectStats st = expect_oracle_at_two_thread_counts(
+                one, two, s, "seed " + std::to_string(seed) + " step " + std::to_string(step));
             EXPECT_EQ(st.nodes, static_cast<std::int64_t>(layout->cells.size()));
             rays += st.ray_tests;
             for (Eigen::Index v = 0; v < s.positions.rows(); ++v) {

@@ -3,16 +3,18 @@
 /// The cells and portals of the `portals` broad phase (DetectParams::method = Method::portals, docs/partitions.md):
 /// the world divided into convex cells (rooms) joined by portals (doors, windows) on the faces they share.
 ///
-/// Cells are closed axis-aligned boxes whose interiors do not overlap (they may share faces, edges and corners, and
-/// need not cover the scene: what lies outside every cell is the "outside" cell of the method). Portals are
-/// axis-aligned rectangles lying on the face two cells share (a flat box: lo == hi on the face's axis). Cells and
-/// portals only decide how the work is divided: the method returns the oracle's contacts for any layout, with or
-/// without portals, and for a scene lying wholly outside its cells. The text format that describes them is read by
-/// `tethash/io/cells.hpp`.
+/// Cells are closed convex polyhedra whose interiors do not overlap (they may share faces, edges and corners, and
+/// need not cover the scene: what lies outside every cell is the "outside" cell of the method): axis-aligned boxes,
+/// or boxes cut by half-spaces (convex cells given as planes or as a closed convex surface). Portals are
+/// axis-aligned rectangles lying on the face two box cells share (a flat box: lo == hi on the face's axis), or convex
+/// polygons on the boundary two cells share. Cells and portals only decide how the work is divided: the method
+/// returns the oracle's contacts for any layout, with or without portals, and for a scene lying wholly outside its
+/// cells. The text format that describes them is read by `tethash/io/cells.hpp`.
 
 #include "tethash/bsp.hpp"
 #include "tethash/mesh.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -20,17 +22,28 @@
 
 namespace tethash {
 
-/// A convex cell: the closed box [lo, hi] (lo < hi on every axis).
+/// The closed half-space n · x ≤ d.
+struct CellPlane {
+    double n[3] = {0, 0, 0};
+    double d = 0;
+};
+
+/// A convex cell: the closed box [lo, hi] (lo < hi on every axis), cut by the closed half-spaces `planes` when there
+/// are any (a box cell has none). A cell of planes has its bounding box as [lo, hi] (convex_cell sets it).
 struct PortalCell {
     std::string name;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    std::vector<CellPlane> planes;
 };
 
-/// A portal between cells a and b (indices into CellLayout::cells, a ≠ b): the closed rectangle [lo, hi] with
-/// lo[axis] == hi[axis] on the plane of the face the two cells share, lying within that shared face.
+/// A portal between cells a and b (indices into CellLayout::cells, a ≠ b). Without `polygon`: the closed rectangle
+/// [lo, hi] with lo[axis] == hi[axis] on the plane of the face the two (box) cells share, lying within that shared
+/// face. With `polygon`: a convex planar polygon (its corners in order, at least 3) lying on the boundary both cells
+/// share; [lo, hi] is then its bounding box (polygon_portal sets it).
 struct Portal {
     Index a = 0, b = 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    std::vector<std::array<double, 3>> polygon;
 };
 
 struct CellLayout {
@@ -38,11 +51,29 @@ struct CellLayout {
     std::vector<Portal> portals;
 };
 
-/// Checks cell k against cells 0..k-1: finite, lo < hi on every axis, a name not used before, no overlap of
-/// interiors. Throws Error naming the cell (and the other cell).
+/// The most planes a convex cell may have (the checks meet every three of them).
+inline constexpr std::size_t max_cell_planes = 64;
+
+/// The convex cell {x : n · x ≤ d for every plane} with its bounding box as [lo, hi]. Throws Error naming the cell
+/// when a plane is not finite or has a zero normal, or when the cell is unbounded or has no interior.
+PortalCell convex_cell(const std::string& name, const std::vector<CellPlane>& planes);
+/// The convex cell bounded by a closed convex triangle surface (vertices k × 3, triangles t × 3, either orientation):
+/// the half-spaces of its faces. Throws Error naming the cell when the surface is not closed, or not convex (a vertex
+/// beyond a face's plane), or when it has more than max_cell_planes distinct face planes.
+PortalCell surface_cell(const std::string& name, const PositionsRef& vertices,
+                        const Eigen::Ref<const Triangles>& triangles);
+/// The portal of the convex polygon `corners` (in order) between cells a and b, its bounding box set.
+Portal polygon_portal(Index a, Index b, std::vector<std::array<double, 3>> corners);
+/// The corners of a cell (the vertices of the polytope: its box cut by its planes).
+std::vector<std::array<double, 3>> cell_corners(const PortalCell& cell);
+
+/// Checks cell k against cells 0..k-1: finite, lo < hi on every axis, a name not used before, planes bounding a
+/// cell with an interior, no overlap of interiors. Throws Error naming the cell (and the other cell).
 void check_cell(const CellLayout& layout, std::size_t k);
-/// Checks portal k: known cells a ≠ b that share a face, finite, flat on that face's plane and lying within the
-/// shared face. Throws Error naming the portal's cells.
+/// Checks portal k: known cells a ≠ b. A rectangle between box cells: the cells share a face, the rectangle is
+/// finite, flat on that face's plane and lies within the shared face. A polygon (or a rectangle touching a cell of
+/// planes): at least 3 finite corners, planar, convex, of positive area, on a boundary plane of each cell and within
+/// both cells. Throws Error naming the portal's cells.
 void check_portal(const CellLayout& layout, std::size_t k);
 /// Every cell and portal checked, in order. Throws Error on the first problem.
 void check_cell_layout(const CellLayout& layout);

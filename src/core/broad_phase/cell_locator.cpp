@@ -65,18 +65,6 @@ void CellLocator::build(const std::vector<Box>& cells)
     }
 }
 
-Index CellLocator::locate(const std::vector<Box>& cells, const double* p) const
-{
-    if (m_empty || !in_box(p, m_union.lo, m_union.hi)) return -1;
-    const std::size_t k = bucket(coord(0, p[0]), coord(1, p[1]), coord(2, p[2]));
-    for (Index i = m_start[k]; i < m_start[k + 1]; ++i) {
-        const Index cell = m_cells[static_cast<std::size_t>(i)];
-        const Box& b = cells[static_cast<std::size_t>(cell)];
-        if (in_box(p, b.lo, b.hi)) return cell;
-    }
-    return -1;
-}
-
 void CellLocator::overlapping(const std::vector<Box>& cells, const Box& b, std::vector<Index>& out) const
 {
     out.clear();

@@ -23,7 +23,25 @@ class CellLocator {
     /// About 8 buckets per cell, at most 64 per axis, shaped like the cells' union.
     void build(const std::vector<Box>& cells);
     /// The first cell (lowest index in its bucket's list) whose closed box contains p, -1 when none.
-    Index locate(const std::vector<Box>& cells, const double* p) const;
+    Index locate(const std::vector<Box>& cells, const double* p) const
+    {
+        return locate(p, [&](Index c) {
+            const Box& b = cells[static_cast<std::size_t>(c)];
+            return in_box(p, b.lo, b.hi);
+        });
+    }
+    /// The first cell of p's bucket (lowest index) that `contains(cell)` accepts, -1 when none. `contains` must
+    /// accept only cells whose box holds p.
+    template <class Contains> Index locate(const double* p, Contains&& contains) const
+    {
+        if (m_empty || !in_box(p, m_union.lo, m_union.hi)) return -1;
+        const std::size_t k = bucket(coord(0, p[0]), coord(1, p[1]), coord(2, p[2]));
+        for (Index i = m_start[k]; i < m_start[k + 1]; ++i) {
+            const Index cell = m_cells[static_cast<std::size_t>(i)];
+            if (contains(cell)) return cell;
+        }
+        return -1;
+    }
     /// `out` = every cell whose closed box intersects b, each once, ascending.
     void overlapping(const std::vector<Box>& cells, const Box& b, std::vector<Index>& out) const;
     std::int64_t bytes() const { return bytes_of(m_start, m_cells); }
