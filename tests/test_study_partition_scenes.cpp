@@ -54,13 +54,22 @@ TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
             EXPECT_EQ(near, 60 * 125);
         } else if (name == "thin") {
             EXPECT_EQ(s.mesh.num_objects(), 12);
-        } else if (name == "building" || name == "hall") {
+        } else if (name == "building" || name == "walled" || name == "hall") {
             EXPECT_EQ(s.mesh.num_objects(), 16 * 10 + 24 * 2);
             EXPECT_EQ(s.mesh.num_tets(), 208 * 162);
             ASSERT_TRUE(s.cells);
             EXPECT_NO_THROW(check_cell_layout(*s.cells));
-            EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
-            EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);
+            EXPECT_EQ(s.walls == nullptr, name == "hall");
+            if (name == "walled") {
+                // 4 outer walls whole; 6 inner ones of 4 doors each: 5 segments and 4 lintels. The 16 rooms are cut
+                // by the doors' edges into more boxes, joined by a portal through each door at least.
+                EXPECT_EQ(s.walls->size(), 4 + 6 * (5 + 4));
+                EXPECT_GT(s.cells->cells.size(), 16U);
+                EXPECT_GE(s.cells->portals.size(), 24U);
+            } else {
+                EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
+                EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);
+            }
             EXPECT_GE(lo.minCoeff(), 0.0); // every object inside the building
             EXPECT_LE(hi.x(), 16.0);
             EXPECT_LE(hi.y(), 16.0);
