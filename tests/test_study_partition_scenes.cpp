@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 using namespace tethash;
 using namespace tethash::study;
@@ -61,11 +62,20 @@ TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
             EXPECT_NO_THROW(check_cell_layout(*s.cells));
             EXPECT_EQ(s.walls == nullptr, name == "hall");
             if (name == "walled") {
-                // 4 outer walls whole; 6 inner ones of 4 doors each: 5 segments and 4 lintels. The 16 rooms are cut
-                // by the doors' edges into more boxes, joined by a portal through each door at least.
+                // 4 outer walls whole; 6 inner ones of 4 doors each: 5 segments and 4 lintels. The free cells: the
+                // 16 rooms whole (3.9 x 3.9 x 3 between the walls) and the 24 door gaps, each gap joined to its two
+                // rooms.
                 EXPECT_EQ(s.walls->size(), 4 + 6 * (5 + 4));
-                EXPECT_GT(s.cells->cells.size(), 16U);
-                EXPECT_GE(s.cells->portals.size(), 24U);
+                int rooms = 0, gaps = 0;
+                for (const PortalCell& c : s.cells->cells) {
+                    if (c.name.rfind("free", 0) != 0) continue;
+                    const double dx = c.hi[0] - c.lo[0], dy = c.hi[1] - c.lo[1], dz = c.hi[2] - c.lo[2];
+                    rooms += std::abs(dx - 3.9) < 1e-9 && std::abs(dy - 3.9) < 1e-9 && dz == 3;
+                    gaps += std::abs(std::min(dx, dy) - 0.1) < 1e-9 && std::abs(std::max(dx, dy) - 1) < 1e-9 && dz == 2;
+                }
+                EXPECT_EQ(rooms, 16);
+                EXPECT_EQ(gaps, 24);
+                EXPECT_EQ(s.cells->portals.size(), 48U);
             } else {
                 EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
                 EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);

@@ -87,7 +87,8 @@ CellLayout grid_cell_layout(const double lo[3], const double hi[3], const int n[
 /// obstacles' boxes is cut on each axis at the obstacles' vertex coordinates (all of them when there are at most
 /// `max_cuts` on the axis, else `max_cuts` of them evenly chosen in their sorted list); each piece of the grid is
 /// "solid" when its centre lies in an obstacle (the first one, by index), else free; the pieces of one kind (free, or
-/// one obstacle's) are merged greedily into boxes, along x, then y, then z. The free boxes (cells "free0", "free1",
+/// one obstacle's) are merged greedily into boxes, seeded from the largest pieces first and grown both ways along x,
+/// then y, then z. The free boxes (cells "free0", "free1",
 /// ...) are joined by a portal on every face two of them share; the solid ones ("solid0", ...) have no portal. With
 /// axis-aligned obstacles the free cells are exactly the space between them (the rooms, split where a wall's corner
 /// or a door's edge cuts them) and the portals exactly the openings between them (the doors); with other obstacles they

@@ -5,6 +5,7 @@
 #include "tethash/portals.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <set>
 #include <tuple>
@@ -96,39 +97,55 @@ CellLayout cells_from_obstacles(const ObstacleSet& obstacles, const double* lo, 
                         break;
                     }
             }
-    // Greedy boxes of one label: along x, then y, then z from the first piece not taken yet.
+    // Greedy boxes of one label, seeded from the largest pieces first (a room's pieces before the thin ones of a door
+    // or a wall, which would otherwise run through the rooms beyond them): from the seed, grown both ways along x,
+    // then y, then z while the slab added is of the seed's label and not taken.
     std::vector<Index> owner(pieces, -1);
     struct Run {
         int lo[3], hi[3]; // pieces lo .. hi - 1
         bool free;
     };
     std::vector<Run> runs;
+    const auto width = [&](int a, int i) {
+        return cuts[a][static_cast<std::size_t>(i) + 1] - cuts[a][static_cast<std::size_t>(i)];
+    };
+    std::vector<std::array<int, 3>> seeds;
+    seeds.reserve(pieces);
     for (int k = 0; k < n[2]; ++k)
         for (int j = 0; j < n[1]; ++j)
-            for (int i = 0; i < n[0]; ++i) {
-                if (owner[piece(i, j, k)] >= 0) continue;
-                const Index l = label[piece(i, j, k)];
-                const auto fits = [&](int x0, int x1, int y0, int y1, int z0, int z1) {
-                    for (int z = z0; z < z1; ++z)
-                        for (int y = y0; y < y1; ++y)
-                            for (int x = x0; x < x1; ++x)
-                                if (owner[piece(x, y, z)] >= 0 || label[piece(x, y, z)] != l) return false;
-                    return true;
-                };
-                int i1 = i + 1, j1 = j + 1, k1 = k + 1;
-                while (i1 < n[0] && fits(i1, i1 + 1, j, j1, k, k1))
-                    ++i1;
-                while (j1 < n[1] && fits(i, i1, j1, j1 + 1, k, k1))
-                    ++j1;
-                while (k1 < n[2] && fits(i, i1, j, j1, k1, k1 + 1))
-                    ++k1;
-                const auto id = static_cast<Index>(runs.size());
-                for (int z = k; z < k1; ++z)
-                    for (int y = j; y < j1; ++y)
-                        for (int x = i; x < i1; ++x)
-                            owner[piece(x, y, z)] = id;
-                runs.push_back({{i, j, k}, {i1, j1, k1}, l < 0});
-            }
+            for (int i = 0; i < n[0]; ++i)
+                seeds.push_back({i, j, k});
+    std::stable_sort(seeds.begin(), seeds.end(), [&](const std::array<int, 3>& u, const std::array<int, 3>& v) {
+        return width(0, u[0]) * width(1, u[1]) * width(2, u[2]) > width(0, v[0]) * width(1, v[1]) * width(2, v[2]);
+    });
+    for (const std::array<int, 3>& seed : seeds) {
+        if (owner[piece(seed[0], seed[1], seed[2])] >= 0) continue;
+        const Index l = label[piece(seed[0], seed[1], seed[2])];
+        int lo[3] = {seed[0], seed[1], seed[2]}, hi[3] = {seed[0] + 1, seed[1] + 1, seed[2] + 1};
+        // The slab of the box [lo, hi) moved to [from, from + 1) on axis a: all of label l and free to take.
+        const auto fits = [&](int a, int from) {
+            int b0[3] = {lo[0], lo[1], lo[2]}, b1[3] = {hi[0], hi[1], hi[2]};
+            b0[a] = from;
+            b1[a] = from + 1;
+            for (int z = b0[2]; z < b1[2]; ++z)
+                for (int y = b0[1]; y < b1[1]; ++y)
+                    for (int x = b0[0]; x < b1[0]; ++x)
+                        if (owner[piece(x, y, z)] >= 0 || label[piece(x, y, z)] != l) return false;
+            return true;
+        };
+        for (int a = 0; a < 3; ++a) {
+            while (hi[a] < n[a] && fits(a, hi[a]))
+                ++hi[a];
+            while (lo[a] > 0 && fits(a, lo[a] - 1))
+                --lo[a];
+        }
+        const auto id = static_cast<Index>(runs.size());
+        for (int z = lo[2]; z < hi[2]; ++z)
+            for (int y = lo[1]; y < hi[1]; ++y)
+                for (int x = lo[0]; x < hi[0]; ++x)
+                    owner[piece(x, y, z)] = id;
+        runs.push_back({{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, l < 0});
+    }
     CellLayout layout;
     Index free_count = 0, solid_count = 0;
     for (const Run& r : runs) {
