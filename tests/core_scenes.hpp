@@ -4,6 +4,7 @@
 #include "support.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/oracle.hpp"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <string>
@@ -177,6 +179,33 @@ inline void make_coincident(Scene& s, std::uint32_t seed)
         s.positions.row(pick(rng)) = s.positions.row(pick(rng)).eval();
     for (Eigen::Index t = 3; t < s.tets.rows(); t += 41)
         s.positions.row(s.tets(t, 1)) = s.positions.row(s.tets(t, 0)).eval();
+}
+
+/// A detector of the `portals` method with the cell layout `layout` (null: cells of its own making) over scene s.
+inline Detector portal_detector(const Scene& s, std::shared_ptr<const CellLayout> layout, int threads)
+{
+    DetectParams p;
+    p.method = Method::portals;
+    p.threads = threads;
+    p.partition.cells = std::move(layout);
+    Detector det(p);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    return det;
+}
+
+/// One call of two detectors (1 and 2 threads) on s: the first's contacts must equal the oracle's (not empty), the
+/// second's be identical; returns the first's statistics.
+inline DetectStats expect_oracle_at_two_thread_counts(Detector& one, Detector& two, const Scene& s,
+                                                      const std::string& where)
+{
+    DetectStats st;
+    const std::vector<Contact> want =
+        brute_force_contacts(s.positions, s.tets, s.vertex_object, s.tet_object, s.objects);
+    EXPECT_FALSE(want.empty()) << where;
+    const std::vector<Contact>& a = one.detect(s.positions, &st);
+    EXPECT_TRUE(same_contacts(a, want)) << where;
+    EXPECT_TRUE(identical(a, two.detect(s.positions))) << where;
+    return st;
 }
 
 } // namespace tethash::test

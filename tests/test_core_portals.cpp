@@ -99,17 +99,6 @@ Scene building_scene(std::uint32_t seed)
     return s;
 }
 
-Detector portal_detector(const Scene& s, std::shared_ptr<const CellLayout> layout, int threads)
-{
-    DetectParams p;
-    p.method = Method::portals;
-    p.threads = threads;
-    p.partition.cells = std::move(layout);
-    Detector det(p);
-    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
-    return det;
-}
-
 } // namespace
 
 TEST(CorePortals, BuildingEqualsTheOracleAtOneAndTwoThreads)

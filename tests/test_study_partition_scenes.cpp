@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 using namespace tethash;
 using namespace tethash::study;
@@ -54,13 +55,31 @@ TEST(StudyPartitionScenes, EachSceneIsWhatItsDescriptionSays)
             EXPECT_EQ(near, 60 * 125);
         } else if (name == "thin") {
             EXPECT_EQ(s.mesh.num_objects(), 12);
-        } else if (name == "building" || name == "hall") {
+        } else if (name == "building" || name == "walled" || name == "hall") {
             EXPECT_EQ(s.mesh.num_objects(), 16 * 10 + 24 * 2);
             EXPECT_EQ(s.mesh.num_tets(), 208 * 162);
             ASSERT_TRUE(s.cells);
             EXPECT_NO_THROW(check_cell_layout(*s.cells));
-            EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
-            EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);
+            EXPECT_EQ(s.walls == nullptr, name == "hall");
+            if (name == "walled") {
+                // 4 outer walls whole; 6 inner ones of 4 doors each: 5 segments and 4 lintels. The free cells: the
+                // 16 rooms whole (3.9 x 3.9 x 3 between the walls) and the 24 door gaps, each gap joined to its two
+                // rooms.
+                EXPECT_EQ(s.walls->size(), 4 + 6 * (5 + 4));
+                int rooms = 0, gaps = 0;
+                for (const PortalCell& c : s.cells->cells) {
+                    if (c.name.rfind("free", 0) != 0) continue;
+                    const double dx = c.hi[0] - c.lo[0], dy = c.hi[1] - c.lo[1], dz = c.hi[2] - c.lo[2];
+                    rooms += std::abs(dx - 3.9) < 1e-9 && std::abs(dy - 3.9) < 1e-9 && dz == 3;
+                    gaps += std::abs(std::min(dx, dy) - 0.1) < 1e-9 && std::abs(std::max(dx, dy) - 1) < 1e-9 && dz == 2;
+                }
+                EXPECT_EQ(rooms, 16);
+                EXPECT_EQ(gaps, 24);
+                EXPECT_EQ(s.cells->portals.size(), 48U);
+            } else {
+                EXPECT_EQ(s.cells->cells.size(), name == "building" ? 16U : 1U);
+                EXPECT_EQ(s.cells->portals.size(), name == "building" ? 24U : 0U);
+            }
             EXPECT_GE(lo.minCoeff(), 0.0); // every object inside the building
             EXPECT_LE(hi.x(), 16.0);
             EXPECT_LE(hi.y(), 16.0);

@@ -68,6 +68,8 @@ class Bsp {
     /// Unsigned distance from p to the surface (closest point over all triangles).
     double distance(const Eigen::Vector3d& p) const;
 
+    /// The surface's vertices (as given, k × 3).
+    const Positions& vertices() const;
     const Eigen::Vector3d& box_lo() const;
     const Eigen::Vector3d& box_hi() const;
     const BspStats& stats() const;

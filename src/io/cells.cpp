@@ -5,9 +5,11 @@
 
 #include "tethash/error.hpp"
 #include "tethash/io/file.hpp"
+#include "tethash/io/surface.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <vector>
@@ -58,10 +60,41 @@ CellLayout parse_cells(const std::string& path, std::string_view text)
         ++line_no;
         const std::vector<std::string_view> w = words_of(line);
         if (w.empty()) continue;
-        if (w[0] == "cell") {
+        if (w[0] == "cell" && w.size() >= 3 && w[2] == "planes") {
+            // cell NAME planes NX NY NZ D ...: the half-spaces n · x <= d.
+            if ((w.size() - 3) % 4 != 0 || w.size() < 3 + 4 * 4)
+                fail("expected 'cell NAME planes NX NY NZ D ...' (4 numbers per plane, at least 4 planes), found " +
+                     std::to_string(w.size() - 3) + " numbers");
+            std::vector<CellPlane> planes((w.size() - 3) / 4);
+            for (std::size_t k = 0; k < planes.size(); ++k) {
+                for (std::size_t a = 0; a < 3; ++a)
+                    planes[k].n[a] = number(w[3 + 4 * k + a], "a plane's normal");
+                planes[k].d = number(w[3 + 4 * k + 3], "a plane's offset");
+            }
+            try {
+                layout.cells.push_back(convex_cell(std::string(w[1]), planes));
+                check_cell(layout, layout.cells.size() - 1);
+            } catch (const Error& e) {
+                fail(e.what());
+            }
+            index.emplace(layout.cells.back().name, static_cast<Index>(layout.cells.size() - 1));
+        } else if (w[0] == "cell" && w.size() >= 3 && w[2] == "surface") {
+            // cell NAME surface FILE: a closed convex surface, FILE relative to the cell file's folder.
+            if (w.size() != 4) fail("expected 'cell NAME surface FILE' (4 fields), found " + std::to_string(w.size()));
+            const std::filesystem::path file = std::filesystem::path(path).parent_path() / std::string(w[3]);
+            try {
+                const SurfaceMesh surface = read_surface(file.string());
+                layout.cells.push_back(surface_cell(std::string(w[1]), surface.vertices, surface.triangles));
+                check_cell(layout, layout.cells.size() - 1);
+            } catch (const Error& e) {
+                fail(e.what());
+            }
+            index.emplace(layout.cells.back().name, static_cast<Index>(layout.cells.size() - 1));
+        } else if (w[0] == "cell") {
             if (w.size() != 8)
-                fail("expected 'cell NAME XMIN YMIN ZMIN XMAX YMAX ZMAX' (8 fields), found " +
-                     std::to_string(w.size()));
+                fail("expected 'cell NAME XMIN YMIN ZMIN XMAX YMAX ZMAX' (8 fields), 'cell NAME planes ...' or "
+                     "'cell NAME surface FILE', found " +
+                     std::to_string(w.size()) + " fields");
             PortalCell c;
             c.name = std::string(w[1]);
             for (int a = 0; a < 3; ++a) {
@@ -75,6 +108,30 @@ CellLayout parse_cells(const std::string& path, std::string_view text)
                 fail(e.what());
             }
             index.emplace(c.name, static_cast<Index>(layout.cells.size() - 1));
+        } else if (w[0] == "portal" && w.size() >= 4 && w[3] == "polygon") {
+            // portal A B polygon X Y Z X Y Z X Y Z ...: a convex polygon, its corners in order.
+            if ((w.size() - 4) % 3 != 0 || w.size() < 4 + 3 * 3)
+                fail("expected 'portal CELL_A CELL_B polygon X Y Z ...' (3 numbers per corner, at least 3 corners), "
+                     "found " +
+                     std::to_string(w.size() - 4) + " numbers");
+            Index ab[2] = {0, 0};
+            for (int k = 0; k < 2; ++k) {
+                const auto it = index.find(w[1 + static_cast<std::size_t>(k)]);
+                if (it == index.end())
+                    fail("portal between unknown cell " + detail::quote_token(w[1 + static_cast<std::size_t>(k)], 40) +
+                         " (cells are declared above the portals that join them)");
+                ab[k] = it->second;
+            }
+            std::vector<std::array<double, 3>> corners((w.size() - 4) / 3);
+            for (std::size_t k = 0; k < corners.size(); ++k)
+                for (std::size_t a = 0; a < 3; ++a)
+                    corners[k][a] = number(w[4 + 3 * k + a], "a corner's coordinate");
+            layout.portals.push_back(polygon_portal(ab[0], ab[1], std::move(corners)));
+            try {
+                check_portal(layout, layout.portals.size() - 1);
+            } catch (const Error& e) {
+                fail(e.what());
+            }
         } else if (w[0] == "portal") {
             if (w.size() != 9)
                 fail("expected 'portal CELL_A CELL_B X0 Y0 Z0 X1 Y1 Z1' (9 fields), found " + std::to_string(w.size()));
@@ -121,14 +178,40 @@ std::string cells_text(const CellLayout& layout)
         }
         out += '\n';
     };
+    auto number = [&](double x) {
+        out += ' ';
+        detail::append_double(out, x);
+    };
     for (const PortalCell& c : layout.cells) {
         out += "cell " + c.name;
-        numbers(c.lo, c.hi);
+        if (c.planes.empty()) {
+            numbers(c.lo, c.hi);
+            continue;
+        }
+        // A convex cell as its planes, its box's faces among them (it reads back as the same set).
+        out += " planes";
+        for (int a = 0; a < 3; ++a) {
+            const double e[3] = {a == 0 ? 1.0 : 0.0, a == 1 ? 1.0 : 0.0, a == 2 ? 1.0 : 0.0};
+            for (double x : {-e[0], -e[1], -e[2], -c.lo[a], e[0], e[1], e[2], c.hi[a]})
+                number(x);
+        }
+        for (const CellPlane& p : c.planes)
+            for (double x : {p.n[0], p.n[1], p.n[2], p.d})
+                number(x);
+        out += '\n';
     }
     for (const Portal& p : layout.portals) {
         out += "portal " + layout.cells.at(static_cast<std::size_t>(p.a)).name + " " +
                layout.cells.at(static_cast<std::size_t>(p.b)).name;
-        numbers(p.lo, p.hi);
+        if (p.polygon.empty()) {
+            numbers(p.lo, p.hi);
+            continue;
+        }
+        out += " polygon";
+        for (const auto& x : p.polygon)
+            for (double v : x)
+                number(v);
+        out += '\n';
     }
     return out;
 }

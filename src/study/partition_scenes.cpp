@@ -95,6 +95,49 @@ TetMesh cube_lattice(int nx, int ny, int nz, const Eigen::Vector3d& h)
     return m;
 }
 
+ObstacleSet building_walls(int nx, int ny)
+{
+    if (nx < 1 || ny < 1) throw Error("building_walls: expected at least one room per axis");
+    constexpr double room = 4, height = 3, door = 1, door_height = 2, half = 0.05;
+    ObstacleSet set;
+    // A box's closed surface: corner k is (k & 1, k & 2, k & 4) of (lo, hi); two outward triangles per face.
+    static const int faces[12][3] = {{0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}, {0, 4, 5}, {0, 5, 1},
+                                     {2, 3, 7}, {2, 7, 6}, {0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}};
+    const int count[2] = {nx, ny};
+    for (int axis = 0; axis < 2; ++axis) {
+        const int other = 1 - axis;
+        for (int i = 0; i <= count[axis]; ++i) {
+            auto wall = [&](double from, double to, double z0, double z1) {
+                Eigen::Vector3d lo, hi;
+                lo[axis] = room * i - half, hi[axis] = room * i + half;
+                lo[other] = from, hi[other] = to;
+                lo[2] = z0, hi[2] = z1;
+                Positions v(8, 3);
+                for (int k = 0; k < 8; ++k)
+                    v.row(k) << (k & 1 ? hi.x() : lo.x()), (k & 2 ? hi.y() : lo.y()), (k & 4 ? hi.z() : lo.z());
+                Triangles t(12, 3);
+                for (int f = 0; f < 12; ++f)
+                    t.row(f) << faces[f][0], faces[f][1], faces[f][2];
+                set.add(Bsp(v, t, "building wall"));
+            };
+            const double end = room * count[other] + half;
+            if (i == 0 || i == count[axis]) {
+                wall(-half, end, 0, height);
+                continue;
+            }
+            double from = -half;
+            for (int j = 0; j < count[other]; ++j) {
+                const double mid = room * (j + 0.5);
+                wall(from, mid - 0.5 * door, 0, height);
+                wall(mid - 0.5 * door, mid + 0.5 * door, door_height, height);
+                from = mid + 0.5 * door;
+            }
+            wall(from, end, 0, height);
+        }
+    }
+    return set;
+}
+
 NamedScene building_scene(int nx, int ny, std::uint64_t seed)
 {
     if (nx < 1 || ny < 1) throw Error("building_scene: expected at least one room per axis");
@@ -153,12 +196,13 @@ NamedScene building_scene(int nx, int ny, std::uint64_t seed)
             }
     check_cell_layout(*layout);
     s.cells = layout;
+    s.walls = std::make_shared<const ObstacleSet>(building_walls(nx, ny));
     return s;
 }
 
 const std::vector<std::string>& partition_scene_names()
 {
-    static const std::vector<std::string> names = {"bars", "sizes", "corner", "thin", "building", "hall"};
+    static const std::vector<std::string> names = {"bars", "sizes", "corner", "thin", "building", "walled", "hall"};
     return names;
 }
 
@@ -198,8 +242,14 @@ NamedScene partition_scene(const std::string& name)
             const Eigen::Vector3d c(1.2 * (o % 3), 1.2 * ((o / 3) % 2), 1.2 * (o / 6));
             place(s.mesh, slab, rng.rotation(), c);
         }
-    } else if (name == "building" || name == "hall") {
-        NamedScene b = building_scene(4, 4); // the same objects in both (building_scene's own seed)
+    } else if (name == "building" || name == "walled" || name == "hall") {
+        NamedScene b = building_scene(4, 4); // the same objects in all three (building_scene's own seed)
+        if (name == "walled") {
+            b.description =
+                "the building's objects (208 3^3-cube objects, edge 0.1, in pairs) with cells made from its "
+                "walls (box obstacles 0.1 thick with the door gaps): free boxes joined by portals";
+            b.cells = std::make_shared<const CellLayout>(cells_from_obstacles(*b.walls));
+        }
         if (name == "hall") {
             b.description =
                 "the building's objects (208 3^3-cube objects, edge 0.1, in pairs) in one open hall 16 x 16 "
@@ -211,6 +261,7 @@ NamedScene partition_scene(const std::string& name)
             c.hi[2] = 3;
             one->cells.push_back(c);
             b.cells = one;
+            b.walls = nullptr; // an open hall
         }
         b.name = name;
         return b;

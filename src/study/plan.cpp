@@ -89,7 +89,7 @@ std::vector<SceneData> load_scenes(const StudyOptions& o)
         } else if (std::find(partition_scene_names().begin(), partition_scene_names().end(), it) ==
                    partition_scene_names().end()) {
             throw Error("--partition-scenes: unknown scene '" + it +
-                        "' (expected bars, sizes, corner, thin, building, hall or all)");
+                        "' (expected bars, sizes, corner, thin, building, walled, hall or all)");
         } else {
             partition_names.push_back(it);
         }

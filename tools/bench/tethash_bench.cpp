@@ -10,9 +10,9 @@
 //                 vertex-in-tet detection on the same scenes
 //   tethash_bench --methods hash,bvh,kd [--partition-scenes bars,sizes]: the other broad phases on every scene, in the
 //                 same run as the hash and the baseline (medians at 1 thread)
-//   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building and the hall with every
-//   object
-//                 walking: CPU ms per step of each method, the portals' segment tests and overlaps per step
+//   tethash_bench --walk [--steps N] [--walk-speed L] [--rooms N] [--methods ...]: the building, the building with
+//                 cells made from its walls and the hall with every object walking: CPU ms per step of each method,
+//                 the portals' segment tests and overlaps per step; every wall against the walls of the cell
 #include "machine.hpp"
 #include "tethash/detect.hpp"
 #include "tethash/detect_grammar.hpp"
@@ -293,17 +293,53 @@ void report_moving(const study::Scenario& sc, const DetectParams& base, int thre
     }
 }
 
-/// --walk: the partition scenes "building" and "hall" with every object moving rigidly at `speed` (length per step)
-/// in a random direction of the floor, turned back at the building's outer walls (objects go through inner walls and
-/// doors alike: nothing stops them). Per method at 1 thread: CPU ms per step (median), the build and query of the
-/// broad phase, and for portals the segment tests and boxes entered beyond their cell per step; the contacts summed
-/// over the steps must agree.
+/// --walk, the object-world part: every vertex against every wall (ObstacleSet::query), then against the walls of
+/// its cell only (CellWalls), the two interleaved step by step at 1 thread; CPU ms per step (medians), the
+/// vertex-obstacle pairs looked at, and the contacts, which must agree.
+void report_walls(const ObstacleSet& walls, const CellLayout& cells, const std::vector<Positions>& frames)
+{
+    const CellWalls by_cell(cells, walls);
+    std::vector<double> all_ms, cell_ms;
+    std::int64_t contacts = 0, tests = 0, every = 0;
+    bool same = true;
+    for (std::size_t k = 1; k < frames.size(); ++k) {
+        double c0 = thread_cpu_ms();
+        const std::vector<ObstacleContact> a = walls.query(frames[k]);
+        all_ms.push_back(thread_cpu_ms() - c0);
+        WallStats ws;
+        c0 = thread_cpu_ms();
+        const std::vector<ObstacleContact> b = by_cell.query(frames[k], &ws);
+        cell_ms.push_back(thread_cpu_ms() - c0);
+        same = same && a.size() == b.size() &&
+               std::equal(a.begin(), a.end(), b.begin(), [](const ObstacleContact& x, const ObstacleContact& y) {
+                   return x.vertex == y.vertex && x.obstacle == y.obstacle && x.depth == y.depth;
+               });
+        contacts += static_cast<std::int64_t>(a.size());
+        tests += ws.tests;
+        every += ws.all;
+    }
+    const double per = 1.0 / static_cast<double>(std::max<std::size_t>(1, frames.size() - 1));
+    std::printf("  walls (%d obstacles, %zu cells)  every wall %7.3f ms/step  walls of the cell %7.3f ms/step  "
+                "pairs %.0f of %.0f/step  wall contacts %lld%s\n",
+                static_cast<int>(walls.size()), cells.cells.size(), median(all_ms), median(cell_ms),
+                static_cast<double>(tests) * per, static_cast<double>(every) * per, static_cast<long long>(contacts),
+                same ? "" : "  ERROR: the walls of the cells give other contacts");
+    std::fflush(stdout);
+}
+
+/// --walk: the partition scenes "building", "walled" (its cells made from its walls) and "hall" with every object
+/// moving rigidly at `speed` (length per step) in a random direction of the floor, turned back at the building's outer
+/// walls (objects go through inner walls and doors alike: nothing stops them). Per method at 1 thread: CPU ms per step
+/// (median), the build and query of the broad phase, and for portals the segment tests and boxes entered beyond their
+/// cell per step; the contacts summed over the steps must agree.
 void report_walk(const std::vector<Method>& methods, const DetectParams& base, int steps, double speed, int rooms)
 {
-    for (const char* name : {"building", "hall"}) {
+    for (const char* name : {"building", "walled", "hall"}) {
         study::NamedScene ps = study::partition_scene(name);
         if (rooms > 0) { // rooms × rooms rooms, the hall one cell over them all
             ps = study::building_scene(rooms, rooms);
+            if (std::string(name) == "walled")
+                ps.cells = std::make_shared<const CellLayout>(cells_from_obstacles(*ps.walls));
             if (std::string(name) == "hall") {
                 auto one = std::make_shared<CellLayout>();
                 PortalCell c;
@@ -312,6 +348,7 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
                 c.hi[2] = 3;
                 one->cells.push_back(c);
                 ps.cells = one;
+                ps.walls = nullptr; // an open hall
             }
         }
         const double side = rooms > 0 ? 4.0 * rooms : 16.0;
@@ -379,6 +416,7 @@ void report_walk(const std::vector<Method>& methods, const DetectParams& base, i
             std::printf("\n");
             std::fflush(stdout);
         }
+        if (ps.walls) report_walls(*ps.walls, *ps.cells, frames);
     }
 }
 
@@ -475,7 +513,7 @@ void add_options(CLI::App& app, BenchOptions& o)
                    "other broad phases to measure on every scene at 1 thread (detect --method names, or all)");
     app.add_option("--partition-scenes", o.partition_scenes,
                    "scenes of the space-partition comparison after the scenarios: bars, sizes, corner, thin, "
-                   "building, hall, all or none")
+                   "building, walled, hall, all or none")
         ->capture_default_str();
     app.add_flag("--edges", o.edges,
                  "the edge-face contacts (set-up, find at 1 and all threads) beside vertex-in-tet detection, on the "
@@ -510,7 +548,7 @@ std::vector<std::string> partition_scene_list(const std::string& text)
         }
         if (std::find(known.begin(), known.end(), item) == known.end())
             throw Error("--partition-scenes: unknown scene '" + item +
-                        "' (expected bars, sizes, corner, thin, building, hall, all or none)");
+                        "' (expected bars, sizes, corner, thin, building, walled, hall, all or none)");
         names.push_back(item);
         item.clear();
     }

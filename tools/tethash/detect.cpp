@@ -25,6 +25,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -423,14 +424,22 @@ void print_detection(const DetectScene& sc, const DetectParams& params, const Ti
     fmt::print("contacts: {}\n", contacts);
 }
 
-/// The vertices inside the obstacles, each obstacle's count printed.
+/// The vertices inside the obstacles, each obstacle's count printed. With `cells` (--method portals), each vertex is
+/// tested against the walls of its cell only (CellWalls: the same answer).
 std::vector<ObstacleContact> query_obstacles(const ObstacleSet& obstacles, const Positions& positions,
-                                             const std::vector<std::string>& paths)
+                                             const std::vector<std::string>& paths, const CellLayout* cells)
 {
     if (obstacles.size() == 0) return {};
+    std::optional<CellWalls> walls;
+    if (cells) walls.emplace(*cells, obstacles);
+    WallStats ws;
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<ObstacleContact> inside = obstacles.query(positions);
+    std::vector<ObstacleContact> inside = walls ? walls->query(positions, &ws) : obstacles.query(positions);
     const double obstacle_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (walls)
+        fmt::print("walls: each vertex against the obstacles meeting its cell: {} vertex-obstacle tests of {} ({} "
+                   "vertices in no cell)\n",
+                   ws.tests, ws.all, ws.outside);
     for (Index k = 0; k < obstacles.size(); ++k) {
         const BspStats& b = obstacles[k].stats();
         const auto n =
@@ -522,6 +531,21 @@ void run(const DetectOptions& o)
     }
     DetectScene sc = load_detect_scene(o);
     params.table_size = parse_table_size(o.table_size, sc.nv);
+    if (!side_by_side && params.method == Method::portals && obstacles.size() > 0 && !params.partition.cells) {
+        // No cell file: the cells of the free space between the obstacles, over the scene's box too.
+        auto derived = std::make_shared<CellLayout>();
+        if (sc.nv > 0) {
+            const auto [lo, hi] = bounding_box(sc.mesh.positions);
+            *derived = cells_from_obstacles(obstacles, lo.data(), hi.data());
+        } else {
+            *derived = cells_from_obstacles(obstacles);
+        }
+        const auto free = std::count_if(derived->cells.begin(), derived->cells.end(),
+                                        [](const PortalCell& c) { return c.name.rfind("free", 0) == 0; });
+        fmt::print("cells from the obstacles: {} cells ({} free, {} solid), {} portals\n", derived->cells.size(), free,
+                   static_cast<std::ptrdiff_t>(derived->cells.size()) - free, derived->portals.size());
+        params.partition.cells = std::move(derived);
+    }
     if (side_by_side) {
         compare_all_methods(sc.mesh, sc.nv, sc.nt, sc.num_objects, sc.vobj, sc.tobj, sc.objects, params, repeat);
         return;
@@ -531,7 +555,9 @@ void run(const DetectOptions& o)
     const TimedDetection timed = time_detection(det, sc.mesh.positions, repeat);
     const std::vector<Contact>& contacts = det.contacts();
     print_detection(sc, params, timed, repeat, contacts.size());
-    const std::vector<ObstacleContact> inside = query_obstacles(obstacles, sc.mesh.positions, o.obstacles);
+    const std::vector<ObstacleContact> inside =
+        query_obstacles(obstacles, sc.mesh.positions, o.obstacles,
+                        params.method == Method::portals ? params.partition.cells.get() : nullptr);
     EdgeFaceResult edge_result;
     double edges_ms = 0;
     if (edges) {
@@ -590,7 +616,9 @@ Registrar reg{
          sub.add_option(
              "--cells", o->cells_path,
              "Portals: the cells and portals, a text file of lines 'cell NAME XMIN YMIN ZMIN XMAX YMAX ZMAX' "
-             "and 'portal CELL_A CELL_B X0 Y0 Z0 X1 Y1 Z1' (default: a grid of cells of its own)");
+             "and 'portal CELL_A CELL_B X0 Y0 Z0 X1 Y1 Z1' (default: the free space between the --obstacle surfaces "
+             "when "
+             "there are any, else a grid of cells of its own; docs/partitions.md)");
          sub.add_option("--contacts", o->contacts_path,
                         "Write the contacts: FILE.csv (scene ids, objects, each side's file and id in that file's "
                         "numbering, barycentric coordinates) or FILE.vtu (the meshes with point data contact, "
@@ -604,7 +632,8 @@ Registrar reg{
          sub.add_option("--obstacle", o->obstacles,
                         "Closed surface file (.obj .off .stl .ply ...): a static obstacle kept as a BSP tree; the "
                         "vertices inside it (closed: on its faces counts) are reported with depth and direction. "
-                        "Repeatable")
+                        "With --method portals each vertex is tested against the walls of its cell only, and "
+                        "without --cells the cells are made of the free space between the obstacles. Repeatable")
              ->allow_extra_args(false);
          sub.add_flag("--continuous", o->continuous,
                       "The two meshes are frames of the same meshes (FRAME0 FRAME1, e.g. simulation frames): report "

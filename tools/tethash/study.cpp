@@ -257,10 +257,10 @@ Registrar reg{
          sub.add_option("--threads", a->o.threads,
                         "thread counts: list or FROM:TO (0 = every hardware thread; default 1; threads sweep: "
                         "1..cores)");
-         sub.add_option(
-                "--partition-scenes", a->o.partition_scenes,
-                "scenes of the space-partition comparison: bars, sizes, corner, thin, building, hall or all (hash "
-                "at its worst; many objects each touching several; rooms and doors for portals)")
+         sub.add_option("--partition-scenes", a->o.partition_scenes,
+                        "scenes of the space-partition comparison: bars, sizes, corner, thin, building, walled, hall "
+                        "or all (hash "
+                        "at its worst; many objects each touching several; rooms and doors for portals)")
              ->delimiter(',');
          // --methods and --leaf-size are shared with the spheres study (study_spheres.cpp registers them).
          sub.add_option("--max-depth", a->o.max_depth, "trees: deepest levels, list (default: the method's)");

@@ -60,6 +60,8 @@ std::vector<Scenario> teschner_scenarios();
 ///    and packed so that neighbours overlap.
 ///  - "building": building_scene(4, 4): 16 rooms joined by 24 doors, 208 small objects (pairs overlapping) spread
 ///    over the rooms and standing in every doorway, with its cells and portals.
+///  - "walled": the building's objects with cells made from its walls (cells_from_obstacles on building_walls(4, 4):
+///    free boxes between the walls joined by portals through the doors), not from its rooms.
 ///  - "hall": the building's objects in one open hall: one cell, no portal (where cells and portals cannot help).
 struct NamedScene {
     std::string name;
@@ -68,6 +70,8 @@ struct NamedScene {
     /// The cells and portals of the scene (the building's rooms and doors), for Method::portals; null for the
     /// scenes without (the method then makes its own).
     std::shared_ptr<const CellLayout> cells;
+    /// The building's walls as static obstacles (building_walls), for the object-world part; null for the others.
+    std::shared_ptr<const ObstacleSet> walls;
 };
 /// The names above, in that order.
 const std::vector<std::string>& partition_scene_names();
@@ -79,6 +83,9 @@ NamedScene partition_scene(const std::string& name);
 /// 3 × 3 × 3-cube lattice of edge 0.1 (162 tets, 64 vertices), randomly rotated. Deterministic in `seed`. The
 /// cells and portals are the rooms and doors (room names "rI_J").
 NamedScene building_scene(int nx, int ny, std::uint64_t seed = 0x5ca1ab1eULL);
+/// The walls of building_scene(nx, ny) as box obstacles 0.1 thick, centred on the rooms' borders, 3 high: the outer
+/// walls whole, the inner ones with the gaps of the doors (1 wide, 2 high, a lintel above each).
+ObstacleSet building_walls(int nx, int ny);
 /// An nx × ny × nz lattice of boxes of size h (corner at the origin), six tets per box: one object.
 TetMesh cube_lattice(int nx, int ny, int nz, const Eigen::Vector3d& h);
 

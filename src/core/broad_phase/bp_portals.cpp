@@ -3,6 +3,12 @@
 // portals by a segment test from its previous position; each tet box is tested against the vertices of the cells it
 // overlaps (its own, and the adjoining ones whose portal, or wall, it reaches).
 //
+// Convex cells (a box cut by half-spaces, portals.hpp) keep the argument below with "closed box" read as "the cell as
+// contains_cell decides it" (in its box and every rounded n · p − d <= 0: a point in the cell is in its box), boxes
+// entered in every cell whose box they meet, and the covering test made conservative: a part of B in convex cells
+// only counts as outside unless B lies in one convex cell with a margin no rounding crosses (inside_convex); the
+// fast path is for layouts of boxes only.
+//
 // Why no pair is missed. Cells are closed boxes with non-empty, pairwise disjoint interiors; the "outside" cell (index
 // = number of cells) holds the points in no closed cell. (1) Every vertex is assigned one cell that contains it
 // (closed): the tracked cell when the point still lies in it, else the cell its segment walk ends in when that cell
@@ -23,10 +29,10 @@
 // no cell iff one piece is in no cell, and a piece [a, b] (a == b for a point) is in a cell iff lo ≤ a and b ≤ hi on
 // every axis.
 //
-// The locator: a uniform grid of buckets over the cells' union box; a cell is listed in the buckets of the range
-// cell_coord(lo) .. cell_coord(hi) (clamped), the expression the points use, so a point (a box) in a cell finds it
-// in its bucket (range) whatever the rounding (bp_common.hpp).
+// The locator: cell_locator.hpp.
 #include "bp_common.hpp"
+#include "cell_locator.hpp"
+#include "convex_cells.hpp"
 
 #include "tethash/portals.hpp"
 
@@ -49,13 +55,6 @@ bool strictly_inside(const Box& outer, const Box& inner)
     return true;
 }
 
-bool intersects(const Box& a, const Box& b)
-{
-    for (int k = 0; k < 3; ++k)
-        if (a.hi[k] < b.lo[k] || b.hi[k] < a.lo[k]) return false;
-    return true;
-}
-
 /// The slabs of a cell: `count` slices across `axis` (y or z), [first, first + count) in the bucket numbering.
 struct Slabs {
     int axis = 1;
@@ -68,10 +67,12 @@ struct Slabs {
 };
 
 struct PortalFace {
-    Box rect;     ///< the portal's rectangle (flat on `axis`)
-    int axis = 0; ///< the face's axis
-    bool upper{}; ///< on the cell's hi face (true) or lo face
-    Index to = 0; ///< the cell on the other side
+    Box rect;         ///< the portal's rectangle (flat on `axis`), or its polygon's bounding box when `general`
+    int axis = 0;     ///< the face's axis
+    bool upper{};     ///< on the cell's hi face (true) or lo face
+    bool general{};   ///< a polygon, or a portal of a convex cell: matched by its box grown by `slack`
+    double slack = 0; ///< 1e-9 of the coordinates' magnitude
+    Index to = 0;     ///< the cell on the other side
 };
 
 class Portals final : public BroadPhaseBase {
@@ -93,9 +94,9 @@ class Portals final : public BroadPhaseBase {
     void query_phase(const PartitionScene& scene, std::vector<CandidateSink>& sinks) override;
     std::int64_t structure_bytes() const override
     {
-        std::int64_t m =
-            bytes_of(m_cells, m_face_start, m_faces, m_bucket_start, m_bucket_cells, m_vcell, m_vold, m_tcell, m_told,
-                     m_slabs, m_vbucket, m_vstart, m_vids, m_vx, m_vyz, m_boxes, m_reg_start, m_reg_tets);
+        std::int64_t m = bytes_of(m_cells, m_face_start, m_faces, m_vcell, m_vold, m_tcell, m_told, m_slabs, m_vbucket,
+                                  m_vstart, m_vids, m_vx, m_vyz, m_boxes, m_reg_start, m_reg_tets) +
+                         m_locator.bytes();
         for (const auto& r : m_thread_regs)
             m += bytes_of(r);
         return m;
@@ -105,13 +106,23 @@ class Portals final : public BroadPhaseBase {
     /// The cells of the method's own making over the vertices' box (no layout given).
     void make_own_layout(const PartitionScene& s);
     Index outside() const { return static_cast<Index>(m_cells.size()); }
-    /// The locator's bucket coordinate of x on axis a (the monotone cell_coord, clamped to the buckets).
-    std::int64_t bucket_coord(int a, double x) const
+    /// p in cell c: in its box and, for a convex cell, n · p − d ≤ 0 (as rounded) for each of its planes.
+    bool contains_cell(Index c, const double* p) const
     {
-        return m_dims[a] == 1 ? 0 : std::clamp<std::int64_t>(cell_coord(x, m_union.lo[a], m_inv[a]), 0, m_dims[a] - 1);
+        const Box& b = m_cells[static_cast<std::size_t>(c)];
+        if (!in_box(p, b.lo, b.hi)) return false;
+        for (const CellPlane& pl : m_planes[static_cast<std::size_t>(c)])
+            if (pl.n[0] * p[0] + pl.n[1] * p[1] + pl.n[2] * p[2] - pl.d > 0) return false;
+        return true;
     }
     /// The first cell (lowest index in its bucket's list) containing p, outside() when none.
-    Index locate(const double* p) const;
+    Index locate(const double* p) const
+    {
+        const Index c = m_locator.locate(p, [&](Index cell) { return contains_cell(cell, p); });
+        return c < 0 ? outside() : c;
+    }
+    /// b lies in the convex cell c with a margin that no rounding of contains_cell can cross: every point of b is in c.
+    bool inside_convex(const Box& b, Index c) const;
     /// The cell of a point at p that was in cell `from` at `old`: `from` when it still contains p, else the walk of the
     /// segment old → p through the portals, else locate(). Counts a segment test in `rays`.
     Index follow(Index from, const double* old, const double* p, std::int64_t& rays) const;
@@ -120,14 +131,12 @@ class Portals final : public BroadPhaseBase {
     bool covered(const Box& b, const std::vector<Index>& cells) const;
 
     std::vector<Box> m_cells;
+    std::vector<std::vector<CellPlane>> m_planes; // per cell: its half-spaces beyond its box (none for a box cell)
+    bool m_convex = false;                        // some cell has planes
     std::vector<Index> m_face_start; // cells + 1: the portals of cell c are m_faces[m_face_start[c], [c + 1])
     std::vector<PortalFace> m_faces;
     bool m_own = false; // the layout is of our making (rebuilt when too many vertices leave it)
-    // Locator.
-    Box m_union{};
-    double m_inv[3] = {1, 1, 1};
-    std::int64_t m_dims[3] = {1, 1, 1};
-    std::vector<Index> m_bucket_start, m_bucket_cells;
+    CellLocator m_locator;
     // Tracking across calls.
     bool m_tracked = false;
     std::vector<Index> m_vcell, m_tcell; // per vertex, per tet: its cell
@@ -148,11 +157,16 @@ void Portals::set_layout(const CellLayout& layout)
 {
     const std::size_t n = layout.cells.size();
     m_cells.resize(n);
-    for (std::size_t c = 0; c < n; ++c)
+    m_planes.assign(n, {});
+    m_convex = false;
+    for (std::size_t c = 0; c < n; ++c) {
         for (int a = 0; a < 3; ++a) {
             m_cells[c].lo[a] = layout.cells[c].lo[a];
             m_cells[c].hi[a] = layout.cells[c].hi[a];
         }
+        m_planes[c] = layout.cells[c].planes;
+        m_convex = m_convex || !m_planes[c].empty();
+    }
     // Portals per cell, both directions.
     m_face_start.assign(n + 1, 0);
     for (const Portal& p : layout.portals) {
@@ -164,6 +178,10 @@ void Portals::set_layout(const CellLayout& layout)
     m_faces.resize(static_cast<std::size_t>(m_face_start[n]));
     std::vector<Index> fill(m_face_start.begin(), m_face_start.end() - 1);
     for (const Portal& p : layout.portals) {
+        const bool general = !p.polygon.empty() || !m_planes[static_cast<std::size_t>(p.a)].empty() ||
+                             !m_planes[static_cast<std::size_t>(p.b)].empty();
+        const double slack = 1e-9 * std::max(detail::magnitude(layout.cells[static_cast<std::size_t>(p.a)]),
+                                             detail::magnitude(layout.cells[static_cast<std::size_t>(p.b)]));
         int axis = 0;
         for (int a = 0; a < 3; ++a)
             if (p.lo[a] == p.hi[a] && (p.lo[a] == m_cells[static_cast<std::size_t>(p.a)].lo[a] ||
@@ -176,66 +194,13 @@ void Portals::set_layout(const CellLayout& layout)
             std::copy(p.hi, p.hi + 3, f.rect.hi);
             f.axis = axis;
             f.upper = p.lo[axis] == m_cells[static_cast<std::size_t>(from)].hi[axis];
+            f.general = general;
+            f.slack = slack;
             f.to = to;
             m_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(from)]++)] = f;
         }
     }
-    // Locator: about 8 buckets per cell, at most 64 per axis, shaped like the cells' union.
-    if (n == 0) {
-        m_bucket_start.assign(2, 0);
-        m_bucket_cells.clear();
-        return;
-    }
-    m_union = m_cells[0];
-    for (const Box& b : m_cells)
-        for (int a = 0; a < 3; ++a) {
-            m_union.lo[a] = std::min(m_union.lo[a], b.lo[a]);
-            m_union.hi[a] = std::max(m_union.hi[a], b.hi[a]);
-        }
-    double ext[3], vol = 1;
-    for (int a = 0; a < 3; ++a) {
-        ext[a] = m_union.hi[a] - m_union.lo[a];
-        vol *= ext[a];
-    }
-    const double edge = std::cbrt(vol / (8.0 * static_cast<double>(n)));
-    std::int64_t buckets = 1;
-    for (int a = 0; a < 3; ++a) {
-        // Extreme extents (overflow, underflow) get one bucket on the axis: every coordinate maps to it.
-        const double k = edge > 0 && std::isfinite(edge) ? std::ceil(ext[a] / edge) : 1;
-        m_dims[a] = std::isfinite(k) ? static_cast<std::int64_t>(std::clamp(k, 1.0, 64.0)) : 1;
-        m_inv[a] = static_cast<double>(m_dims[a]) / ext[a];
-        if (!std::isfinite(m_inv[a])) m_dims[a] = 1;
-        buckets *= m_dims[a];
-    }
-    auto range = [&](const Box& b, std::int64_t lo[3], std::int64_t hi[3]) {
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = bucket_coord(a, b.lo[a]);
-            hi[a] = bucket_coord(a, b.hi[a]);
-        }
-    };
-    m_bucket_start.assign(static_cast<std::size_t>(buckets) + 1, 0);
-    for (int pass = 0; pass < 2; ++pass) {
-        std::vector<Index> fill_b;
-        if (pass == 1) {
-            for (std::int64_t k = 0; k < buckets; ++k)
-                m_bucket_start[static_cast<std::size_t>(k) + 1] += m_bucket_start[static_cast<std::size_t>(k)];
-            m_bucket_cells.resize(static_cast<std::size_t>(m_bucket_start.back()));
-            fill_b.assign(m_bucket_start.begin(), m_bucket_start.end() - 1);
-        }
-        for (std::size_t c = 0; c < n; ++c) {
-            std::int64_t lo[3], hi[3];
-            range(m_cells[c], lo, hi);
-            for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-                for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                    for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                        const auto k = static_cast<std::size_t>((x * m_dims[1] + y) * m_dims[2] + z);
-                        if (pass == 0)
-                            ++m_bucket_start[k + 1];
-                        else
-                            m_bucket_cells[static_cast<std::size_t>(fill_b[k]++)] = static_cast<Index>(c);
-                    }
-        }
-    }
+    m_locator.build(m_cells);
 }
 
 void Portals::make_own_layout(const PartitionScene& s)
@@ -264,23 +229,9 @@ void Portals::make_own_layout(const PartitionScene& s)
     m_own = true;
 }
 
-Index Portals::locate(const double* p) const
-{
-    if (m_cells.empty() || !contains_point(m_union, p)) return outside();
-    std::int64_t c[3];
-    for (int a = 0; a < 3; ++a)
-        c[a] = bucket_coord(a, p[a]);
-    const auto k = static_cast<std::size_t>((c[0] * m_dims[1] + c[1]) * m_dims[2] + c[2]);
-    for (Index i = m_bucket_start[k]; i < m_bucket_start[k + 1]; ++i) {
-        const Index cell = m_bucket_cells[static_cast<std::size_t>(i)];
-        if (contains_point(m_cells[static_cast<std::size_t>(cell)], p)) return cell;
-    }
-    return outside();
-}
-
 Index Portals::follow(Index from, const double* old, const double* p, std::int64_t& rays) const
 {
-    if (from != outside() && contains_point(m_cells[static_cast<std::size_t>(from)], p)) return from;
+    if (from != outside() && contains_cell(from, p)) return from;
     if (from == outside()) {
         // A point outside stays there until the locator finds it in a cell (no portal leads in from outside).
         return locate(p);
@@ -294,7 +245,7 @@ Index Portals::follow(Index from, const double* old, const double* p, std::int64
         const Box& b = m_cells[static_cast<std::size_t>(cell)];
         double t_exit = 2;
         int axis = -1;
-        bool upper = false;
+        bool upper = false, by_plane = false;
         for (int a = 0; a < 3; ++a) {
             if (d[a] == 0) continue;
             const bool up = d[a] > 0;
@@ -305,29 +256,75 @@ Index Portals::follow(Index from, const double* old, const double* p, std::int64
                 upper = up;
             }
         }
-        if (axis < 0 || t_exit > 1) break; // p lies beyond no face of this cell (rounding): let the locator decide
+        for (const CellPlane& pl : m_planes[static_cast<std::size_t>(cell)]) {
+            const double nd = pl.n[0] * d[0] + pl.n[1] * d[1] + pl.n[2] * d[2];
+            if (!(nd > 0)) continue;
+            const double t = (pl.d - (pl.n[0] * old[0] + pl.n[1] * old[1] + pl.n[2] * old[2])) / nd;
+            if (t < t_exit) {
+                t_exit = t;
+                by_plane = true;
+            }
+        }
+        if ((axis < 0 && !by_plane) || t_exit > 1) break; // p lies beyond no face (rounding): the locator decides
         double q[3];
         for (int a = 0; a < 3; ++a)
             q[a] = old[a] + t_exit * d[a];
-        q[axis] = upper ? b.hi[axis] : b.lo[axis];
+        if (!by_plane) q[axis] = upper ? b.hi[axis] : b.lo[axis];
+        // The portal holding the exit point: a rectangle of the face left by, or a polygon (or a portal of a convex
+        // cell) whose box, grown by its slack, holds it. A wrong guess costs nothing: the cell must hold p below.
         Index next = -1;
         for (Index f = m_face_start[static_cast<std::size_t>(cell)];
              f < m_face_start[static_cast<std::size_t>(cell) + 1]; ++f) {
             const PortalFace& face = m_faces[static_cast<std::size_t>(f)];
-            if (face.axis == axis && face.upper == upper && contains_point(face.rect, q)) {
+            bool hit = false;
+            if (face.general) {
+                hit = true;
+                for (int a = 0; a < 3; ++a)
+                    hit = hit && face.rect.lo[a] - face.slack <= q[a] && q[a] <= face.rect.hi[a] + face.slack;
+            } else {
+                hit = !by_plane && face.axis == axis && face.upper == upper && contains_point(face.rect, q);
+            }
+            if (hit) {
                 next = face.to;
                 break;
             }
         }
         if (next < 0) break; // through a wall: the locator decides
         cell = next;
-        if (contains_point(m_cells[static_cast<std::size_t>(cell)], p)) return cell;
+        if (contains_cell(cell, p)) return cell;
     }
     return locate(p);
 }
 
+bool Portals::inside_convex(const Box& b, Index c) const
+{
+    const Box& cb = m_cells[static_cast<std::size_t>(c)];
+    for (int a = 0; a < 3; ++a)
+        if (b.lo[a] < cb.lo[a] || b.hi[a] > cb.hi[a]) return false;
+    double big[3];
+    for (int a = 0; a < 3; ++a)
+        big[a] = std::max(std::abs(b.lo[a]), std::abs(b.hi[a]));
+    for (const CellPlane& pl : m_planes[static_cast<std::size_t>(c)]) {
+        // n · x − d is affine: below −margin at the corners, below it in the box; the margin (1e-12 of the terms'
+        // magnitude) is far above the rounding of contains_cell's expression at any point of the box.
+        const double margin = 1e-12 * (std::abs(pl.n[0]) * big[0] + std::abs(pl.n[1]) * big[1] +
+                                       std::abs(pl.n[2]) * big[2] + std::abs(pl.d));
+        for (int k = 0; k < 8; ++k) {
+            const double x = k & 1 ? b.hi[0] : b.lo[0], y = k & 2 ? b.hi[1] : b.lo[1], z = k & 4 ? b.hi[2] : b.lo[2];
+            if (!(pl.n[0] * x + pl.n[1] * y + pl.n[2] * z - pl.d < -margin)) return false;
+        }
+    }
+    return true;
+}
+
 bool Portals::covered(const Box& b, const std::vector<Index>& cells) const
 {
+    // Convex cells: b inside one of them (with its margin); else the box cells alone must cover it (a piece of b
+    // covered by convex cells only counts as uncovered: b is then entered in the outside cell too, which is safe).
+    if (m_convex) {
+        for (Index c : cells)
+            if (c != outside() && !m_planes[static_cast<std::size_t>(c)].empty() && inside_convex(b, c)) return true;
+    }
     // Pieces per axis: the cut points of b's range [lo, hi] at the cells' borders, as [a, a] points and [a, b]
     // standing for the open interval between two cut points.
     std::vector<double> cuts[3];
@@ -335,7 +332,7 @@ bool Portals::covered(const Box& b, const std::vector<Index>& cells) const
     for (int a = 0; a < 3; ++a) {
         cuts[a] = {b.lo[a], b.hi[a]};
         for (Index c : cells) {
-            if (c == outside()) continue;
+            if (c == outside() || !m_planes[static_cast<std::size_t>(c)].empty()) continue;
             const Box& cb = m_cells[static_cast<std::size_t>(c)];
             if (cb.lo[a] > b.lo[a] && cb.lo[a] < b.hi[a]) cuts[a].push_back(cb.lo[a]);
             if (cb.hi[a] > b.lo[a] && cb.hi[a] < b.hi[a]) cuts[a].push_back(cb.hi[a]);
@@ -353,7 +350,7 @@ bool Portals::covered(const Box& b, const std::vector<Index>& cells) const
                 const std::pair<double, double> piece[3] = {px, py, pz};
                 bool in_some = false;
                 for (Index c : cells) {
-                    if (c == outside()) continue;
+                    if (c == outside() || !m_planes[static_cast<std::size_t>(c)].empty()) continue;
                     const Box& cb = m_cells[static_cast<std::size_t>(c)];
                     bool in = true;
                     for (int a = 0; a < 3; ++a)
@@ -370,25 +367,7 @@ bool Portals::covered(const Box& b, const std::vector<Index>& cells) const
 
 void Portals::overlapped_cells(const Box& b, std::vector<Index>& out, std::vector<Index>& scratch) const
 {
-    scratch.clear();
-    if (!m_cells.empty() && intersects(m_union, b)) {
-        std::int64_t lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            lo[a] = bucket_coord(a, b.lo[a]);
-            hi[a] = bucket_coord(a, b.hi[a]);
-        }
-        for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
-            for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
-                    const auto k = static_cast<std::size_t>((x * m_dims[1] + y) * m_dims[2] + z);
-                    for (Index i = m_bucket_start[k]; i < m_bucket_start[k + 1]; ++i) {
-                        const Index c = m_bucket_cells[static_cast<std::size_t>(i)];
-                        if (intersects(m_cells[static_cast<std::size_t>(c)], b)) scratch.push_back(c);
-                    }
-                }
-        std::sort(scratch.begin(), scratch.end());
-        scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
-    }
+    m_locator.overlapping(m_cells, b, scratch);
     out.insert(out.end(), scratch.begin(), scratch.end());
     if (!covered(b, scratch)) out.push_back(outside());
 }
@@ -458,7 +437,8 @@ bool Portals::build_phase(const PartitionScene& s, int threads)
             Index& home = m_tcell[static_cast<std::size_t>(t)];
             home = tracked ? follow(home, old, c, r) : locate(c);
             std::copy(c, c + 3, old);
-            if (home != outside() && strictly_inside(m_cells[static_cast<std::size_t>(home)], b)) {
+            // The fast path needs box cells only (a convex cell's box may reach into its neighbours').
+            if (!m_convex && home != outside() && strictly_inside(m_cells[static_cast<std::size_t>(home)], b)) {
                 regs.emplace_back(home, t);
                 continue;
             }

@@ -1,6 +1,8 @@
 // Cells and portals (portals.hpp): the checks of a layout and the grid layout the method makes for itself.
 #include "tethash/portals.hpp"
 
+#include "convex_cells.hpp"
+
 #include "tethash/error.hpp"
 
 #include <cmath>
@@ -51,17 +53,113 @@ void check_cell(const CellLayout& layout, std::size_t k)
         if (!(c.lo[a] < c.hi[a]))
             throw Error(name + ": inverted or flat box " + box_text(c.lo, c.hi) +
                         " (expected min < max on every axis)");
+    std::vector<std::array<double, 3>> corners;
+    if (!c.planes.empty()) {
+        if (c.planes.size() > max_cell_planes)
+            throw Error(name + ": " + std::to_string(c.planes.size()) + " planes (at most " +
+                        std::to_string(max_cell_planes) + ")");
+        for (std::size_t p = 0; p < c.planes.size(); ++p)
+            if (!finite3(c.planes[p].n) || !std::isfinite(c.planes[p].d) || !(detail::plane_norm(c.planes[p]) > 0))
+                throw Error(name + ": plane " + std::to_string(p + 1) + " must be finite, with a non-zero normal");
+        // An interior: the corners' centroid strictly inside every half-space.
+        corners = cell_corners(c);
+        const double eps = 1e-9 * detail::magnitude(c);
+        double mid[3] = {0, 0, 0};
+        for (const auto& x : corners)
+            for (int a = 0; a < 3; ++a)
+                mid[a] += x[static_cast<std::size_t>(a)] / static_cast<double>(corners.size());
+        bool interior = corners.size() >= 4;
+        for (const CellPlane& p : detail::all_planes(c))
+            interior = interior && detail::plane_value(p, mid) < -eps * detail::plane_norm(p);
+        if (!interior) throw Error(name + ": the planes leave no volume in the box " + box_text(c.lo, c.hi));
+    }
     for (std::size_t j = 0; j < k; ++j) {
         const PortalCell& o = layout.cells[j];
         if (o.name == c.name) throw Error(name + ": the name is used twice");
         bool overlap = true;
         for (int a = 0; a < 3; ++a)
             overlap = overlap && c.lo[a] < o.hi[a] && o.lo[a] < c.hi[a];
+        if (overlap && (!c.planes.empty() || !o.planes.empty())) {
+            // Convex cells: apart when a face plane of one has the other on its far side.
+            if (corners.empty()) corners = cell_corners(c);
+            const double eps = 1e-9 * std::max(detail::magnitude(c), detail::magnitude(o));
+            overlap = !detail::separated(c, corners, o, cell_corners(o), eps);
+        }
         if (overlap)
             throw Error(name + " " + box_text(c.lo, c.hi) + " overlaps cell '" + o.name + "' " + box_text(o.lo, o.hi) +
-                        " (cells may share faces, not volume)");
+                        " (cells may share faces, not volume; convex cells must lie on either side of a face plane "
+                        "of one of them)");
     }
 }
+
+namespace {
+
+/// The checks of a polygon portal (portals.hpp: check_portal).
+void check_polygon(const PortalCell& a, const PortalCell& b, const std::vector<std::array<double, 3>>& poly,
+                   const std::string& name)
+{
+    if (poly.size() < 3) throw Error(name + ": a polygon needs at least 3 corners, got " + std::to_string(poly.size()));
+    double scale = std::max(detail::magnitude(a), detail::magnitude(b));
+    for (const auto& x : poly) {
+        if (!finite3(x.data())) throw Error(name + ": coordinates must be finite");
+        for (double v : x)
+            scale = std::max(scale, std::abs(v));
+    }
+    const double eps = 1e-9 * scale;
+    // Newell's normal: twice the area along each axis.
+    double n[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        const auto& p = poly[i];
+        const auto& q = poly[(i + 1) % poly.size()];
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > eps * scale)) throw Error(name + ": the polygon has no area");
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        double off = 0;
+        for (int k = 0; k < 3; ++k)
+            off += n[k] / len * (poly[i][static_cast<std::size_t>(k)] - poly[0][static_cast<std::size_t>(k)]);
+        if (std::abs(off) > eps)
+            throw Error(name + ": the polygon is not planar (corner " + std::to_string(i + 1) +
+                        " is off the plane of the others)");
+    }
+    // Convex: every turn the same way as the normal.
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        const auto& p = poly[i];
+        const auto& q = poly[(i + 1) % poly.size()];
+        const auto& r = poly[(i + 2) % poly.size()];
+        double u[3], v[3];
+        for (std::size_t k = 0; k < 3; ++k) {
+            u[k] = q[k] - p[k];
+            v[k] = r[k] - q[k];
+        }
+        const double turn = (u[1] * v[2] - u[2] * v[1]) * n[0] + (u[2] * v[0] - u[0] * v[2]) * n[1] +
+                            (u[0] * v[1] - u[1] * v[0]) * n[2];
+        if (turn < -eps * scale * len)
+            throw Error(name + ": the polygon is not convex (at corner " + std::to_string((i + 1) % poly.size() + 1) +
+                        ")");
+    }
+    // On the boundary both cells share: on a face plane of each, and within both.
+    for (const PortalCell* c : {&a, &b}) {
+        bool on_face = false;
+        for (const CellPlane& p : detail::all_planes(*c)) {
+            bool all = true;
+            for (const auto& x : poly)
+                all = all && std::abs(detail::plane_value(p, x.data())) <= eps * detail::plane_norm(p);
+            on_face = on_face || all;
+        }
+        for (std::size_t i = 0; i < poly.size() && on_face; ++i)
+            if (!detail::contains_near(*c, poly[i].data(), eps))
+                throw Error(name + ": the polygon is not on the shared boundary (corner " + std::to_string(i + 1) +
+                            " is outside cell '" + c->name + "')");
+        if (!on_face)
+            throw Error(name + ": the polygon is not on the shared boundary (not on a face of cell '" + c->name + "')");
+    }
+}
+
+} // namespace
 
 void check_portal(const CellLayout& layout, std::size_t k)
 {
@@ -74,6 +172,26 @@ void check_portal(const CellLayout& layout, std::size_t k)
     const PortalCell& b = layout.cells[static_cast<std::size_t>(p.b)];
     const std::string name = "portal '" + a.name + "' - '" + b.name + "'";
     if (p.a == p.b) throw Error(name + ": a portal joins two different cells");
+    if (!p.polygon.empty() || !a.planes.empty() || !b.planes.empty()) {
+        if (!p.polygon.empty()) {
+            check_polygon(a, b, p.polygon, name);
+            return;
+        }
+        // A rectangle touching a convex cell: its four corners as a polygon.
+        int flat = -1;
+        for (int j = 0; j < 3; ++j)
+            if (p.lo[j] == p.hi[j]) flat = j;
+        if (flat < 0) throw Error(name + ": the rectangle " + box_text(p.lo, p.hi) + " is not flat on any axis");
+        const int u = (flat + 1) % 3, v = (flat + 2) % 3;
+        std::vector<std::array<double, 3>> poly(4);
+        for (std::size_t k = 0; k < 4; ++k) {
+            poly[k][static_cast<std::size_t>(flat)] = p.lo[flat];
+            poly[k][static_cast<std::size_t>(u)] = k == 1 || k == 2 ? p.hi[u] : p.lo[u];
+            poly[k][static_cast<std::size_t>(v)] = k >= 2 ? p.hi[v] : p.lo[v];
+        }
+        check_polygon(a, b, poly, name);
+        return;
+    }
     if (!finite3(p.lo) || !finite3(p.hi)) throw Error(name + ": coordinates must be finite");
     double plane = 0;
     const int axis = shared_face(a, b, plane);

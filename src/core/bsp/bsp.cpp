@@ -316,6 +316,10 @@ double Bsp::distance(const Eigen::Vector3d& p) const
     return std::sqrt(d2);
 }
 
+const Positions& Bsp::vertices() const
+{
+    return m_impl->vertices;
+}
 const Eigen::Vector3d& Bsp::box_lo() const
 {
     return m_impl->lo;
