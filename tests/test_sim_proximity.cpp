@@ -9,6 +9,7 @@
 #include "tethash/sim/scene.hpp"
 #include "tethash/sim/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -172,4 +173,37 @@ TEST(SimProximity, SceneKeys)
     expect_error([&] { load_scene((dir / "bad.toml").string()); }, {"contact.margin", "bad.toml"});
     write_text(dir / "bad2.toml", "[contact]\nspeculative = 3\n[[object]]\ngenerate = { shape = \"box\" }\n");
     expect_error([&] { load_scene((dir / "bad2.toml").string()); }, {"contact.speculative", "bad2.toml"});
+}
+
+TEST(SimProximity, SameMarginContactsAtAnyThreadCount)
+{
+    // The boundary vertices split over the threads (enough of them: over a thousand): the margin contacts, their
+    // order and every field, the same at one and two threads, step after step, as two boxes settle on each other
+    // and on a plate.
+    auto scene = [](int threads) {
+        Scene s = box_on_plate(0.02);
+        s.objects.push_back(box_object(Eigen::Vector3d(0.5, 0.5, 0.3), {0.05, 0, 0.45}, 12));
+        s.objects[1] = box_object(Eigen::Vector3d(0.4, 0.4, 0.2), {0, 0, 0.12}, 12);
+        s.ground.enabled = false;
+        s.detect.threads = threads;
+        return s;
+    };
+    Simulation one(scene(1)), two(scene(2));
+    size_t most = 0;
+    for (int i = 0; i < 60; ++i) {
+        one.step();
+        two.step();
+        const std::vector<Contact>&a = one.margin_contacts(), &b = two.margin_contacts();
+        ASSERT_EQ(a.size(), b.size()) << "step " << i + 1;
+        most = std::max(most, a.size());
+        for (size_t k = 0; k < a.size(); ++k) {
+            ASSERT_EQ(a[k].vertex, b[k].vertex) << "step " << i + 1 << " contact " << k;
+            ASSERT_EQ(a[k].tet, b[k].tet) << "step " << i + 1 << " contact " << k;
+            ASSERT_EQ(a[k].depth, b[k].depth) << "step " << i + 1 << " contact " << k;
+            for (int r = 0; r < 3; ++r)
+                ASSERT_EQ(a[k].direction[r], b[k].direction[r]) << "step " << i + 1 << " contact " << k;
+        }
+        ASSERT_TRUE((one.positions().array() == two.positions().array()).all()) << "step " << i + 1;
+    }
+    EXPECT_GT(most, 100U);
 }

@@ -1,4 +1,5 @@
 #include "contact_response.hpp"
+#include "thread_choice.hpp"
 
 #include "core/timing.hpp"
 
@@ -57,7 +58,15 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         if (scene.contact.margin > 0 || scene.contact.speculative)
             m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
                               local_contact_edges);
+        m_proximity.set_threads(scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core());
     }
+}
+
+void ContactResponse::set_threads(int threads)
+{
+    if (!m_enabled) return;
+    m_detector.set_threads(threads);
+    m_proximity.set_threads(threads > 0 ? threads : detail::ThreadChoice::every_core());
 }
 
 double ContactResponse::pair_stiffness(Index a, Index b, double m_eff) const

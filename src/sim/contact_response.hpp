@@ -33,10 +33,7 @@ class ContactResponse {
                const SceneObstacles* obstacles = nullptr);
     bool enabled() const { return m_enabled; }
     /// The detector's thread count from the next update on (0 = every core); the contacts do not depend on it.
-    void set_threads(int threads)
-    {
-        if (m_enabled) m_detector.set_threads(threads);
-    }
+    void set_threads(int threads);
 
     /// Detects at `x`, drops the local self-contacts, fills depth/direction, adds the margin contacts for a
     /// substep h at velocities v (proximity.hpp), and the coefficients. Adds its times

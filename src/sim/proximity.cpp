@@ -1,5 +1,7 @@
 #include "proximity.hpp"
 
+#include "core/team.hpp"
+
 #include "core/hash/box_grid.hpp"
 
 #include "tethash/geometry.hpp"
@@ -130,7 +132,6 @@ void Proximity::setup(const TetMesh& mesh, const Positions& rest, const Model& m
     for (const auto& [code, f] : order)
         sorted.push_back(m_faces[static_cast<size_t>(f)]);
     m_faces.swap(sorted);
-    m_stamp.assign(m_faces.size(), -1);
     m_vertex_margin.assign(static_cast<size_t>(mesh.num_vertices()), 0.0);
     for (Index i : m_vertices)
         m_vertex_margin[static_cast<size_t>(i)] =
@@ -207,11 +208,14 @@ void Proximity::hash_faces(const Positions& x)
         m_grid.add(lo, hi);
     }
     m_grid.finish();
-    m_stamp.assign(nf, -1);
+    m_scratch.resize(static_cast<size_t>(m_threads));
+    for (Scratch& sc : m_scratch)
+        sc.stamp.assign(nf, -1);
 }
 
 // Inlined into query_cells' loop: the query's fields stay in registers, as in one function.
-__attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::int32_t f, const Positions& x)
+__attribute__((always_inline)) inline void Proximity::visit_face(Query& q, Scratch& s, std::int32_t f,
+                                                                 const Positions& x) const
 {
     const Face& fc = m_faces[static_cast<size_t>(f)];
     const Index p = q.p, op = q.op;
@@ -252,14 +256,14 @@ __attribute__((always_inline)) inline void Proximity::visit_face(Query& q, std::
     if (n.dot(x.row(fc.opp).transpose() - a) > 0) n = -n;
     if (!((q.xp - cp).dot(n) > 0)) return;
     const double d = std::sqrt(d2);
-    auto it = std::find_if(m_best.begin(), m_best.end(), [&](const Best& bs) { return bs.object == fc.object; });
-    if (it == m_best.end())
-        m_best.push_back({fc.object, f, d, cp});
+    auto it = std::find_if(s.best.begin(), s.best.end(), [&](const Best& bs) { return bs.object == fc.object; });
+    if (it == s.best.end())
+        s.best.push_back({fc.object, f, d, cp});
     else if (d < it->dist || (d == it->dist && f < it->face))
         *it = {fc.object, f, d, cp};
 }
 
-void Proximity::query_cells(Query& q, const Positions& x)
+void Proximity::query_cells(Query& q, Scratch& s, const Positions& x) const
 {
     const double rq = q.r + m_object_reach[static_cast<size_t>(q.op)]; // the query box: any partner object
     double lo[3], hi[3];
@@ -269,15 +273,15 @@ void Proximity::query_cells(Query& q, const Positions& x)
     }
     // A face met twice changes neither the nearest face per object nor the clearance: a query of one cell takes no
     // stamps.
-    m_grid.query(lo, hi, m_stamp.data(), static_cast<std::int32_t>(q.p), m_hits, true,
-                 [&](std::int32_t f) { visit_face(q, f, x); });
+    m_grid.query(lo, hi, s.stamp.data(), static_cast<std::int32_t>(q.p), s.hits, true,
+                 [&](std::int32_t f) { visit_face(q, s, f, x); });
 }
 
-void Proximity::keep_contacts(const Query& q, const Positions& x, const std::vector<Contact>& inside,
+void Proximity::keep_contacts(const Query& q, Scratch& s, const Positions& x, const std::vector<Contact>& inside,
                               std::vector<Contact>& out)
 {
     const Index p = q.p;
-    std::sort(m_best.begin(), m_best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
+    std::sort(s.best.begin(), s.best.end(), [](const Best& a, const Best& b) { return a.object < b.object; });
     // The vertex's penetration contacts (`inside` is sorted by vertex): the objects it is inside answer for it.
     const auto in_begin =
         std::lower_bound(inside.begin(), inside.end(), p, [](const Contact& c, Index vtx) { return c.vertex < vtx; });
@@ -290,20 +294,18 @@ void Proximity::keep_contacts(const Query& q, const Positions& x, const std::vec
     double& vm = m_vertex_margin[static_cast<size_t>(p)];
     const double full = m_margin[static_cast<size_t>(q.op)];
     vm = std::min(full, m_first ? std::sqrt(clearance) : std::max(vm, std::sqrt(clearance)));
-    for (const Best& bs : m_best)
+    for (const Best& bs : s.best)
         if (std::none_of(in_begin, in_end, [&](const Contact& c) { return c.tet_object == bs.object; }))
             out.push_back(margin_contact(x, p, q.op, bs.object, bs.face, bs.dist, bs.q));
 }
 
-void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
-                       std::vector<Contact>& out)
+void Proximity::query_range(size_t begin, size_t end, Scratch& s, const Positions& x,
+                            const std::vector<Contact>& inside, std::vector<Contact>& out)
 {
-    if (m_faces.empty()) return;
-    motion(v, h);
-    hash_faces(x);
     const Model& model = *m_model;
     Query q;
-    for (Index p : m_vertices) {
+    for (size_t i = begin; i < end; ++i) {
+        const Index p = m_vertices[i];
         q.p = p;
         q.op = model.vertex_object[static_cast<size_t>(p)];
         q.xp = x.row(p).transpose();
@@ -315,9 +317,39 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
         q.reach2 = m_reach2[static_cast<size_t>(q.op)];
         q.local_reach = q.reach2 > 0 ? std::sqrt(q.reach2) * (1 - 1e-5) : -1.0;
         q.far_reach = q.reach2 > 0 ? std::sqrt(q.reach2) * (1 + 1e-5) : -1.0;
-        m_best.clear();
-        query_cells(q, x);
-        keep_contacts(q, x, inside, out);
+        s.best.clear();
+        query_cells(q, s, x);
+        keep_contacts(q, s, x, inside, out);
+    }
+}
+
+void Proximity::update(const Positions& x, const Positions& v, double h, const std::vector<Contact>& inside,
+                       std::vector<Contact>& out)
+{
+    if (m_faces.empty()) return;
+    motion(v, h);
+    hash_faces(x);
+    const size_t nv = m_vertices.size();
+    const int threads = nv >= 1024 ? m_threads : 1;
+    if (threads == 1) {
+        query_range(0, nv, m_scratch[0], x, inside, out);
+    } else {
+        // Each thread its contiguous range of vertices and its own contacts, joined in thread order: the contacts
+        // of one thread, in vertex order. (Each vertex writes only its own margin.)
+        for (Scratch& sc : m_scratch)
+            sc.out.clear();
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel num_threads(threads)
+#endif
+        {
+            const int t = tethash::detail::team_rank(), parts = tethash::detail::team_size();
+            std::int64_t begin = 0, end = 0;
+            tethash::detail::team_split(static_cast<std::int64_t>(nv), t, parts, begin, end);
+            Scratch& sc = m_scratch[static_cast<size_t>(t)];
+            query_range(static_cast<size_t>(begin), static_cast<size_t>(end), sc, x, inside, sc.out);
+        }
+        for (const Scratch& sc : m_scratch)
+            out.insert(out.end(), sc.out.begin(), sc.out.end());
     }
     m_first = false;
 }

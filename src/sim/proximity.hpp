@@ -9,8 +9,9 @@
 // starts with a negative depth and pushes only if the gap closes below δ within the substep (a speculative contact;
 // vbd sees it close in its iterations, the other integrators push positive depths only).
 // Faces are hashed into the core's grid of boxes (core/hash/box_grid.hpp), cells of two mean edges; each vertex looks
-// at the cells its reach covers (one cell when nothing moves relative to its object). Deterministic: one thread, fixed
-// order.
+// at the cells its reach covers (one cell when nothing moves relative to its object). Deterministic at any thread
+// count: the boundary vertices split into one contiguous range per thread, each with its own scratch, and their
+// contacts joined in vertex order.
 
 #include "core/hash/box_grid.hpp"
 #include "tethash/detect.hpp"
@@ -32,6 +33,8 @@ class Proximity {
     void setup(const TetMesh& mesh, const Positions& rest, const Model& model,
                const std::vector<ObjectOptions>& options, double margin_edges, bool speculative, double reach_edges);
     bool enabled() const { return !m_faces.empty(); }
+    /// Threads of the next updates (≥ 1); the contacts do not depend on it.
+    void set_threads(int threads) { m_threads = threads > 1 ? threads : 1; }
 
     /// At positions x (velocities v, substep h): appends to `out` one margin contact per (vertex, object) with the
     /// nearest far face within watch, depth δ − distance (negative: speculative), unless the vertex is already
@@ -58,6 +61,13 @@ class Proximity {
         double dist;
         Eigen::Vector3d q;
     };
+    /// One thread's scratch: the grid query's hits and per-face stamps, the nearest face per object of the vertex
+    /// being queried, the contacts of its range of vertices.
+    struct Scratch {
+        std::vector<std::int32_t> hits, stamp;
+        std::vector<Best> best;
+        std::vector<Contact> out;
+    };
     /// Mean velocities per object, each boundary vertex's reach, the object pairs' reach.
     void motion(const Positions& v, double h);
     /// Faces' boxes grown by their reach and the largest margin, into the grid.
@@ -73,12 +83,15 @@ class Proximity {
     };
     /// The faces in the cells of q's box: for each far face within watch on its outer side, the nearest per object
     /// into m_best; q.clearance the nearest far face's squared distance.
-    void query_cells(Query& q, const Positions& x);
-    void visit_face(Query& q, std::int32_t f, const Positions& x);
+    void query_cells(Query& q, Scratch& s, const Positions& x) const;
+    void visit_face(Query& q, Scratch& s, std::int32_t f, const Positions& x) const;
     /// The vertex's margin from its clearance, and its margin contacts (one per object of m_best that it is not
     /// inside already) appended to `out`.
-    void keep_contacts(const Query& q, const Positions& x, const std::vector<Contact>& inside,
+    void keep_contacts(const Query& q, Scratch& s, const Positions& x, const std::vector<Contact>& inside,
                        std::vector<Contact>& out);
+    /// The queries of boundary vertices [begin, end) of m_vertices, their contacts appended to `out`.
+    void query_range(size_t begin, size_t end, Scratch& s, const Positions& x, const std::vector<Contact>& inside,
+                     std::vector<Contact>& out);
     Contact margin_contact(const Positions& x, Index p, Index op, Index object, Index face, double dist,
                            const Eigen::Vector3d& q) const;
 
@@ -100,11 +113,10 @@ class Proximity {
     std::vector<double> m_object_mass;     ///< per object (scratch of motion)
     std::vector<double> m_pair_now;        ///< objects²: how far two objects may close on each other in h
     std::vector<double> m_object_reach;    ///< per object: its widest m_pair_now, for its vertices' query boxes
-    // Scratch kept between calls: the grid of the faces' boxes (detail::BoxGrid), per-face stamps.
-    tethash::detail::BoxGrid m_grid;  ///< faces' boxes grown by their reach and the largest margin
-    std::vector<std::int32_t> m_hits; ///< entries of one bucket whose box meets the query's
-    std::vector<std::int32_t> m_stamp;
-    std::vector<Best> m_best;
+    // Scratch kept between calls: the grid of the faces' boxes (detail::BoxGrid), one Scratch per thread.
+    tethash::detail::BoxGrid m_grid; ///< faces' boxes grown by their reach and the largest margin
+    std::vector<Scratch> m_scratch;
+    int m_threads = 1;
 };
 
 } // namespace tethash::sim
