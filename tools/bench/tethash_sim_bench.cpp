@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -230,7 +231,7 @@ struct SimBenchOptions {
     std::string meshes_dir = TETHASH_SHARED_MESHES, filter, csv;
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     std::vector<double> sizes{1.0}, youngs, bodies;
-    double seconds = 0.5;
+    double seconds = 0; ///< 0: automatic (run_seconds)
     int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
     double convergence = -1;
     bool no_coarse = false;
@@ -258,7 +259,9 @@ void add_options(CLI::App& app, SimBenchOptions& o)
                      "Young's moduli (Pa), comma-separated; each scene runs at each (default: the scenes' 1e5)")
         ->delimiter(',')
         ->check(CLI::PositiveNumber);
-    runs->add_option("--seconds", o.seconds, "simulated time per run")->capture_default_str();
+    runs->add_option("--seconds", o.seconds,
+                     "simulated time per run (default: 0.5 s, or 2.5 times the fall for a drop whose fall takes more "
+                     "than 0.25 s, so that large bodies land and settle: 1.1 s at 5 m, 1.6 s at 10 m)");
     runs->add_option("--threads", o.threads,
                      "detector and solver threads; 0: every core, fewer in the steps where they do not pay (chosen "
                      "as the run goes, as `tethash simulate` does)")
@@ -305,7 +308,9 @@ void print_header(SimBenchOptions& o)
     std::printf("tethash_sim_bench: %s, flags '%s', %u hardware threads, %d thread(s), load %.2f %.2f %.2f\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), o.threads, load[0],
                 load[1], load[2]);
-    std::printf("%s s simulated per run; ms are medians over the steps\n", fmt::format("{}", o.seconds).c_str());
+    std::printf("%s simulated per run; ms are medians over the steps\n",
+                o.seconds > 0 ? fmt::format("{} s", o.seconds).c_str()
+                              : "0.5 s (2.5 times the fall where it takes more than 0.25 s)");
 #ifdef TETHASH_HAVE_BULLET
     std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
                 bench::bullet_version() / 100, bench::bullet_version() % 100, o.peer_iterations,
@@ -317,6 +322,21 @@ void print_header(SimBenchOptions& o)
 }
 
 /// The scenes: each shared mesh dropped at each size and modulus, and the two armadillos thrown at each other.
+/// Simulated time of a run: --seconds, or 0.5 s, or for a drop whose fall to the ground takes longer than 0.25 s
+/// (bodies above about 1.5 m) 2.5 times the fall, so that it lands and settles (a 10 m body falls 2 m, 0.64 s).
+double run_seconds(const SimBenchOptions& o, const sim::Scene& scene)
+{
+    if (o.seconds > 0) return o.seconds;
+    double low = INFINITY;
+    for (const sim::ObjectSpec& obj : scene.objects)
+        if (obj.data && obj.data->num_vertices() > 0)
+            low = std::min(low, obj.translate.z() + obj.scale.z() * obj.data->positions.col(2).minCoeff());
+    const double g = scene.gravity.norm();
+    if (!std::isfinite(low) || !(low > 0) || !(g > 0)) return 0.5;
+    const double fall = std::sqrt(2 * low / g);
+    return fall > 0.25 ? 2.5 * fall : 0.5;
+}
+
 /// --bodies: a sphere of about `tets` tets (the lattice's 6.5 tets per cell cubed), 1 m, dropped 0.2 m.
 std::pair<std::string, sim::Scene> body_scene(double tets)
 {
@@ -481,7 +501,8 @@ int main(int argc, char** argv)
         std::vector<sim::Integrator> integ;
         for (const std::string& i : o.integrators)
             integ.push_back(sim::parse_integrator(i));
-        if (!(o.seconds > 0)) throw Error("--seconds must be positive");
+        if (!(o.seconds >= 0) || !std::isfinite(o.seconds))
+            throw Error("--seconds must be positive (or 0: automatic), found " + fmt::format("{}", o.seconds));
         if (o.threads < 0 || o.threads > 256) throw Error("--threads must be in 0..256 (0: chosen step by step)");
         if (o.bodies.empty() && !std::filesystem::is_directory(o.meshes_dir)) {
             std::printf("shared meshes not found at %s: nothing to run\n", o.meshes_dir.c_str());
@@ -506,7 +527,7 @@ int main(int argc, char** argv)
                     for (int threads : thread_counts) {
                         apply_overrides(scene, o, i, dt);
                         scene.detect.threads = threads;
-                        const int steps = std::max(1, static_cast<int>(std::lround(o.seconds / dt)));
+                        const int steps = std::max(1, static_cast<int>(std::lround(run_seconds(o, scene) / dt)));
                         const Row r = run(name, scene, steps);
                         print(r);
                         rows.push_back(r);
@@ -515,8 +536,9 @@ int main(int argc, char** argv)
             if (!o.no_peer && o.bodies.empty())
                 for (double dt : steps_dt) {
                     scene.dt = dt;
-                    const Row r = run_peer(name, scene, std::max(1, static_cast<int>(std::lround(o.seconds / dt))),
-                                           o.peer_iterations);
+                    const Row r =
+                        run_peer(name, scene, std::max(1, static_cast<int>(std::lround(run_seconds(o, scene) / dt))),
+                                 o.peer_iterations);
                     print(r);
                     rows.push_back(r);
                 }
