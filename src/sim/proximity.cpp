@@ -208,9 +208,6 @@ void Proximity::hash_faces(const Positions& x)
         m_grid.add(lo, hi);
     }
     m_grid.finish();
-    m_scratch.resize(static_cast<size_t>(m_threads));
-    for (Scratch& sc : m_scratch)
-        sc.stamp.assign(nf, -1);
 }
 
 // Inlined into query_cells' loop: the query's fields stay in registers, as in one function.
@@ -331,6 +328,10 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
     hash_faces(x);
     const size_t nv = m_vertices.size();
     const int threads = nv >= 1024 ? m_threads : 1;
+    // A scratch per thread of this update, its face stamps cleared (the tags, vertex ids, repeat between updates).
+    m_scratch.resize(static_cast<size_t>(threads));
+    for (Scratch& sc : m_scratch)
+        sc.stamp.assign(m_faces.size(), -1);
     if (threads == 1) {
         query_range(0, nv, m_scratch[0], x, inside, out);
     } else {

@@ -126,8 +126,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
             prox.push_back(st.ms_proximity);
             resp.push_back(st.ms_response);
             integ.push_back(st.ms_integrate);
-            other.push_back(st.ms_step - st.ms_detect - st.ms_depth - st.ms_proximity - st.ms_response -
-                            st.ms_integrate);
+            other.push_back(st.ms_checks());
             threads.push_back(st.threads);
             sw.push_back(st.solver_iterations);
             con.push_back(static_cast<double>(st.contacts));

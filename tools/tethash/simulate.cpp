@@ -370,8 +370,7 @@ struct RunTotals {
     {
         ++steps;
         if (st.threads == 1) ++one_thread_steps;
-        ms_checks +=
-            std::max(0.0, st.ms_step - st.ms_detect - st.ms_depth - st.ms_proximity - st.ms_response - st.ms_integrate);
+        ms_checks += st.ms_checks();
         ms_detect += st.ms_detect;
         ms_depth += st.ms_depth;
         ms_proximity += st.ms_proximity;

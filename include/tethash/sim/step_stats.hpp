@@ -14,8 +14,7 @@ struct StepStats {
     double ms_proximity = 0;        ///< margin and speculative contacts (near pairs of far surfaces)
     double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
     double ms_integrate = 0;        ///< forces, matrix assembly, solve, update
-    double ms_step = 0;             ///< the whole step; less the stages above: its checks (energy, inverted tets,
-                                    ///< blow-up) and the copies of steps taken again
+    double ms_step = 0;             ///< the whole step (the stages above and ms_checks())
     int threads = 1;                ///< threads the step ran on (threads = 0: chosen step by step)
     std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
     std::int64_t near_contacts = 0; ///< margin contacts at the last substep: vertices near a far surface
@@ -29,6 +28,13 @@ struct StepStats {
     int crossings = 0; ///< times the step was taken again in more substeps for a vertex that entered a far part unseen
                        ///< (Scene::crossing_check)
     int tightened = 0; ///< times the step was taken again with tighter tolerances for energy it gained
+
+    /// The step less its stages: its checks (energy, inverted tets, blow-up) and the copies of steps taken again.
+    double ms_checks() const
+    {
+        const double rest = ms_step - ms_detect - ms_depth - ms_proximity - ms_response - ms_integrate;
+        return rest > 0 ? rest : 0.0;
+    }
 };
 
 } // namespace tethash::sim
