@@ -31,7 +31,7 @@ void ThreadChoice::record(double ms_per_substep)
         m_probe_step = 0;
         m_since = 0;
         m_settle = true;
-        if (!(m_kept_ms > 0) || probe < margin * m_kept_ms) {
+        if (probe < margin * m_kept_ms) { // a probe starts only once the kept count has a time
             m_kept = m_now;
             m_kept_ms = probe;
             m_interval = min_interval;
