@@ -108,6 +108,14 @@ TEST(Surface, ReadErrorsNameTheFile)
     tethash::test::write_text(points, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
     EXPECT_THROW(io::read_surface(points.string()), Error);
     EXPECT_THROW(io::write_surface((dir / "x.xyz").string(), sphere_surface(4)), Error);
+    // An OFF header whose counts the file cannot hold (found by the fuzzer: assimp read "OFF5555555555" as 5.6e9
+    // vertices and asked for 15 GB) is refused before the import, naming the file and the count.
+    const auto huge = dir / "huge.off";
+    tethash::test::write_text(huge, "OFF5555555555\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n");
+    expect_error([&] { io::read_surface(huge.string()); }, {huge.string(), "5555555555 vertices"});
+    const auto faces = dir / "faces.off";
+    tethash::test::write_text(faces, "OFF\n# a comment\n4 900000000 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n");
+    expect_error([&] { io::read_surface(faces.string()); }, {faces.string(), "900000000 faces"});
 }
 
 TEST(Surface, ReadsHandWrittenObjWithQuads)

@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <unistd.h>
@@ -101,6 +103,42 @@ void collect(const std::string& path, const aiScene* scene, const aiNode* node, 
         collect(path, scene, node->mChildren[c], m, depth + 1, xyz, tri);
 }
 
+/// An OFF file's declared vertex and face counts against its size, before assimp sizes its arrays by them (its
+/// importer reads "OFF5555555555" as 5.6e9 vertices and asks for 15 GB): each vertex takes at least 5 bytes
+/// ("0 0 0"), each face 7 ("3 0 1 2").
+void check_off_counts(const std::string& path)
+{
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return; // assimp says why
+    char head[512] = {};
+    const std::size_t got = std::fread(head, 1, sizeof head - 1, f);
+    std::fclose(f);
+    const std::string text(head, got);
+    const std::size_t off = text.find("OFF");
+    if (off == std::string::npos) return;
+    const double size = static_cast<double>(std::filesystem::file_size(path));
+    const char* p = text.c_str() + off + 3;
+    const char* names[2] = {"vertices", "faces"};
+    const double least[2] = {5, 7};
+    for (int k = 0; k < 2; ++k) {
+        while (*p != 0 && (std::isspace(static_cast<unsigned char>(*p)) != 0 || *p == '#')) {
+            if (*p == '#') // a comment line
+                while (*p != 0 && *p != '\n')
+                    ++p;
+            else
+                ++p;
+        }
+        char* end = nullptr;
+        const double n = std::strtod(p, &end);
+        if (end == p) return; // not a count: assimp says why
+        if (n * least[k] > size)
+            throw Error(path + ": the OFF header declares " + std::to_string(static_cast<long long>(n)) + " " +
+                        names[k] + ", more than the file's " + std::to_string(static_cast<long long>(size)) +
+                        " bytes can hold");
+        p = end;
+    }
+}
+
 /// Every triangle of the scene with its node transform applied, as a soup (vertices per mesh).
 void import_with_assimp(const std::string& path, std::vector<double>& xyz, std::vector<Index>& tri)
 {
@@ -123,8 +161,10 @@ SurfaceMesh read_surface(const std::string& path)
     std::vector<Index> tri;
     if (extension_of(path) == ".ply")
         detail::read_ply(path, xyz, tri); // assimp 5.2's PLY importer crashes on broken files
-    else
+    else {
+        if (extension_of(path) == ".off") check_off_counts(path);
         import_with_assimp(path, xyz, tri);
+    }
     if (tri.empty()) throw Error(path + ": no triangles in the file");
     // Before the join: NaN compares unequal to itself, which stalled the loop below (and breaks the sort).
     for (std::size_t i = 0; i < xyz.size(); ++i)
