@@ -103,10 +103,11 @@ struct DetectParams {
     int threads = 0; ///< 0 = OpenMP default; 1 = serial
     /// Candidate reuse between calls (moving scenes, as the neighbour lists of molecular dynamics). With a skin
     /// s > 0 a full detection collects each tet's candidates with its box inflated by s and keeps them; a later
-    /// call whose moving vertices all moved less than s/2 per axis since that detection only re-runs the exact
-    /// inside tests on the kept candidates (same contacts, bit for bit). 0 = off (the default). Must be ≥ 0 and
+    /// call whose moving vertices all moved less than s/2 per axis since that detection, once their common
+    /// translation is taken off (static vertices count as not moving), only re-runs the exact inside tests on the
+    /// kept candidates (same contacts, bit for bit). 0 = off (the default). Must be ≥ 0 and
     /// finite. Costs 24 bytes per vertex plus 4 bytes per kept candidate (see docs/detection.md). When a kept list
-    /// was not reused even once (the scene moves faster than s/2 per call), full detections run without the skin
+    /// was not reused even once (the scene deforms faster than s/2 per call), full detections run without the skin
     /// until a call moved less than s/4 since the previous one (DetectStats::skin then reads 0).
     enum class SkinMode { absolute, factor_of_cell_size };
     SkinMode skin_mode = SkinMode::absolute;

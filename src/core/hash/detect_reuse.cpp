@@ -6,40 +6,57 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tethash {
 
-// Skin: true when every moving vertex moved less than `limit` per axis since the remembered positions (the last full
-// detection; reuse_limit < skin / 2 allows reuse). A non-finite coordinate counts as moved too far (the full detection
-// then reports it). Blocks of 1,024 values with an early exit; parallel over the team for big scenes only (a region
-// costs more than checking 20,000 vertices).
+// Skin: true when the moving vertices' displacements since the remembered positions (the last full detection) span
+// less than 2 × `limit` per axis, with 0 among them when the scene has static vertices (those never move). The
+// contacts do not change under a common translation, so what must stay below `limit` is each displacement minus the
+// centre of that span (reuse_limit < skin / 2 allows reuse: docs/detection.md, "why it is exact"); a body falling
+// or thrown as a whole keeps its candidates. A non-finite coordinate counts as moved too far (the full detection
+// then reports it). Blocks of 1,024 vertices with an early exit; parallel over the team for big scenes only (a
+// region costs more than checking 20,000 vertices).
 bool DetectorImpl::moved_less_than(const double* P, int T, double limit) const
 {
-    const double h = limit;
+    const double span = 2.0 * limit;
     const double* R = reference.data();
     const std::int64_t n = static_cast<std::int64_t>(dynamic_ids.size());
     const Index* ids = dynamic_ids.data();
     constexpr std::int64_t block = 1024;
     const std::int64_t blocks = (n + block - 1) / block;
+    // Static vertices put 0 among the displacements; otherwise the span starts empty.
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const double start_lo = any_static ? 0.0 : inf, start_hi = any_static ? 0.0 : -inf;
+    double lo0 = start_lo, lo1 = start_lo, lo2 = start_lo, hi0 = start_hi, hi1 = start_hi, hi2 = start_hi;
     int far = 0;
-#pragma omp parallel for schedule(static) reduction(| : far) num_threads(T) if (T > 1 && n >= 65536)
+#pragma omp parallel for schedule(static) reduction(|                                                                  \
+                                                    : far) reduction(min                                               \
+                                                                     : lo0, lo1, lo2) reduction(max                    \
+                                                                                                : hi0, hi1, hi2)       \
+    num_threads(T) if (T > 1 && n >= 65536)
     for (std::int64_t b = 0; b < blocks; ++b) {
         if (far) continue;
         const std::int64_t i0 = b * block, i1 = std::min(n, i0 + block);
+        double lo[3] = {lo0, lo1, lo2}, hi[3] = {hi0, hi1, hi2};
         int bad = 0;
-        if (!any_static) { // all vertices move: one contiguous pass over both arrays
-            for (std::int64_t i = 3 * i0; i < 3 * i1; ++i)
-                bad |= !(std::fabs(P[i] - R[i]) < h);
-        } else {
-            for (std::int64_t i = i0; i < i1; ++i) {
-                const double* p = P + 3 * static_cast<std::size_t>(ids[i]);
-                const double* r = R + 3 * i;
-                bad |= !(std::fabs(p[0] - r[0]) < h) | !(std::fabs(p[1] - r[1]) < h) | !(std::fabs(p[2] - r[2]) < h);
+        for (std::int64_t i = i0; i < i1; ++i) {
+            const double* p = P + 3 * static_cast<std::size_t>(any_static ? ids[i] : static_cast<Index>(i));
+            const double* r = R + 3 * i;
+            for (int k = 0; k < 3; ++k) {
+                const double d = p[k] - r[k];
+                bad |= !(std::fabs(d) < inf); // NaN or infinite
+                lo[k] = std::min(lo[k], d);
+                hi[k] = std::max(hi[k], d);
             }
         }
+        // This thread's span so far is part of the whole: when it is already too wide, so is the whole.
+        for (int k = 0; k < 3; ++k)
+            bad |= !(hi[k] - lo[k] < span);
+        lo0 = lo[0], lo1 = lo[1], lo2 = lo[2], hi0 = hi[0], hi1 = hi[1], hi2 = hi[2];
         far |= bad;
     }
-    return !far;
+    return !far && hi0 - lo0 < span && hi1 - lo1 < span && hi2 - lo2 < span;
 }
 
 // Skin: after a full detection, remembers the moving vertices' positions and where each chunk's candidate runs are
