@@ -1,6 +1,10 @@
 // The grid of boxes (src/core/hash/box_grid.hpp): its box filter kernels agree with the direct test and follow
 // TETHASH_SIMD; a query meets every box whose box meets its own, once, on random boxes of every size (one cell to
 // many, cells shared in buckets), as the direct test over all boxes does.
+// The team build splits work by the OpenMP team (src/core/team.hpp): this file sees the team as the library does.
+#if defined(_OPENMP) && !defined(TETHASH_HAVE_OPENMP)
+#define TETHASH_HAVE_OPENMP 1
+#endif
 #include "../src/core/hash/box_grid.hpp"
 #include "support.hpp"
 
@@ -127,4 +131,65 @@ TEST(CoreBoxGrid, QueryMeetsEachMeetingBoxOnce)
         }
     }
     EXPECT_GT(met, 200);
+}
+
+TEST(CoreBoxGrid, TeamBuildIsTheGridOfOneThread)
+{
+    // The grid built by teams of 1, 2 and 3 threads (each its part of the boxes, counts, cursors, scatter) visits
+    // every query's boxes in the same order as the grid of begin/add/finish: the same buckets holding the same
+    // boxes in the same order. Also with fewer boxes than threads, and none.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> where(-3.0, 3.0), size(0.0, 1.5);
+    for (const std::size_t count : {std::size_t{500}, std::size_t{2}, std::size_t{0}}) {
+        std::vector<std::array<double, 6>> boxes(count);
+        for (auto& b : boxes)
+            for (int k = 0; k < 3; ++k) {
+                b[static_cast<size_t>(k)] = where(rng);
+                b[static_cast<size_t>(3 + k)] = b[static_cast<size_t>(k)] + (rng() % 4 == 0 ? 0.0 : size(rng));
+            }
+        detail::BoxGrid serial;
+        serial.begin(0.5, 128, boxes.size());
+        for (const auto& b : boxes)
+            serial.add(b.data(), b.data() + 3);
+        serial.finish();
+        const auto box_of = [&](std::int32_t i, double lo[3], double hi[3]) {
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = boxes[static_cast<size_t>(i)][static_cast<size_t>(k)];
+                hi[k] = boxes[static_cast<size_t>(i)][static_cast<size_t>(3 + k)];
+            }
+        };
+        for (const int threads : {1, 2, 3}) {
+            detail::BoxGrid team;
+            for (int round = 0; round < 2; ++round) { // a second build reuses the parts' buffers
+                int team_size = 1;
+#pragma omp parallel num_threads(threads)
+                {
+                    team.build_team(0.5, 128, boxes.size(), box_of);
+#pragma omp single
+                    team_size = detail::team_size();
+                }
+#ifdef _OPENMP
+                EXPECT_EQ(team_size, threads);
+#endif
+                std::vector<std::int32_t> stamp_a(boxes.size() + 1, -1), stamp_b(boxes.size() + 1, -1), hits;
+                int visits = 0;
+                for (std::int32_t query = 0; query < 200; ++query) {
+                    double lo[3], hi[3];
+                    for (int k = 0; k < 3; ++k) {
+                        lo[k] = where(rng);
+                        hi[k] = lo[k] + size(rng);
+                    }
+                    std::vector<std::int32_t> a, b;
+                    serial.query(lo, hi, stamp_a.data(), query, hits, false, [&](std::int32_t i) { a.push_back(i); });
+                    team.query(lo, hi, stamp_b.data(), query, hits, false, [&](std::int32_t i) { b.push_back(i); });
+                    EXPECT_EQ(a, b) << count << " boxes, " << threads << " threads, round " << round << ", query "
+                                    << query;
+                    visits += static_cast<int>(a.size());
+                }
+                if (count > 100) {
+                    EXPECT_GT(visits, 500);
+                }
+            }
+        }
+    }
 }

@@ -197,17 +197,14 @@ void Proximity::hash_faces(const Positions& x)
     size_t buckets = 1;
     while (buckets < 2 * nf)
         buckets <<= 1;
-    m_grid.begin(cell_edges * m_edge, buckets, nf);
-    for (const Face& fc : m_faces) {
+    m_grid.build_team(cell_edges * m_edge, buckets, nf, [&](std::int32_t i, double lo[3], double hi[3]) {
+        const Face& fc = m_faces[static_cast<size_t>(i)];
         const double grow = face_reach(m_reach, fc) + m_margin_max;
-        double lo[3], hi[3];
         for (int k = 0; k < 3; ++k) {
             lo[k] = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
             hi[k] = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
         }
-        m_grid.add(lo, hi);
-    }
-    m_grid.finish();
+    });
 }
 
 // Inlined into query_cells' loop: the query's fields stay in registers, as in one function.
@@ -325,7 +322,6 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
 {
     if (m_faces.empty()) return;
     motion(v, h);
-    hash_faces(x);
     const size_t nv = m_vertices.size();
     const int threads = nv >= 1024 ? m_threads : 1;
     // A scratch per thread of this update, its face stamps cleared (the tags, vertex ids, repeat between updates).
@@ -333,16 +329,19 @@ void Proximity::update(const Positions& x, const Positions& v, double h, const s
     for (Scratch& sc : m_scratch)
         sc.stamp.assign(m_faces.size(), -1);
     if (threads == 1) {
+        hash_faces(x);
         query_range(0, nv, m_scratch[0], x, inside, out);
     } else {
-        // Each thread its contiguous range of vertices and its own contacts, joined in thread order: the contacts
-        // of one thread, in vertex order. (Each vertex writes only its own margin.)
+        // One region: the team builds the faces' grid (the same grid at any team size), then each thread queries
+        // its contiguous range of vertices into its own contacts, joined in thread order: the contacts of one
+        // thread, in vertex order. (Each vertex writes only its own margin.)
         for (Scratch& sc : m_scratch)
             sc.out.clear();
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel num_threads(threads)
 #endif
         {
+            hash_faces(x);
             const int t = tethash::detail::team_rank(), parts = tethash::detail::team_size();
             std::int64_t begin = 0, end = 0;
             tethash::detail::team_split(static_cast<std::int64_t>(nv), t, parts, begin, end);

@@ -2,6 +2,7 @@
 
 #include "../simd.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -90,6 +91,19 @@ void BoxGrid::begin(double cell, std::size_t buckets, std::size_t boxes)
     m_start.assign(buckets + 1, 0);
 }
 
+void BoxGrid::lay_out(std::size_t entries)
+{
+    for (int k = 0; k < 3; ++k) {
+        m_column[k].resize(entries + 8);
+        m_column[3 + k].resize(entries + 8);
+        std::fill(m_column[k].begin() + static_cast<std::ptrdiff_t>(entries), m_column[k].end(),
+                  std::numeric_limits<float>::infinity());
+        std::fill(m_column[3 + k].begin() + static_cast<std::ptrdiff_t>(entries), m_column[3 + k].end(),
+                  -std::numeric_limits<float>::infinity());
+    }
+    m_item.resize(entries);
+}
+
 void BoxGrid::finish()
 {
     for (const auto& e : m_entries)
@@ -97,22 +111,10 @@ void BoxGrid::finish()
     const std::size_t buckets = m_start.size() - 1;
     for (std::size_t b = 0; b < buckets; ++b)
         m_start[b + 1] += m_start[b];
-    const std::size_t ne = m_entries.size();
-    for (int k = 0; k < 3; ++k) {
-        m_column[k].assign(ne + 8, std::numeric_limits<float>::infinity());
-        m_column[3 + k].assign(ne + 8, -std::numeric_limits<float>::infinity());
-    }
-    m_item.resize(ne);
+    lay_out(m_entries.size());
     m_cursor.assign(m_start.begin(), m_start.end() - 1);
-    for (const auto& [b, i] : m_entries) {
-        const auto at = static_cast<std::size_t>(m_cursor[b]++);
-        const Box& box = m_box[static_cast<std::size_t>(i)];
-        for (int k = 0; k < 3; ++k) {
-            m_column[k][at] = box.lo[k];
-            m_column[3 + k][at] = box.hi[k];
-        }
-        m_item[at] = i;
-    }
+    for (const auto& [b, i] : m_entries)
+        place(static_cast<std::size_t>(m_cursor[b]++), i);
 }
 
 } // namespace tethash::detail

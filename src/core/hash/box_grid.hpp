@@ -11,6 +11,7 @@
 /// The float test is a filter: it keeps every box whose double box meets the query's, and the caller's own test
 /// decides.
 
+#include "../team.hpp"
 #include "hash_grid.hpp"
 
 #include <cmath>
@@ -57,21 +58,72 @@ class BoxGrid {
     void add(const double lo[3], const double hi[3])
     {
         const auto i = static_cast<std::int32_t>(m_box.size());
-        Box& box = m_box.emplace_back();
-        std::int64_t c0[3], c1[3];
-        for (int k = 0; k < 3; ++k) {
-            box.lo[k] = round_down(lo[k]);
-            box.hi[k] = round_up(hi[k]);
-            c0[k] = cell_of(lo[k], m_inv);
-            c1[k] = cell_of(hi[k], m_inv);
-        }
-        for (std::int64_t cx = c0[0]; cx <= c1[0]; ++cx)
-            for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy)
-                for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz)
-                    m_entries.emplace_back(bucket(cx, cy, cz), i);
+        m_box.emplace_back();
+        enter(i, lo, hi, m_entries);
     }
     /// Counting-sorts the entries by bucket and lays out the buckets' boxes: the grid is ready for queries.
     void finish();
+
+    /// The same grid as begin(cell, buckets, count), add() of boxes 0, 1, ..., count − 1 in order and finish(),
+    /// built by the current team (every thread of an OpenMP region calls it with the same arguments; outside a
+    /// region, one thread builds it all). box_of(i, lo, hi) writes box i's corners, once per box, from the thread
+    /// whose contiguous part of [0, count) holds i. Each part's entries are counted per bucket, the counts turned
+    /// into each part's cursors (buckets split over the team), and each part scatters its own entries: a bucket
+    /// holds its boxes in box order whatever the team's size. The grid is complete for every thread on return.
+    template <class BoxOf> void build_team(double cell, std::size_t buckets, std::size_t count, BoxOf&& box_of)
+    {
+        const int rank = team_rank(), parts = team_size();
+        if (rank == 0) {
+            m_inv = 1.0 / cell;
+            m_mask = static_cast<std::uint32_t>(buckets - 1);
+            m_box.resize(count);
+            m_part.resize(static_cast<std::size_t>(parts));
+            m_start.resize(buckets + 1);
+        }
+        team_barrier();
+        Part& mine = m_part[static_cast<std::size_t>(rank)];
+        mine.entries.clear();
+        mine.count.assign(buckets, 0);
+        std::int64_t first = 0, last = 0;
+        team_split(static_cast<std::int64_t>(count), rank, parts, first, last);
+        for (auto i = static_cast<std::int32_t>(first); i < static_cast<std::int32_t>(last); ++i) {
+            double lo[3], hi[3];
+            box_of(i, lo, hi);
+            enter(i, lo, hi, mine.entries);
+        }
+        for (const auto& e : mine.entries)
+            ++mine.count[e.first];
+        team_barrier();
+        // This thread's buckets: their sizes summed over the parts; then, from the sums of the buckets before them,
+        // where each part's entries of each bucket go.
+        std::int64_t b0 = 0, b1 = 0;
+        team_split(static_cast<std::int64_t>(buckets), rank, parts, b0, b1);
+        std::int32_t sum = 0;
+        for (auto b = static_cast<std::size_t>(b0); b < static_cast<std::size_t>(b1); ++b)
+            for (const Part& part : m_part)
+                sum += part.count[b];
+        mine.bucket_sum = sum;
+        team_barrier();
+        std::int32_t at = 0;
+        for (int r = 0; r < rank; ++r)
+            at += m_part[static_cast<std::size_t>(r)].bucket_sum;
+        for (auto b = static_cast<std::size_t>(b0); b < static_cast<std::size_t>(b1); ++b) {
+            m_start[b] = at;
+            for (Part& part : m_part) {
+                const std::int32_t n = part.count[b];
+                part.count[b] = at;
+                at += n;
+            }
+        }
+        if (rank == parts - 1) {
+            m_start[buckets] = at;
+            lay_out(static_cast<std::size_t>(at));
+        }
+        team_barrier();
+        for (const auto& [b, i] : mine.entries)
+            place(static_cast<std::size_t>(mine.count[b]++), i);
+        team_barrier();
+    }
 
     /// Calls visit(i) once for every box i whose box meets lo..hi (in single precision: a filter), bucket by bucket
     /// over the cells of lo..hi: stamp[i] = tag marks the boxes met (`stamp`: one per box, none equal to `tag` before
@@ -124,11 +176,47 @@ class BoxGrid {
     struct Box {
         float lo[3], hi[3];
     };
+    using Entries = std::vector<std::pair<std::uint32_t, std::int32_t>>;
+    /// Box i (its slot in m_box exists) rounded outwards into m_box, and an entry (bucket, i) per cell it meets.
+    void enter(std::int32_t i, const double lo[3], const double hi[3], Entries& entries)
+    {
+        Box& box = m_box[static_cast<std::size_t>(i)];
+        std::int64_t c0[3], c1[3];
+        for (int k = 0; k < 3; ++k) {
+            box.lo[k] = round_down(lo[k]);
+            box.hi[k] = round_up(hi[k]);
+            c0[k] = cell_of(lo[k], m_inv);
+            c1[k] = cell_of(hi[k], m_inv);
+        }
+        for (std::int64_t cx = c0[0]; cx <= c1[0]; ++cx)
+            for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy)
+                for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz)
+                    entries.emplace_back(bucket(cx, cy, cz), i);
+    }
+    /// Sizes the columns and items for `entries` entries, the eight padding entries set (meeting no box).
+    void lay_out(std::size_t entries);
+    /// Entry `at` (in bucket order) is box i.
+    void place(std::size_t at, std::int32_t i)
+    {
+        const Box& box = m_box[static_cast<std::size_t>(i)];
+        for (int k = 0; k < 3; ++k) {
+            m_column[k][at] = box.lo[k];
+            m_column[3 + k][at] = box.hi[k];
+        }
+        m_item[at] = i;
+    }
+    /// One thread's part of a team build: its entries, then its count per bucket, then its cursor per bucket.
+    struct Part {
+        Entries entries;
+        std::vector<std::int32_t> count;
+        std::int32_t bucket_sum = 0;
+    };
+    std::vector<Part> m_part;
     double m_inv = 1;
     std::uint32_t m_mask = 0;
-    std::vector<Box> m_box;                                        ///< per box, rounded outwards
-    std::vector<std::pair<std::uint32_t, std::int32_t>> m_entries; ///< (bucket, box) in the order entered
-    std::vector<std::int32_t> m_start;                             ///< per bucket + 1: its entries' range
+    std::vector<Box> m_box;            ///< per box, rounded outwards
+    Entries m_entries;                 ///< (bucket, box) in the order entered
+    std::vector<std::int32_t> m_start; ///< per bucket + 1: its entries' range
     /// Per entry, in bucket order, column by column (lo x, y, z, hi x, y, z), padded by eight entries that no box
     /// meets.
     std::vector<float> m_column[6];
