@@ -63,6 +63,12 @@ namespace {
     return ::testing::AssertionSuccess();
 }
 
+DetectParams with_threads(DetectParams p, int threads)
+{
+    p.threads = threads;
+    return p;
+}
+
 void set_topology(Detector& d, const Scene& s)
 {
     d.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
@@ -282,11 +288,9 @@ TEST(CoreReuse, ACommonTranslationKeepsTheCandidates)
         DetectParams p;
         p.skin = skin;
         p.threads = 1;
-        DetectParams p2 = p;
-        p2.threads = 2;
-        Detector det(p), det2(p2);
-        set_topology(det, s);
-        set_topology(det2, s);
+        Detector det(p), det2(with_threads(p, 2));
+        for (Detector* d : {&det, &det2})
+            set_topology(*d, s);
         std::mt19937 rng(5);
         std::uniform_real_distribution<double> u(-1.0, 1.0);
         int reused = 0, contacts = 0;
@@ -327,9 +331,7 @@ TEST(CoreReuse, FastMotionPausesTheSkinAndSlowMotionResumesIt)
     DetectParams p;
     p.skin = skin;
     p.threads = 1;
-    DetectParams p2 = p;
-    p2.threads = 2;
-    Detector det(p), det2(p2);
+    Detector det(p), det2(with_threads(p, 2));
     set_topology(det, s);
     set_topology(det2, s);
     // Calls 0-5 move object 1 by 1.2 skin per call along x (object 0 stays: relative to each other they moved more
