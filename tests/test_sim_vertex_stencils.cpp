@@ -48,17 +48,19 @@ struct Stencils {
             for (int e = 0; e < 3; ++e) {
                 SpringLanes& s = springs[static_cast<std::size_t>(e)];
                 s.other[l] = own;
-                s.k[l] = s.rest[l] = s.length_t[l] = 0;
+                s.rest[l] = 0;
+                s.k[l] = s.stretch_t[l] = 0;
                 if (l >= lanes || e >= 3 - l / 2) continue;
                 s.other[l] = 4 + 3 * l + e;
                 s.k[l] = 10.0 * (1 + e + l);
                 s.rest[l] = 0.3 * length(own, s.other[l]);
-                s.length_t[l] = s.rest[l];
+                s.stretch_t[l] = 0; // damping relative to the rest length
             }
             for (int e = 0; e < 4; ++e) {
                 TetLanes& t = tets[static_cast<std::size_t>(e)];
                 t.a[l] = t.b[l] = t.c[l] = own;
-                t.k36[l] = t.w0[l] = t.wt[l] = 0;
+                t.w0[l] = 0;
+                t.k36[l] = t.excess_t[l] = 0;
                 t.guard[l] = 0;
                 if (l >= lanes || e >= 4 - l) continue;
                 t.guard[l] = 0.02F * static_cast<float>(e + 1);
@@ -67,7 +69,7 @@ struct Stencils {
                 t.c[l] = 4 + (l + 2 * e + 9) % 12;
                 t.k36[l] = 3.0 + e;
                 t.w0[l] = 0.1 * (e + 1);
-                t.wt[l] = t.w0[l];
+                t.excess_t[l] = 0; // damping relative to the rest volume
             }
         }
     }
@@ -215,11 +217,11 @@ TEST(SimVertexStencils, RunTimeKernelAgreesWithTheOneLaneVersionWithDamping)
         for (SpringLanes& sp : s.springs)
             for (int l = 0; l < 4; ++l) {
                 sp.rest[l] *= 5;
-                sp.length_t[l] = 0.9 * sp.rest[l];
+                sp.stretch_t[l] = static_cast<float>(-0.1 * sp.rest[l]);
             }
         for (TetLanes& t : s.tets)
             for (int l = 0; l < 4; ++l)
-                t.wt[l] = 2 * t.w0[l];
+                t.excess_t[l] = static_cast<float>(t.w0[l]);
         const LaneTerms a = s.gather(fast), b = s.gather(slow);
         for (int l = 0; l < 4; ++l) {
             for (int r = 0; r < 3; ++r)
@@ -291,8 +293,10 @@ TEST(SimVertexStencils, StartOfSubstepLengthsAndVolumesMatchTheOneLaneVersion)
     choose_start(slow)(s.g, sb.data(), tb.data(), x4.data()->c);
     for (std::size_t e = 0; e < sa.size(); ++e)
         for (int l = 0; l < 4; ++l) {
-            EXPECT_NEAR(sa[e].length_t[l], s.length(s.g.vertex[l], sa[e].other[l]), 1e-14);
-            EXPECT_NEAR(sb[e].length_t[l], s.length(s.g.vertex[l], sb[e].other[l]), 1e-14);
+            // Kept in single precision: length − rest rounded to the nearest float, in both kernels.
+            const double stretch = s.length(s.g.vertex[l], sa[e].other[l]) - sa[e].rest[l];
+            EXPECT_NEAR(sa[e].stretch_t[l], stretch, 1e-14 + 0x1p-24 * std::fabs(stretch));
+            EXPECT_NEAR(sb[e].stretch_t[l], stretch, 1e-14 + 0x1p-24 * std::fabs(stretch));
         }
     for (std::size_t e = 0; e < ta.size(); ++e)
         for (int l = 0; l < 4; ++l) {
@@ -308,8 +312,11 @@ TEST(SimVertexStencils, StartOfSubstepLengthsAndVolumesMatchTheOneLaneVersion)
             const double w = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
                              m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
                              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-            EXPECT_NEAR(ta[e].wt[l], w, 1e-13) << "entry " << e << " lane " << l;
-            EXPECT_NEAR(tb[e].wt[l], w, 1e-13) << "entry " << e << " lane " << l;
+            const double excess = w - ta[e].w0[l];
+            EXPECT_NEAR(ta[e].excess_t[l], excess, 1e-13 + 0x1p-24 * std::fabs(excess))
+                << "entry " << e << " lane " << l;
+            EXPECT_NEAR(tb[e].excess_t[l], excess, 1e-13 + 0x1p-24 * std::fabs(excess))
+                << "entry " << e << " lane " << l;
         }
 }
 
@@ -328,8 +335,12 @@ TEST(SimVertexStencils, InversionGuardLowersNoTetBelowItsFloor)
             const LaneTerms t = s.gather(fn);
             // The gather without the guard (the default path) gives the same terms and no reach.
             const LaneTerms plain = s.gather(scalar ? scalar_gather() : choose_gather());
-            EXPECT_EQ(std::memcmp(plain.f, t.f, sizeof(t.f)), 0) << gather_kernel_name(fn) << " seed " << seed;
-            EXPECT_EQ(std::memcmp(plain.H, t.H, sizeof(t.H)), 0) << gather_kernel_name(fn) << " seed " << seed;
+            for (int l = 0; l < 4; ++l) {
+                for (int r = 0; r < 3; ++r)
+                    EXPECT_EQ(plain.f[r][l], t.f[r][l]) << gather_kernel_name(fn) << " seed " << seed;
+                for (int r = 0; r < 6; ++r)
+                    EXPECT_EQ(plain.H[r][l], t.H[r][l]) << gather_kernel_name(fn) << " seed " << seed;
+            }
             for (int l = 0; l < 4; ++l) {
                 EXPECT_TRUE(std::isinf(plain.reach2[l])) << gather_kernel_name(fn) << " seed " << seed;
                 double expect = std::numeric_limits<double>::infinity();

@@ -374,19 +374,21 @@ void BlockDescent::pack_lane(LaneGroup& g, int l, const detail::Incidences& spri
     for (std::int32_t e = 0; e < g.spring_end - g.spring_begin; ++e) {
         SpringLanes& sl = m_springs[static_cast<size_t>(g.spring_begin + e)];
         sl.other[l] = i;
-        sl.k[l] = sl.rest[l] = sl.length_t[l] = 0;
+        sl.rest[l] = 0;
+        sl.k[l] = sl.stretch_t[l] = 0;
         if (!real || e >= count_of(springs_at, i)) continue;
         const Index edge_id = springs_at.entries[static_cast<size_t>(springs_at.start[static_cast<size_t>(i)] + e)];
         const Index j =
             model.springs.edges(edge_id, 0) == i ? model.springs.edges(edge_id, 1) : model.springs.edges(edge_id, 0);
         sl.other[l] = static_cast<std::int32_t>(j);
-        sl.k[l] = model.springs.k[static_cast<size_t>(edge_id)];
+        sl.k[l] = static_cast<float>(model.springs.k[static_cast<size_t>(edge_id)]);
         sl.rest[l] = model.springs.rest[static_cast<size_t>(edge_id)];
     }
     for (std::int32_t e = 0; e < g.tet_end - g.tet_begin; ++e) {
         TetLanes& tl = m_tets[static_cast<size_t>(g.tet_begin + e)];
         tl.a[l] = tl.b[l] = tl.c[l] = i;
-        tl.k36[l] = tl.w0[l] = tl.wt[l] = 0;
+        tl.w0[l] = 0;
+        tl.k36[l] = tl.excess_t[l] = 0;
         tl.guard[l] = 0;
         if (!real || e >= count_of(tets_at, i)) continue;
         const std::int32_t entry = tets_at.entries[static_cast<size_t>(tets_at.start[static_cast<size_t>(i)] + e)];
@@ -396,8 +398,8 @@ void BlockDescent::pack_lane(LaneGroup& g, int l, const detail::Incidences& spri
         tl.a[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][0]));
         tl.b[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][1]));
         tl.c[l] = static_cast<std::int32_t>(model.volumes.tets(t, others[a][2]));
-        tl.k36[l] = model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0;
-        tl.w0[l] = tl.wt[l] = 6.0 * v0;
+        tl.k36[l] = static_cast<float>(model.volumes.k[static_cast<size_t>(t)] / v0 / 36.0);
+        tl.w0[l] = 6.0 * v0;
         tl.guard[l] = !m_ctx.scene.inversion_guard || model.volumes.sliver[static_cast<size_t>(t)]
                           ? 0.0F
                           : static_cast<float>(detail::guard_fraction * 6.0 * v0);

@@ -63,7 +63,8 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
             const double len = std::sqrt(len2), inv = 1.0 / len;
             const double ux = dx * inv, uy = dy * inv, uz = dz * inv;
             const double k = sp.k[l];
-            const double fs = k * ((len - sp.rest[l]) + dh[l] * (len - sp.length_t[l]));
+            const double stretch = len - sp.rest[l];
+            const double fs = k * (stretch + dh[l] * (stretch - static_cast<double>(sp.stretch_t[l])));
             f[0][l] -= fs * ux;
             f[1][l] -= fs * uy;
             f[2][l] -= fs * uz;
@@ -83,7 +84,8 @@ void gather_scalar(const LaneGroup& g, const SpringLanes* springs, const TetLane
             double n[3];
             const double w = volume_term(t, l, x, xi[l], yi[l], zi[l], n);
             const double nx = n[0], ny = n[1], nz = n[2];
-            const double fs = t.k36[l] * ((w - t.w0[l]) + dh[l] * (w - t.wt[l]));
+            const double excess = w - t.w0[l];
+            const double fs = t.k36[l] * (excess + dh[l] * (excess - static_cast<double>(t.excess_t[l])));
             f[0][l] += fs * nx;
             f[1][l] += fs * ny;
             f[2][l] += fs * nz;
@@ -133,7 +135,7 @@ void start_scalar(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, cons
             const double* xi = x + 4 * static_cast<std::size_t>(g.vertex[l]);
             const double* xj = x + 4 * static_cast<std::size_t>(sp.other[l]);
             const double dx = xi[0] - xj[0], dy = xi[1] - xj[1], dz = xi[2] - xj[2];
-            sp.length_t[l] = std::sqrt(dx * dx + dy * dy + dz * dz);
+            sp.stretch_t[l] = static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz) - sp.rest[l]);
         }
     }
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
@@ -141,7 +143,7 @@ void start_scalar(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, cons
         for (int l = 0; l < 4; ++l) {
             const double* xi = x + 4 * static_cast<std::size_t>(g.vertex[l]);
             double n[3];
-            t.wt[l] = volume_term(t, l, x, xi[0], xi[1], xi[2], n);
+            t.excess_t[l] = static_cast<float>(volume_term(t, l, x, xi[0], xi[1], xi[2], n) - t.w0[l]);
         }
     }
 }
@@ -231,11 +233,11 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         const __m256d live = _mm256_cmp_pd(len2, zero, _CMP_GT_OQ); // a zero-length spring (or padding) is skipped
         const __m256d len = _mm256_sqrt_pd(len2);
         const __m256d inv = _mm256_and_pd(live, _mm256_div_pd(one, len));
-        const __m256d k = _mm256_and_pd(live, _mm256_load_pd(sp.k));
+        const __m256d k = _mm256_and_pd(live, _mm256_cvtps_pd(_mm_load_ps(sp.k)));
         const __m256d rest = _mm256_load_pd(sp.rest);
         const __m256d ux = _mm256_mul_pd(dx, inv), uy = _mm256_mul_pd(dy, inv), uz = _mm256_mul_pd(dz, inv);
-        const __m256d stretch =
-            _mm256_fmadd_pd(dh, _mm256_sub_pd(len, _mm256_load_pd(sp.length_t)), _mm256_sub_pd(len, rest));
+        const __m256d s0 = _mm256_sub_pd(len, rest);
+        const __m256d stretch = _mm256_fmadd_pd(dh, _mm256_sub_pd(s0, _mm256_cvtps_pd(_mm_load_ps(sp.stretch_t))), s0);
         const __m256d fs = _mm256_and_pd(live, _mm256_mul_pd(k, stretch));
         fx = _mm256_fnmadd_pd(fs, ux, fx);
         fy = _mm256_fnmadd_pd(fs, uy, fy);
@@ -258,9 +260,9 @@ __attribute__((target("avx2,fma"))) void gather_avx2(const LaneGroup& g, const S
         const TetLanes& t = tets[s];
         __m256d nx, ny, nz;
         const __m256d w = face_normal_and_w(x, t, xi, yi, zi, nx, ny, nz);
-        const __m256d k36 = _mm256_load_pd(t.k36);
-        const __m256d excess =
-            _mm256_fmadd_pd(dh, _mm256_sub_pd(w, _mm256_load_pd(t.wt)), _mm256_sub_pd(w, _mm256_load_pd(t.w0)));
+        const __m256d k36 = _mm256_cvtps_pd(_mm_load_ps(t.k36));
+        const __m256d e0 = _mm256_sub_pd(w, _mm256_load_pd(t.w0));
+        const __m256d excess = _mm256_fmadd_pd(dh, _mm256_sub_pd(e0, _mm256_cvtps_pd(_mm_load_ps(t.excess_t))), e0);
         const __m256d fs = _mm256_mul_pd(k36, excess);
         fx = _mm256_fmadd_pd(fs, nx, fx);
         fy = _mm256_fmadd_pd(fs, ny, fy);
@@ -305,13 +307,14 @@ __attribute__((target("avx2,fma"))) void start_avx2(const LaneGroup& g, SpringLa
         __m256d ox, oy, oz;
         load3(x, sp.other, ox, oy, oz);
         const __m256d dx = _mm256_sub_pd(xi, ox), dy = _mm256_sub_pd(yi, oy), dz = _mm256_sub_pd(zi, oz);
-        _mm256_store_pd(sp.length_t,
-                        _mm256_sqrt_pd(_mm256_fmadd_pd(dx, dx, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dz, dz)))));
+        const __m256d len = _mm256_sqrt_pd(_mm256_fmadd_pd(dx, dx, _mm256_fmadd_pd(dy, dy, _mm256_mul_pd(dz, dz))));
+        _mm_store_ps(sp.stretch_t, _mm256_cvtpd_ps(_mm256_sub_pd(len, _mm256_load_pd(sp.rest))));
     }
     for (std::int32_t s = g.tet_begin; s < g.tet_end; ++s) {
         TetLanes& t = tets[s];
         __m256d nx, ny, nz;
-        _mm256_store_pd(t.wt, face_normal_and_w(x, t, xi, yi, zi, nx, ny, nz));
+        const __m256d w = face_normal_and_w(x, t, xi, yi, zi, nx, ny, nz);
+        _mm_store_ps(t.excess_t, _mm256_cvtpd_ps(_mm256_sub_pd(w, _mm256_load_pd(t.w0))));
     }
 }
 

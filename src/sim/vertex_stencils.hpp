@@ -13,20 +13,24 @@
 
 namespace tethash::sim::detail {
 
-/// A spring seen from its end in each of four lanes (k = 0 pads).
+/// A spring seen from its end in each of four lanes (k = 0 pads). The sweeps stream these entries from memory, so
+/// the stiffness (a scale) and the stretch at the start of the substep (a small difference, exactly 0 at rest) are
+/// kept in single precision; the rest length, which the stretch is measured from, in double. 64 bytes: one cache
+/// line.
 struct alignas(32) SpringLanes {
-    double k[4], rest[4];
-    double length_t[4];    ///< length at the start of the substep (relative damping)
+    double rest[4];
+    float k[4];
+    float stretch_t[4];    ///< length − rest at the start of the substep (relative damping)
     std::int32_t other[4]; ///< the other end's vertex id
-    std::int32_t unused[4];
 };
 
 /// A volume term seen from one corner i in each of four lanes, in terms of W = 6V = (x_a − x_i) · N,
 /// N = (x_b − x_a) × (x_c − x_a): energy ½ k36 (W − W0)², ∇_i W = −N (W is linear in x_i). k36 = 0 pads.
+/// Single precision for the stiffness and the start-of-substep excess, as for springs. 128 bytes.
 struct alignas(32) TetLanes {
-    double k36[4]; ///< k / (36 V0): the volume term's ½ (k/V0) (V − V0)² in W
-    double w0[4];  ///< 6 V0
-    double wt[4];  ///< 6 V at the start of the substep (relative damping)
+    double w0[4];      ///< 6 V0
+    float k36[4];      ///< k / (36 V0): the volume term's ½ (k/V0) (V − V0)² in W
+    float excess_t[4]; ///< W − W0 at the start of the substep (relative damping)
     std::int32_t a[4], b[4], c[4];
     float guard[4]; ///< the inversion guard's floor τ on W (guard_fraction · W0); 0: not guarded (padding)
 };
@@ -58,8 +62,8 @@ struct LaneTerms {
 using GatherFn = void (*)(const LaneGroup& g, const SpringLanes* springs, const TetLanes* tets, const double* x,
                           double inv_h, LaneTerms& out);
 
-/// Sets length_t and wt of a group's entries (every lane, padding included) from positions x: the lengths and
-/// volumes at the start of the substep, for the relative damping.
+/// Sets stretch_t and excess_t of a group's entries (every lane, padding included) from positions x: how far the
+/// lengths and volumes are from their rest values at the start of the substep, for the relative damping.
 using StartFn = void (*)(const LaneGroup& g, SpringLanes* springs, TetLanes* tets, const double* x);
 
 /// The fraction (0 … 1] of lane l's step d that the inversion guard allows: min(1, 0.9 t) with t the largest factor
