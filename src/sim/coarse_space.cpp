@@ -18,7 +18,7 @@ namespace {
 /// of two to three mean edges: a node couples with up to 125 others). Where ω h is a few tens a substep converges in
 /// about six sweeps and the factorisation is the larger cost: at 400 nodes the 15 cm hand (ω h 12.6 at 1/240) spent
 /// 5 ms a step factorising (395 nodes, 156k entries in the factor) where the 1 m hand (115 nodes) spent 0.6 ms; 200
-/// made the 15 cm steps 0.74-0.93 of their cost (hand, raptor, octocat, two armadillos). Where ω h is larger the
+/// made the 15 cm steps 0.62-0.93 of their cost (hand, raptor, octocat, two armadillos). Where ω h is larger the
 /// sweeps a substep needs grow and the finer lattice saves more than it costs: at 200 nodes the hand of young 1e9 at
 /// 15 cm and 1/60 (ω h 5,000) took 369 sweeps a step against 112, and octocat at 1/60 (ω h 62) 12 a step against
 /// 5 (docs/simulator.md, "A small body no dearer than a big one").
