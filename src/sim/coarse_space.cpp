@@ -12,8 +12,19 @@ namespace tethash::sim::detail {
 
 namespace {
 
-/// The most lattice nodes one object gets (each carries three unknowns of the factorised system).
+/// The most lattice nodes one object gets (each carries three unknowns of the factorised system): nodes_per_omega_h
+/// times its ω h, between min_nodes_cap and max_nodes_per_object. The lattice is factorised again at most substeps
+/// (the ground's and contacts' terms change), and its factorisation grows faster than the square of its nodes (cells
+/// of two to three mean edges: a node couples with up to 125 others). Where ω h is a few tens a substep converges in
+/// about six sweeps and the factorisation is the larger cost: at 400 nodes the 15 cm hand (ω h 12.6 at 1/240) spent
+/// 5 ms a step factorising (395 nodes, 156k entries in the factor) where the 1 m hand (115 nodes) spent 0.6 ms; 200
+/// made the 15 cm steps 0.62-0.93 of their cost (hand, raptor, octocat, two armadillos). Where ω h is larger the
+/// sweeps a substep needs grow and the finer lattice saves more than it costs: at 200 nodes the hand of young 1e9 at
+/// 15 cm and 1/60 (ω h 5,000) took 369 sweeps a step against 112, and octocat at 1/60 (ω h 62) 12 a step against
+/// 5 (docs/simulator.md, "A small body no dearer than a big one").
 constexpr size_t max_nodes_per_object = 400;
+constexpr size_t min_nodes_cap = 200;
+constexpr double nodes_per_omega_h = 8.0;
 
 /// The weight-to-bending number ρ g L³ / (E t²) above which a thin sheet's weight folds it (no lattice, below).
 constexpr double sheet_folds = 10.0;
@@ -81,10 +92,12 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
         const double cells_per_extent = 6.0 * std::max(1.0, omega_h / 4.0);
         const double extent = (hi - lo).maxCoeff();
         double cell = std::max(2.0 * model.object_mean_edge[o], extent / cells_per_extent);
-        // At most a quarter as many nodes as the object has vertices (125 for any object), and max_nodes_per_object:
-        // the factorisation grows about as the square of the nodes (hundreds of milliseconds a substep on a real
-        // mesh with cells of two mean edges; docs/simulator.md).
-        const size_t cap = std::min<size_t>(max_nodes_per_object, std::max<size_t>(125, vs.size() / 4));
+        // At most a quarter as many nodes as the object has vertices (125 for any object), and at most 8 ω h between
+        // 200 and 400 (above: the factorisation's cost against the sweeps it saves).
+        const size_t most =
+            static_cast<size_t>(std::clamp(nodes_per_omega_h * omega_h, static_cast<double>(min_nodes_cap),
+                                           static_cast<double>(max_nodes_per_object)));
+        const size_t cap = std::min<size_t>(most, std::max<size_t>(125, vs.size() / 4));
         Eigen::Array3i dims;
         std::vector<std::int32_t> id;
         for (;;) {

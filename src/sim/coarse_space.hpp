@@ -21,8 +21,8 @@
 // terms at the current iterate are added, vertex by vertex (their diagonal blocks). Pinned vertices hold their
 // lattice nodes by a stiff term. The lattice's cells are a sixth of the object's longest extent while ω h ≤ 4, finer
 // as ω h grows (the waves a substep couples reach further), and at least two
-// mean edges; an object gets at most a quarter as many nodes as it has vertices (125 for any) and at most 400, so that
-// the factorisation costs a few sweeps (and is kept across substeps, below).
+// mean edges; an object gets at most a quarter as many nodes as it has vertices (125 for any) and at most 8 ω h
+// between 200 and 400: the factorisation costs a few sweeps, and is worth more where ω h makes a substep need many.
 
 #include "tethash/sim/model.hpp"
 
