@@ -48,6 +48,8 @@
 #include "inversion_guard.hpp"
 #include "vertex_stencils.hpp"
 
+#include "core/team.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -187,6 +189,11 @@ class BlockDescent final : public StepIntegrator {
     // Fixed set-up, built once: the free vertices of each colour in groups of four lanes (vertex_stencils.hpp),
     // the groups' entries stored in sweep order, so that a sweep reads them front to back.
     std::vector<std::int32_t> m_colour_start; ///< groups of each colour
+    /// Prefix sums of the groups' gather costs (group_cost), to split a range of groups over a team in equal work.
+    std::vector<std::int64_t> m_cost_prefix;
+    /// Groups [begin, end) split over `parts` threads by cost: part `part`'s contiguous range.
+    std::pair<std::int32_t, std::int32_t> balanced_part(std::int32_t begin, std::int32_t end, int part,
+                                                        int parts) const;
     std::vector<LaneGroup> m_groups;
     std::vector<SpringLanes> m_springs;
     std::vector<TetLanes> m_tets;
@@ -354,6 +361,26 @@ void BlockDescent::pack_lanes(const std::vector<std::int32_t>& colour_start, con
         }
         m_colour_start.push_back(static_cast<std::int32_t>(m_groups.size()));
     }
+    // A group's gather cost: its entries (a tet entry about twice a spring's work) and its solve. Colours are sorted
+    // by their vertices' tet counts, most first, so equal counts of groups would be unequal work.
+    m_cost_prefix.assign(1, 0);
+    for (const LaneGroup& g : m_groups)
+        m_cost_prefix.push_back(m_cost_prefix.back() + 2 * (g.tet_end - g.tet_begin) + (g.spring_end - g.spring_begin) +
+                                4);
+}
+
+std::pair<std::int32_t, std::int32_t> BlockDescent::balanced_part(std::int32_t begin, std::int32_t end, int part,
+                                                                  int parts) const
+{
+    const std::int64_t* P = m_cost_prefix.data();
+    const std::int64_t total = P[end] - P[begin];
+    const auto cut = [&](int k) {
+        if (k <= 0) return begin;
+        if (k >= parts) return end;
+        const std::int64_t target = P[begin] + total * k / parts;
+        return static_cast<std::int32_t>(std::lower_bound(P + begin, P + end, target) - P);
+    };
+    return {cut(part), cut(part + 1)};
 }
 
 void BlockDescent::pack_lane(LaneGroup& g, int l, const detail::Incidences& springs_at,
@@ -412,10 +439,13 @@ void BlockDescent::start_substep(const double* x4)
     // entries only, so the groups split over the threads.
     const std::int32_t groups = static_cast<std::int32_t>(m_groups.size());
 #ifdef TETHASH_HAVE_OPENMP
-#pragma omp parallel for num_threads(m_threads) schedule(static) if (m_threads > 1 && groups > 64)
+#pragma omp parallel num_threads(m_threads) if (m_threads > 1 && groups > 64)
 #endif
-    for (std::int32_t g = 0; g < groups; ++g)
-        m_start(m_groups[static_cast<size_t>(g)], m_springs.data(), m_tets.data(), x4);
+    {
+        const auto [first, last] = balanced_part(0, groups, tethash::detail::team_rank(), tethash::detail::team_size());
+        for (std::int32_t g = first; g < last; ++g)
+            m_start(m_groups[static_cast<size_t>(g)], m_springs.data(), m_tets.data(), x4);
+    }
 }
 
 void BlockDescent::gather_contacts()
@@ -701,34 +731,37 @@ void BlockDescent::residual(const double* xp, double h, std::vector<double>& r, 
     // Every group's terms at x4, none moved: the residual and, if asked, the blocks the ground and the contacts add
     // to the vertex's Hessian (its total less the elastic part and the inertia).
 #ifdef TETHASH_HAVE_OPENMP
-#pragma omp parallel for num_threads(m_threads) schedule(static) if (m_threads > 1)
+#pragma omp parallel num_threads(m_threads) if (m_threads > 1)
 #endif
-    for (std::int32_t gi = 0; gi < groups; ++gi) {
-        const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
-        LaneTerms terms;
-        m_gather(grp, m_springs.data(), m_tets.data(), xp, 1.0 / h, terms);
-        double elastic[6][4];
-        for (int q = 0; q < 6; ++q)
-            for (int l = 0; l < 4; ++l)
-                elastic[q][l] = terms.H[q][l];
-        for (int l = 0; l < grp.lanes; ++l) {
-            add_lane_terms(grp, l, terms, xp, h);
-            const size_t u = static_cast<size_t>(grp.vertex[l]);
-            for (size_t q = 0; q < 3; ++q)
-                r[3 * u + q] = terms.f[q][l];
-            if (!extra) continue;
-            const double m_h2 = model.mass[u] * inv_h2;
-            // What the ground and the contacts added (0 where they add nothing: the sum less its parts leaves
-            // round-off, which would list every vertex).
-            bool any = false;
-            double e[6];
-            for (size_t q = 0; q < 6; ++q) {
-                const double base = elastic[q][l] + (q < 3 ? m_h2 : 0.0);
-                e[q] = terms.H[q][l] - base;
-                any = any || std::abs(e[q]) > 1e-9 * (std::abs(base) + m_h2);
+    {
+        const auto [first, last] = balanced_part(0, groups, tethash::detail::team_rank(), tethash::detail::team_size());
+        for (std::int32_t gi = first; gi < last; ++gi) {
+            const LaneGroup& grp = m_groups[static_cast<size_t>(gi)];
+            LaneTerms terms;
+            m_gather(grp, m_springs.data(), m_tets.data(), xp, 1.0 / h, terms);
+            double elastic[6][4];
+            for (int q = 0; q < 6; ++q)
+                for (int l = 0; l < 4; ++l)
+                    elastic[q][l] = terms.H[q][l];
+            for (int l = 0; l < grp.lanes; ++l) {
+                add_lane_terms(grp, l, terms, xp, h);
+                const size_t u = static_cast<size_t>(grp.vertex[l]);
+                for (size_t q = 0; q < 3; ++q)
+                    r[3 * u + q] = terms.f[q][l];
+                if (!extra) continue;
+                const double m_h2 = model.mass[u] * inv_h2;
+                // What the ground and the contacts added (0 where they add nothing: the sum less its parts leaves
+                // round-off, which would list every vertex).
+                bool any = false;
+                double e[6];
+                for (size_t q = 0; q < 6; ++q) {
+                    const double base = elastic[q][l] + (q < 3 ? m_h2 : 0.0);
+                    e[q] = terms.H[q][l] - base;
+                    any = any || std::abs(e[q]) > 1e-9 * (std::abs(base) + m_h2);
+                }
+                for (size_t q = 0; q < 6; ++q)
+                    m_extra[6 * u + q] = any ? e[q] : 0.0;
             }
-            for (size_t q = 0; q < 6; ++q)
-                m_extra[6 * u + q] = any ? e[q] : 0.0;
         }
     }
 }
@@ -801,9 +834,12 @@ BlockDescent::Sweep BlockDescent::sweep(double* xp, double h)
             const std::int32_t begin = m_colour_start[static_cast<size_t>(c)],
                                end = m_colour_start[static_cast<size_t>(c) + 1];
             if (end - begin > 8) {
-#pragma omp for schedule(static)
-                for (std::int32_t g = begin; g < end; ++g)
+                // Each thread a contiguous range of equal cost (the groups are sorted dearest first).
+                const auto [first, last] =
+                    balanced_part(begin, end, tethash::detail::team_rank(), tethash::detail::team_size());
+                for (std::int32_t g = first; g < last; ++g)
                     largest = std::max(largest, solve_group(g, xp, h, moved[g]));
+#pragma omp barrier
             } else {
 #pragma omp single
                 for (std::int32_t g = begin; g < end; ++g)
