@@ -298,9 +298,16 @@ bool SimulationImpl::entered_unseen()
     watched.clear();
     for (const Contact& c : contacts.contacts())
         if (c.tet >= 0) watched.emplace_back(c.vertex, c.tet_object);
+    const auto middle = static_cast<std::ptrdiff_t>(watched.size());
     for (const Contact& c : contacts.margin_contacts())
         watched.emplace_back(c.vertex, c.tet_object);
-    std::sort(watched.begin(), watched.end());
+    // Both parts come sorted (contacts by vertex then tet, an object's tets in one run; margin contacts by vertex
+    // then object): merged in linear time; sorted whole where a part is not.
+    const auto mid = watched.begin() + middle;
+    if (std::is_sorted(watched.begin(), mid) && std::is_sorted(mid, watched.end()))
+        std::inplace_merge(watched.begin(), mid, watched.end());
+    else
+        std::sort(watched.begin(), watched.end());
     return unseen;
 }
 
