@@ -276,6 +276,26 @@ TEST(CoreContinuous, KeptDetectorMovingMaskAndFilter)
     expect_same(filtered, edges_only, "edge-edge only");
     EXPECT_EQ(filtered.vertex_face_candidates, 0);
     EXPECT_EQ(filtered.edge_edge_candidates, all.edge_edge_candidates);
+    // First only: at least one contact, each one of the full detection's, at 1 and 2 threads; none where nothing
+    // meets (B far from A).
+    for (int threads : {1, 2}) {
+        ContinuousParams p;
+        p.threads = threads;
+        p.first_only = true;
+        const ContinuousResult& first = d.detect(s.x0, s.x1, p);
+        ASSERT_FALSE(first.contacts.empty()) << threads;
+        EXPECT_LT(first.contacts.size(), all.contacts.size()) << threads;
+        for (const auto& c : first.contacts)
+            EXPECT_TRUE(std::any_of(all.contacts.begin(), all.contacts.end(), [&](const ContinuousContact& q) {
+                return q.kind == c.kind && q.a == c.a && q.b == c.b && q.toi == c.toi;
+            }));
+        Positions far0 = s.x0, far1 = s.x1;
+        for (Index v = n / 2; v < n; ++v) {
+            far0(v, 0) += 10;
+            far1(v, 0) += 10;
+        }
+        EXPECT_TRUE(d.detect(far0, far1, p).contacts.empty()) << threads;
+    }
     // Positions of another size are refused.
     test::expect_error([&] { d.detect(s.x0.topRows(n - 1), s.x1); }, {"start", "rows"});
 }

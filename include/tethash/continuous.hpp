@@ -26,6 +26,10 @@ namespace tethash::ccd {
 struct ContinuousParams {
     CcdParams query; ///< tolerance and cap of each narrow-phase query
     int threads = 1; ///< OpenMP threads (0: all); the result does not depend on it
+    /// ContinuousDetector::detect only: stop testing pairs once one has met (a caller that needs to know whether
+    /// anything meets). Whether contacts are found still does not depend on the thread count; which ones, and the
+    /// candidate counts, do.
+    bool first_only = false;
 };
 
 enum class ContinuousKind : std::uint8_t {

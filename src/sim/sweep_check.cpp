@@ -136,6 +136,7 @@ bool SweepCheck::crossed(const Positions& x0, const Positions& x1, const std::ve
     };
     ccd::ContinuousParams params;
     params.threads = threads;
+    params.first_only = true; // whether, not which
     const ccd::ContinuousResult& r = m_detector.detect(x0, x1, params, m_moving, keep);
     m_impacts = static_cast<std::int64_t>(r.contacts.size());
     return m_impacts > 0;

@@ -31,7 +31,7 @@ class SweepCheck {
     /// by its margin contact.
     bool crossed(const Positions& x0, const Positions& x1, const std::vector<std::pair<Index, Index>>& watched,
                  int threads);
-    /// The impacts the last call found (unwatched, far), and the vertices it marked moving.
+    /// The impacts the last call found (unwatched, far; it stops at the first), and the vertices it marked moving.
     std::int64_t impacts() const { return m_impacts; }
     std::int64_t moving() const { return m_moving_count; }
 

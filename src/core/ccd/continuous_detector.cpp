@@ -12,6 +12,7 @@
 #include "tethash/error.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -82,11 +83,15 @@ class Occupancy {
     {
         m_inv = 1 / coarse;
         m_bits.assign(words, 0);
+        m_everywhere = false;
     }
     void mark(const Box& b)
     {
         std::int64_t c0[3], c1[3];
-        cells(b, c0, c1);
+        if (!cells(b, c0, c1)) {
+            m_everywhere = true; // a box over very many coarse cells: every query goes on to the grid
+            return;
+        }
         for (std::int64_t x = c0[0]; x <= c1[0]; ++x)
             for (std::int64_t y = c0[1]; y <= c1[1]; ++y)
                 for (std::int64_t z = c0[2]; z <= c1[2]; ++z) {
@@ -97,7 +102,7 @@ class Occupancy {
     bool meets(const Box& b) const
     {
         std::int64_t c0[3], c1[3];
-        cells(b, c0, c1);
+        if (m_everywhere || !cells(b, c0, c1)) return true;
         for (std::int64_t x = c0[0]; x <= c1[0]; ++x)
             for (std::int64_t y = c0[1]; y <= c1[1]; ++y)
                 for (std::int64_t z = c0[2]; z <= c1[2]; ++z) {
@@ -109,12 +114,18 @@ class Occupancy {
 
   private:
     static constexpr std::size_t words = 1024; // 65,536 bits
-    void cells(const Box& b, std::int64_t c0[3], std::int64_t c1[3]) const
+    /// The coarse cells of b; false when they are more than 512.
+    bool cells(const Box& b, std::int64_t c0[3], std::int64_t c1[3]) const
     {
+        double count = 1;
         for (int k = 0; k < 3; ++k) {
+            const double lo = b.lo[k] * m_inv, hi = b.hi[k] * m_inv;
+            if (!(hi - lo < 512)) return false;
+            count *= hi - lo + 2;
             c0[k] = detail::BoxGrid::cell_of(b.lo[k], m_inv);
             c1[k] = detail::BoxGrid::cell_of(b.hi[k], m_inv);
         }
+        return count <= 512;
     }
     static std::uint64_t bit(std::int64_t x, std::int64_t y, std::int64_t z)
     {
@@ -123,6 +134,7 @@ class Occupancy {
     }
     double m_inv = 1;
     std::vector<std::uint64_t> m_bits;
+    bool m_everywhere = false;
 };
 
 } // namespace
@@ -240,8 +252,8 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
         s.edge_moving[e] = is_moving(edges(ei, 0)) || is_moving(edges(ei, 1));
         length += (x0.row(edges(ei, 0)) - x0.row(edges(ei, 1))).norm();
     }
-    // Cell size: the mean boundary edge at the start, doubled while the swept boxes would cover more than 64 cells
-    // each on average (a fast step), and at least 2^-20 of the extent.
+    // Cell size: the mean boundary edge at the start (every primitive queries the grids), doubled while the swept boxes
+    // would cover more than 64 cells each on average (a fast step), and at least 2^-20 of the extent.
     Box all = s.face_box[0];
     for (const Box& b : s.face_box)
         grow(all, b);
@@ -296,6 +308,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                edges(e, 1) == edges(g, 1);
     };
     auto row = [](const PositionsRef& x, Index v) { return Vec3(x(v, 0), x(v, 1), x(v, 2)); };
+    std::atomic<bool> met{false}; // params.first_only: some pair met
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel num_threads(threads) if (threads > 1)
 #endif
@@ -303,20 +316,26 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
         const int rank = detail::team_rank(), size = detail::team_size();
         State::Scratch& w = s.scratch[static_cast<std::size_t>(rank)];
         auto vertex_face = [&](Index v, Index f) {
+            if (params.first_only && met.load(std::memory_order_relaxed)) return;
             if (keep && !keep(ContinuousKind::vertex_face, v, f)) return;
             ++w.vf;
             const CcdResult r = vertex_face_ccd(row(x0, v), row(x0, faces(f, 0)), row(x0, faces(f, 1)),
                                                 row(x0, faces(f, 2)), row(x1, v), row(x1, faces(f, 0)),
                                                 row(x1, faces(f, 1)), row(x1, faces(f, 2)), params.query);
-            if (r.hit) w.found.push_back({ContinuousKind::vertex_face, v, f, r.toi, r.outcome});
+            if (!r.hit) return;
+            w.found.push_back({ContinuousKind::vertex_face, v, f, r.toi, r.outcome});
+            met.store(true, std::memory_order_relaxed);
         };
         auto edge_edge = [&](Index e, Index g) {
+            if (params.first_only && met.load(std::memory_order_relaxed)) return;
             if (keep && !keep(ContinuousKind::edge_edge, e, g)) return;
             ++w.ee;
             const CcdResult r = edge_edge_ccd(row(x0, edges(e, 0)), row(x0, edges(e, 1)), row(x0, edges(g, 0)),
                                               row(x0, edges(g, 1)), row(x1, edges(e, 0)), row(x1, edges(e, 1)),
                                               row(x1, edges(g, 0)), row(x1, edges(g, 1)), params.query);
-            if (r.hit) w.found.push_back({ContinuousKind::edge_edge, e, g, r.toi, r.outcome});
+            if (!r.hit) return;
+            w.found.push_back({ContinuousKind::edge_edge, e, g, r.toi, r.outcome});
+            met.store(true, std::memory_order_relaxed);
         };
         std::int64_t begin = 0, end = 0;
         // Every vertex against the moving faces.
