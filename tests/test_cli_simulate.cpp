@@ -77,9 +77,10 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
 {
     const auto dir = temp_dir();
     write_text(dir / "s.toml", kSmall);
-    const auto r = run_tethash("simulate " + quote(dir / "s.toml") +
-                               " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --crossing-check on --out " +
-                               quote(dir / "out"));
+    const auto r = run_tethash(
+        "simulate " + quote(dir / "s.toml") +
+        " --steps 3 --dt 1e-3 --integrator vbd --threads 1 --crossing-check on --continuous-check on --out " +
+        quote(dir / "out"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("vbd"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("steps: 3 "), std::string::npos) << r.out;
@@ -160,6 +161,11 @@ TEST(CliSimulate, BadSceneKeysAndOptionsExit2)
     write_text(dir / "bad3.toml", "crossing_check = 1\n[[object]]\ngenerate = { shape = \"box\" }\n");
     r = run_tethash("simulate " + quote(dir / "bad3.toml") + " --steps 1 --out " + quote(dir / "o"));
     expect_refused(r, {"bad3.toml:1", "crossing_check"});
+    r = run_tethash("simulate --continuous-check 1 --steps 1 --out " + quote(dir / "o"));
+    expect_refused(r, {"--continuous-check", "on or off", "'1'"});
+    write_text(dir / "bad4.toml", "continuous_check = \"on\"\n[[object]]\ngenerate = { shape = \"box\" }\n");
+    r = run_tethash("simulate " + quote(dir / "bad4.toml") + " --steps 1 --out " + quote(dir / "o"));
+    expect_refused(r, {"bad4.toml:1", "continuous_check"});
 }
 
 TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)

@@ -204,3 +204,98 @@ TEST(CoreContinuous, CandidatesAreTheOverlappingPairsTheNarrowPhaseGets)
             sharing_free += c1.faces(f, 0) != v && c1.faces(f, 1) != v && c1.faces(f, 2) != v;
     EXPECT_EQ(brute.vertex_face_candidates, sharing_free);
 }
+
+TEST(CoreContinuous, KeptDetectorEqualsDetectContinuousAtOneAndTwoThreads)
+{
+    // One detector kept over steps of the same tets: each step's contacts, tois and candidate counts are
+    // detect_continuous's (itself checked against brute force above), at 1 and 2 threads.
+    ContinuousDetector one, two;
+    int with_contacts = 0;
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+        const Scene s = two_blocks({1.6, 0.3, 0.2}, {-1.2 - 0.2 * seed, 0.1 * seed, -0.05 * seed}, 0.05, seed);
+        if (seed == 1) {
+            one.set_topology(s.tets, static_cast<Index>(s.x0.rows()));
+            two.set_topology(s.tets, static_cast<Index>(s.x0.rows()));
+        }
+        ContinuousParams p1, p2;
+        p1.threads = 1;
+        p2.threads = 2;
+        const ContinuousResult want = detect_continuous(s.tets, s.x0, s.x1, p1);
+        const ContinuousResult& r1 = one.detect(s.x0, s.x1, p1);
+        expect_same(r1, want, "seed " + std::to_string(seed) + ", kept at 1 thread");
+        EXPECT_EQ(r1.vertex_face_candidates, want.vertex_face_candidates);
+        EXPECT_EQ(r1.edge_edge_candidates, want.edge_edge_candidates);
+        EXPECT_TRUE(r1.faces == want.faces && r1.edges == want.edges);
+        const ContinuousResult& r2 = two.detect(s.x0, s.x1, p2);
+        expect_same(r2, want, "seed " + std::to_string(seed) + ", kept at 2 threads");
+        EXPECT_EQ(r2.vertex_face_candidates, want.vertex_face_candidates);
+        EXPECT_EQ(r2.edge_edge_candidates, want.edge_edge_candidates);
+        with_contacts += !want.contacts.empty();
+    }
+    EXPECT_EQ(with_contacts, 6);
+}
+
+TEST(CoreContinuous, KeptDetectorMovingMaskAndFilter)
+{
+    // Only block B's vertices marked moving: the contacts are exactly those of the full detection that involve a
+    // vertex of B (A's own pairs, which its jitter moves, are not candidates), at 1 and 2 threads; a filter that
+    // refuses vertex-face pairs leaves the edge-edge contacts alone.
+    const Scene s = two_blocks({1.6, 0.3, 0.2}, {-1.5, 0.2, -0.1}, 0.05, 3);
+    const auto n = static_cast<Index>(s.x0.rows());
+    std::vector<unsigned char> moving(static_cast<std::size_t>(n), 0);
+    for (Index v = n / 2; v < n; ++v) // the blocks have as many vertices each, B second
+        moving[static_cast<std::size_t>(v)] = 1;
+    ContinuousDetector d;
+    d.set_topology(s.tets, n);
+    const ContinuousResult all = d.detect(s.x0, s.x1);
+    const auto involves_b = [&](const ContinuousContact& c) {
+        if (c.kind == ContinuousKind::vertex_face)
+            return moving[static_cast<std::size_t>(c.a)] || moving[static_cast<std::size_t>(all.faces(c.b, 0))];
+        return moving[static_cast<std::size_t>(all.edges(c.a, 0))] ||
+               moving[static_cast<std::size_t>(all.edges(c.b, 0))];
+    };
+    ContinuousResult want = all;
+    want.contacts.clear();
+    for (const auto& c : all.contacts)
+        if (involves_b(c)) want.contacts.push_back(c);
+    ASSERT_FALSE(want.contacts.empty());
+    for (int threads : {1, 2}) {
+        ContinuousParams p;
+        p.threads = threads;
+        const ContinuousResult& masked = d.detect(s.x0, s.x1, p, moving);
+        expect_same(masked, want, "masked at " + std::to_string(threads) + " threads");
+        EXPECT_LT(masked.vertex_face_candidates, all.vertex_face_candidates);
+    }
+    ContinuousResult edges_only = all;
+    edges_only.contacts.clear();
+    for (const auto& c : all.contacts)
+        if (c.kind == ContinuousKind::edge_edge) edges_only.contacts.push_back(c);
+    ASSERT_FALSE(edges_only.contacts.empty());
+    const ContinuousResult& filtered =
+        d.detect(s.x0, s.x1, {}, {}, [](ContinuousKind k, Index, Index) { return k == ContinuousKind::edge_edge; });
+    expect_same(filtered, edges_only, "edge-edge only");
+    EXPECT_EQ(filtered.vertex_face_candidates, 0);
+    EXPECT_EQ(filtered.edge_edge_candidates, all.edge_edge_candidates);
+    // First only: at least one contact, each one of the full detection's, at 1 and 2 threads; none where nothing
+    // meets (B far from A).
+    for (int threads : {1, 2}) {
+        ContinuousParams p;
+        p.threads = threads;
+        p.first_only = true;
+        const ContinuousResult& first = d.detect(s.x0, s.x1, p);
+        ASSERT_FALSE(first.contacts.empty()) << threads;
+        EXPECT_LT(first.contacts.size(), all.contacts.size()) << threads;
+        for (const auto& c : first.contacts)
+            EXPECT_TRUE(std::any_of(all.contacts.begin(), all.contacts.end(), [&](const ContinuousContact& q) {
+                return q.kind == c.kind && q.a == c.a && q.b == c.b && q.toi == c.toi;
+            }));
+        Positions far0 = s.x0, far1 = s.x1;
+        for (Index v = n / 2; v < n; ++v) {
+            far0(v, 0) += 10;
+            far1(v, 0) += 10;
+        }
+        EXPECT_TRUE(d.detect(far0, far1, p).contacts.empty()) << threads;
+    }
+    // Positions of another size are refused.
+    test::expect_error([&] { d.detect(s.x0.topRows(n - 1), s.x1); }, {"start", "rows"});
+}

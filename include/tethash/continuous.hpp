@@ -16,6 +16,9 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
 #include <vector>
 
 namespace tethash::ccd {
@@ -23,6 +26,10 @@ namespace tethash::ccd {
 struct ContinuousParams {
     CcdParams query; ///< tolerance and cap of each narrow-phase query
     int threads = 1; ///< OpenMP threads (0: all); the result does not depend on it
+    /// ContinuousDetector::detect only: stop testing pairs once one has met (a caller that needs to know whether
+    /// anything meets). Whether contacts are found still does not depend on the thread count; which ones, and the
+    /// candidate counts, do.
+    bool first_only = false;
 };
 
 enum class ContinuousKind : std::uint8_t {
@@ -66,6 +73,42 @@ struct ContinuousCandidates {
 /// detect_continuous does.
 ContinuousCandidates continuous_candidates(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,
                                            int threads = 1);
+
+/// Continuous detection kept between calls on the same tets: the boundary (faces, edges, vertices) is found once
+/// by set_topology, the per-call buffers are kept, so a call costs the broad phase and the narrow phase only. The
+/// broad phase is the core's grid of boxes (the hash of box_grid.hpp, as the edge-face contacts and the simulator's
+/// margin contacts use): the swept boxes of the faces and of the edges hashed into cells of about a boundary edge,
+/// each vertex's and edge's swept box queried, the double boxes tested exactly. detect(x0, x1) is detect_continuous
+/// on the kept tets: the same contacts, tois and candidate counts, at every thread count.
+class ContinuousDetector {
+  public:
+    ContinuousDetector();
+    ~ContinuousDetector();
+    ContinuousDetector(ContinuousDetector&&) noexcept;
+    ContinuousDetector& operator=(ContinuousDetector&&) noexcept;
+
+    /// Keeps the boundary of `tets` over `num_vertices` vertices. Throws Error when a tet names a vertex outside
+    /// [0, num_vertices).
+    void set_topology(const TetsRef& tets, Index num_vertices);
+    const Triangles& faces() const;
+    const Edges& edges() const;
+
+    /// Decides before the narrow phase whether a candidate pair is tested (kind, then a and b as in
+    /// ContinuousContact). Called from several threads at once when params.threads > 1.
+    using PairFilter = std::function<bool(ContinuousKind, Index, Index)>;
+
+    /// Continuous detection of the step x0 → x1 (num_vertices × 3 each): detect_continuous's result (the faces and
+    /// edges those above). `moving` (empty, or one entry per vertex): only pairs with a vertex whose entry is nonzero
+    /// are candidates (a caller that knows where nothing moved enough to meet anything); `keep` (may be empty): only
+    /// pairs it accepts reach the narrow phase and the candidate counts. The result stays valid until the next call.
+    /// Throws Error as detect_continuous does.
+    const ContinuousResult& detect(const PositionsRef& x0, const PositionsRef& x1, const ContinuousParams& params = {},
+                                   std::span<const unsigned char> moving = {}, const PairFilter& keep = {});
+
+  private:
+    struct State;
+    std::unique_ptr<State> m_state;
+};
 
 /// The same by brute force over all pairs (no broad phase): the reference of the tests.
 ContinuousResult detect_continuous_brute_force(const TetsRef& tets, const PositionsRef& x0, const PositionsRef& x1,

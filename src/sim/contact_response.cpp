@@ -17,11 +17,6 @@ using Mat3 = Eigen::Matrix3d;
 using tethash::detail::Clock;
 using tethash::detail::ms_since;
 
-/// A self-contact whose tet lies within this many mean edge lengths of the vertex in the rest state is local
-/// inversion (a fold of the vertex's own neighbourhood), left to the elastic and volume terms: pushing the
-/// vertex out through the nearest face of a neighbouring tet inverts the mesh further.
-constexpr double local_contact_edges = 2.0;
-
 } // namespace
 
 void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model& model,

@@ -26,6 +26,11 @@ inline constexpr double contact_rate_factor = 50;
 
 class ContactResponse {
   public:
+    /// A self-contact whose tet lies within this many mean edge lengths of the vertex in the rest state is local
+    /// inversion (a fold of the vertex's own neighbourhood), left to the elastic and volume terms: pushing the
+    /// vertex out through the nearest face of a neighbouring tet inverts the mesh further.
+    static constexpr double local_contact_edges = 2.0;
+
     /// Builds the detector and penetration topology when some pair of objects can collide; the automatic
     /// penalty per object.
     /// `obstacles` (kept, may be null): static BSP obstacles whose contacts join the tet contacts (tet −1).

@@ -458,6 +458,7 @@ std::vector<Key<Scene>> scene_keys(std::optional<Eigen::Vector3d>& up)
         key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),
         key("inversion_guard", &Scene::inversion_guard, &Reader::boolean),
         key("crossing_check", &Scene::crossing_check, &Reader::boolean),
+        key("continuous_check", &Scene::continuous_check, &Reader::boolean),
         key("gravity", &Scene::gravity, &Reader::vec3),
         // The scene's up axis (applied by parse_scene): gravity 9.81 m/s² against it and the ground's normal along
         // it (meshes made with y up are common; the default is z up). A `gravity` or `[ground] normal` given too wins.

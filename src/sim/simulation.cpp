@@ -7,6 +7,7 @@
 #include "integrator.hpp"
 #include "objects.hpp"
 #include "obstacles.hpp"
+#include "sweep_check.hpp"
 #include "thread_choice.hpp"
 
 #include "core/timing.hpp"
@@ -98,6 +99,9 @@ class SimulationImpl {
     bool contacts_at_end = false;
     Positions x_end, v_end;
     double h_end = 0;
+    // Scene::continuous_check: the sweep of each substep, and the substep's start positions.
+    SweepCheck sweep;
+    Positions x_substep;
 
     explicit SimulationImpl(const Scene& s);
     std::string object_name(size_t k) const
@@ -174,6 +178,9 @@ SimulationImpl::SimulationImpl(const Scene& s) : scene(s)
     set_auto_max_substeps();
     threads_now = scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core();
     choose_threads = scene.detect.threads == 0 && threads_now > 1;
+    if (scene.continuous_check && contacts.enabled())
+        sweep.setup(mesh(), model, objects.options, objects.vertices, ContactResponse::local_contact_edges,
+                    scene.contact.margin);
     if (choose_threads) thread_choice = detail::ThreadChoice(threads_now);
 }
 
@@ -481,6 +488,7 @@ void Simulation::step()
     substeps = std::max(substeps, approach);
     const std::int64_t allowed = std::max(s.inverted, static_cast<std::int64_t>(s.model.volumes.tets.rows()) / 100);
     // Back to the step's start with twice the substeps, while max_substeps allows.
+    const bool sweeping = s.scene.continuous_check && s.contacts.enabled();
     auto refine = [&] {
         if (substeps * 2 > max_substeps) return false;
         x = s.x_save;
@@ -493,7 +501,7 @@ void Simulation::step()
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
-        bool crossed = false;
+        bool crossed = false, swept = false;
         for (sub = 0; sub < substeps; ++sub) {
             try {
                 s.update_contacts(x, h, st);
@@ -504,10 +512,13 @@ void Simulation::step()
                 break;
             }
             // A far part entered within the last substep, unseen by its contacts: the step again in more substeps.
-            if (s.scene.crossing_check && s.entered_unseen() && sub > 0 && substeps * 2 <= max_substeps) {
+            // (The watch is kept for the sweep too.)
+            const bool watch = s.scene.crossing_check || sweeping;
+            if (watch && s.entered_unseen() && s.scene.crossing_check && sub > 0 && substeps * 2 <= max_substeps) {
                 crossed = true;
                 break;
             }
+            if (sweeping) s.x_substep = x;
             const auto t0 = Clock::now();
             st.solver_iterations += s.integrator->substep(x, s.v, h);
             if (!s.integrator->converged()) ++st.unconverged;
@@ -520,9 +531,21 @@ void Simulation::step()
             }
             bad = s.failure.check_substep(s.model, x, s.v, s.t + (sub + 1) * h);
             if (!bad.empty()) break;
+            // A far pair met within the substep, unwatched (passing through, or an edge through a face): the step
+            // again in more substeps.
+            if (sweeping && substeps * 2 <= max_substeps) {
+                const auto t1 = Clock::now();
+                const bool met = s.sweep.crossed(s.x_substep, x, s.watched, s.threads_now);
+                st.ms_continuous += ms_since(t1);
+                if (met) {
+                    crossed = swept = true;
+                    break;
+                }
+            }
         }
         if (crossed && refine()) {
             ++st.crossings;
+            if (swept) ++st.continuous_crossings;
             continue;
         }
         if (bad.empty()) {

@@ -66,8 +66,9 @@ struct SimulateOptions {
     std::string dt; ///< "" = the scene's
     int substeps = unset;
     std::string integrator;
-    std::string crossing_check; ///< "" = the scene's; "on" or "off"
-    std::string threads;        ///< "" = the scene's
+    std::string crossing_check;   ///< "" = the scene's; "on" or "off"
+    std::string continuous_check; ///< "" = the scene's; "on" or "off"
+    std::string threads;          ///< "" = the scene's
     std::string out = "out";
     bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
     CcdQueryOptions ccd; ///< --ccd-queries: the steps' continuous queries in the CCD benchmark's format
@@ -148,6 +149,7 @@ steps = 480             # steps to run
 substeps = 1            # substeps per step (each with its own detection)
 integrator = "vbd"      # vbd (default), implicit_euler, symplectic_euler
 # crossing_check = true   # retake a step in more substeps where a far part was entered unseen within a substep
+# continuous_check = false # also sweep each substep (continuous detection): retake where a far pair met unseen
 # iterations = 0        # vbd sweeps per substep; 0: until converged
 # convergence = 0.1     # vbd: relative tolerance of the sweeps
 # max_iterations = 100  # vbd: the most sweeps a substep takes (reaching it is reported)
@@ -269,6 +271,11 @@ sim::Scene simulate_scene(SimulateOptions& o, std::string& mesh_scene)
         if (o.crossing_check != "on" && o.crossing_check != "off")
             throw Error("--crossing-check must be on or off, found '" + o.crossing_check + "'");
         scene.crossing_check = o.crossing_check == "on";
+    }
+    if (!o.continuous_check.empty()) {
+        if (o.continuous_check != "on" && o.continuous_check != "off")
+            throw Error("--continuous-check must be on or off, found '" + o.continuous_check + "'");
+        scene.continuous_check = o.continuous_check == "on";
     }
     if (!o.threads.empty())
         scene.detect.threads = parse_threads(o.threads);
@@ -624,6 +631,11 @@ Registrar reg{
          sub.add_option("--crossing-check", o->crossing_check,
                         "on or off (overrides the scene's crossing_check): take a step again in more substeps where a "
                         "vertex entered a far part within a substep unseen by the contacts");
+         sub.add_option("--continuous-check", o->continuous_check,
+                        "on or off (overrides the scene's continuous_check): sweep each substep by continuous "
+                        "detection and take the step again in more substeps where a vertex-face or edge-edge pair of "
+                        "different objects or far parts met unseen by the contacts (a vertex through a thin layer, an "
+                        "edge through a face)");
          sub.add_option("--threads", o->threads,
                         "Threads of the detector and the solver: 0 = every hardware thread, fewer in the steps "
                         "where they do not pay (measured as the run goes), or a fixed 1..256 (default: the scene's "

@@ -142,6 +142,13 @@ struct Scene {
     /// parts that would cross each other within a substep are met by the contacts of shorter substeps instead
     /// (docs/simulator.md, "Crossings"). The end of each step is detected once more for it.
     bool crossing_check = true;
+    /// With it, each substep is also swept: continuous detection of the boundary between the substep's start and
+    /// end positions (tethash/continuous.hpp) finds a vertex-face or edge-edge impact between different objects, or
+    /// far parts of one, that no contact of the substep's start watched (a vertex passing through a whole thin layer
+    /// within the substep, an edge through a face with no vertex inside, which the check of where vertices end
+    /// cannot see); the step is then taken again in twice the substeps like a crossing (docs/simulator.md,
+    /// "Crossings").
+    bool continuous_check = false;
     double sweep_tolerance = 0; ///< vbd: > 0 stops sweeping when no vertex moved more than this × its object's mean
                                 ///< edge in a sweep (faster, less accurate: 1e-3 stopped a sliding box after one sweep
                                 ///< and overstated its friction by 36 %); 0 = always `iterations` sweeps

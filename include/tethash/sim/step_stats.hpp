@@ -27,7 +27,9 @@ struct StepStats {
     int unconverged = 0;            ///< substeps whose iterations reached their cap unconverged (vbd: max_iterations)
     int crossings = 0; ///< times the step was taken again in more substeps for a vertex that entered a far part unseen
                        ///< (Scene::crossing_check)
-    int tightened = 0; ///< times the step was taken again with tighter tolerances for energy it gained
+    int continuous_crossings = 0; ///< of those, the ones the substep's sweep found (Scene::continuous_check)
+    double ms_continuous = 0;     ///< the substeps' sweeps (Scene::continuous_check; part of ms_checks())
+    int tightened = 0;            ///< times the step was taken again with tighter tolerances for energy it gained
 
     /// The step less its stages: its checks (energy, inverted tets, blow-up) and the copies of steps taken again.
     double ms_checks() const

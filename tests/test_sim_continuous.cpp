@@ -1,0 +1,156 @@
+// Scene::continuous_check: each substep swept by continuous detection (tethash/continuous.hpp), a step taken again
+// in more substeps where a far pair met within a substep unwatched. It sees what the check of where vertices end
+// cannot: a thin plate passing through a thin plate within a substep and ending beyond it, and an edge passing
+// through a face with no vertex inside anything. Runs are the same bit for bit at one and two threads; the scene key
+// is read and checked.
+#include "sim_support.hpp"
+#include "support.hpp"
+
+#include "tethash/sim/scene.hpp"
+#include "tethash/sim/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace tethash;
+using namespace tethash::sim;
+using namespace tethash::test;
+
+namespace {
+
+/// A 0.6 × 0.6 plate 0.05 thick thrown down at `speed` onto a static 1 × 1 plate as thin, top at 0.025; no gravity,
+/// dt 1/100, no margin or speculative contacts (only what ends inside is pushed), the crossing check on.
+Scene plates(double speed, bool continuous)
+{
+    Scene s;
+    ObjectSpec lower = box_object(Eigen::Vector3d(1.0, 1.0, 0.05), {0, 0, 0}, 4);
+    lower.is_static = true;
+    s.objects.push_back(lower);
+    s.objects.push_back(box_object(Eigen::Vector3d(0.6, 0.6, 0.05), {0, 0, 0.4}, 3));
+    s.objects[1].velocity = Eigen::Vector3d(0, 0, -speed);
+    s.gravity.setZero();
+    s.dt = 1.0 / 100;
+    s.output.every = 0;
+    s.contact.margin = 0;
+    s.contact.speculative = false;
+    s.crossing_check = true;
+    s.continuous_check = continuous;
+    return s;
+}
+
+/// Lowest vertex of object 1 over `steps` steps.
+double lowest(const Scene& s, int steps)
+{
+    Simulation sim(s);
+    const auto [b0, bn] = sim.object_vertices(1);
+    double low = INFINITY;
+    for (int i = 0; i < steps; ++i) {
+        sim.step();
+        low = std::min(low, sim.positions().middleRows(b0, bn).col(2).minCoeff());
+    }
+    return low;
+}
+
+/// A bar: one cube of six tets (vertices at its corners only), `size`, centred at `at`.
+ObjectSpec bar(const Eigen::Vector3d& size, const Eigen::Vector3d& at)
+{
+    std::vector<Eigen::Vector3d> x;
+    for (int k = 0; k <= 1; ++k)
+        for (int j = 0; j <= 1; ++j)
+            for (int i = 0; i <= 1; ++i)
+                x.emplace_back(i - 0.5, j - 0.5, k - 0.5);
+    const auto id = [](int i, int j, int k) { return static_cast<Index>(i + 2 * (j + 2 * k)); };
+    const auto tets = kuhn_tets(0, 0, 0, id);
+    ObjectSpec o;
+    TetMesh m;
+    m.positions = matrix_of<Positions>(x);
+    m.tets = matrix_of<Tets>(std::vector<std::array<Index, 4>>(tets.begin(), tets.end()));
+    o.data = m;
+    o.scale = size;
+    o.translate = at;
+    o.material.density = 100;
+    o.material.young = 1e4;
+    o.material.damping = 0.01;
+    o.self_collision = false;
+    return o;
+}
+
+/// A bar along y (0.05 thick) thrown down at 10 m/s across a static bar along x as thin, 0.12 above it: after one
+/// step of 1/100 it straddles the other, its lower long edges through the other's side faces, and no vertex of
+/// either is inside the other (their vertices are at their far ends). No gravity, the crossing check on.
+Scene crossed_bars(bool continuous)
+{
+    Scene s;
+    ObjectSpec lower = bar({1.0, 0.05, 0.05}, {0, 0, 0});
+    lower.is_static = true;
+    s.objects.push_back(lower);
+    s.objects.push_back(bar({0.05, 1.0, 0.05}, {0, 0, 0.12}));
+    s.objects[1].velocity = Eigen::Vector3d(0, 0, -10);
+    s.gravity.setZero();
+    s.dt = 1.0 / 100;
+    s.output.every = 0;
+    s.crossing_check = true;
+    s.continuous_check = continuous;
+    return s;
+}
+
+} // namespace
+
+TEST(SimContinuous, ThinPlateThroughAThinPlateWithinASubstep)
+{
+    // At 15 m/s the plate crosses the whole lower plate (0.05 thick) within a step of 0.15 and ends below it: the
+    // crossing check, which looks where vertices end, sees nothing and the plate flies on. The sweep sees its faces
+    // meet within the substep and takes the step again in more substeps, until its vertices end inside the lower
+    // plate, where they are pushed back: it stays above the lower plate's bottom.
+    EXPECT_LT(lowest(plates(15.0, false), 20), -1.0);
+    EXPECT_GT(lowest(plates(15.0, true), 20), -0.025);
+}
+
+TEST(SimContinuous, EdgeThroughFaceWithNoVertexInside)
+{
+    // The crossing check sees no vertex inside anything at any step; the sweep sees the edges meet in the first
+    // step and takes it again in more substeps.
+    for (const bool continuous : {false, true}) {
+        Simulation sim(crossed_bars(continuous));
+        sim.step();
+        EXPECT_EQ(sim.last_stats().contacts, 0) << continuous;
+        const auto [b0, bn] = sim.object_vertices(1);
+        const double bottom = sim.positions().middleRows(b0, bn).col(2).minCoeff();
+        EXPECT_LT(bottom, 0.025) << "the bar ends the step straddling the other";
+        EXPECT_GT(bottom, -0.025) << "the bar ends the step straddling the other";
+        if (continuous) {
+            EXPECT_GT(sim.last_stats().continuous_crossings, 0);
+            EXPECT_GT(sim.health().crossing_steps, 0);
+        } else {
+            EXPECT_EQ(sim.last_stats().crossings, 0);
+            EXPECT_EQ(sim.health().crossing_steps, 0);
+        }
+    }
+}
+
+TEST(SimContinuous, BitIdenticalAtOneAndTwoThreads)
+{
+    Scene s1 = plates(15.0, true), s2 = s1;
+    s1.detect.threads = 1;
+    s2.detect.threads = 2;
+    Simulation one(s1), two(s2);
+    for (int i = 0; i < 6; ++i) {
+        one.step();
+        two.step();
+        ASSERT_EQ(one.last_stats().substeps, two.last_stats().substeps) << "step " << i + 1;
+        ASSERT_TRUE((one.positions().array() == two.positions().array()).all()) << "step " << i + 1;
+        ASSERT_TRUE((one.velocities().array() == two.velocities().array()).all()) << "step " << i + 1;
+    }
+    EXPECT_GT(one.health().crossing_steps, 0); // the sweep's retakes were exercised
+}
+
+TEST(SimContinuous, SceneKey)
+{
+    const auto dir = temp_dir();
+    write_text(dir / "s.toml", "continuous_check = true\n[[object]]\ngenerate = { shape = \"box\" }\n");
+    EXPECT_TRUE(load_scene((dir / "s.toml").string()).continuous_check);
+    write_text(dir / "bad.toml", "continuous_check = \"yes\"\n[[object]]\ngenerate = { shape = \"box\" }\n");
+    expect_error([&] { load_scene((dir / "bad.toml").string()); }, {"continuous_check", "bad.toml:1"});
+}
