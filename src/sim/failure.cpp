@@ -82,18 +82,37 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
         m_object_height.push_back(hi_h[o] > lo_h[o] ? hi_h[o] - lo_h[o] : 0.0);
 }
 
-std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out, double* volume)
+std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out, double* volume,
+                                int threads)
 {
+    (void)threads; // without OpenMP every block runs on the calling thread
+    // Blocks of a fixed size, each with its own list and sum, joined in block order: the same at any thread count.
+    constexpr Index block = 4096;
+    const Index nt = static_cast<Index>(model.volumes.tets.rows());
+    const Index blocks = (nt + block - 1) / block;
+    std::vector<std::vector<std::int32_t>> lists(static_cast<size_t>(blocks));
+    std::vector<double> sums(static_cast<size_t>(blocks), 0.0);
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
+#endif
+    for (Index b = 0; b < blocks; ++b) {
+        double six_volume = 0;
+        std::vector<std::int32_t>& list = lists[static_cast<size_t>(b)];
+        for (Index t = b * block; t < std::min(nt, (b + 1) * block); ++t) {
+            const auto tet = model.volumes.tets.row(t);
+            const Eigen::Vector3d a = x.row(tet(0)).transpose();
+            const double w = (x.row(tet(1)).transpose() - a)
+                                 .dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
+            six_volume += w;
+            if (!(w > 0)) list.push_back(static_cast<std::int32_t>(t));
+        }
+        sums[static_cast<size_t>(b)] = six_volume;
+    }
     out.clear();
     double six_volume = 0;
-    const Index nt = static_cast<Index>(model.volumes.tets.rows());
-    for (Index t = 0; t < nt; ++t) {
-        const auto tet = model.volumes.tets.row(t);
-        const Eigen::Vector3d a = x.row(tet(0)).transpose();
-        const double w =
-            (x.row(tet(1)).transpose() - a).dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
-        six_volume += w;
-        if (!(w > 0)) out.push_back(static_cast<std::int32_t>(t));
+    for (Index b = 0; b < blocks; ++b) {
+        out.insert(out.end(), lists[static_cast<size_t>(b)].begin(), lists[static_cast<size_t>(b)].end());
+        six_volume += sums[static_cast<size_t>(b)];
     }
     if (volume) *volume = six_volume / 6;
     return static_cast<std::int64_t>(out.size());

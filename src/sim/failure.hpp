@@ -52,9 +52,10 @@ class FailureCheck {
 
 /// Tets of the model's volume terms (the dynamic ones) whose signed volume at x is ≤ 0, by row, into `out`
 /// (cleared first); returns their count. `volume`, when given, receives the sum of their signed volumes (the same
-/// pass: what the run's health reads every step).
+/// pass: what the run's health reads every step). Blocks of tets split over `threads`, joined in order: the same
+/// list and sum at any thread count.
 std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out,
-                                double* volume = nullptr);
+                                double* volume = nullptr, int threads = 1);
 
 /// Short number for messages (3 significant digits).
 std::string short_number(double v);

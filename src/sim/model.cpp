@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace tethash::sim {
 
@@ -331,31 +332,79 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
     }
 }
 
-Energy Model::energy(const Positions& x, const Positions& v) const
+namespace {
+
+/// Sums f(begin, end) over [0, n) in blocks of a fixed size, each block's partial kept and the partials added in
+/// block order: the same bits whatever the number of threads that computed the blocks.
+template <class T, class F> T block_sum(Index n, int threads, F&& f)
 {
+    constexpr Index block = 4096;
+    const Index blocks = (n + block - 1) / block;
+    std::vector<T> part(static_cast<size_t>(blocks));
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
+#endif
+    for (Index b = 0; b < blocks; ++b)
+        part[static_cast<size_t>(b)] = f(b * block, std::min(n, (b + 1) * block));
+    T sum{};
+    for (const T& p : part)
+        sum += p;
+    return sum;
+}
+
+struct VertexSums {
+    double kinetic = 0, gravity = 0, ground = 0;
+    VertexSums& operator+=(const VertexSums& o)
+    {
+        kinetic += o.kinetic;
+        gravity += o.gravity;
+        ground += o.ground;
+        return *this;
+    }
+};
+
+} // namespace
+
+Energy Model::energy(const Positions& x, const Positions& v, int threads) const
+{
+    (void)threads; // without OpenMP every block runs on the calling thread
     Energy en;
-    const Index n = num_vertices();
-    for (Index i = 0; i < n; ++i) {
-        if (fixed[static_cast<size_t>(i)]) continue;
-        en.kinetic += 0.5 * mass[static_cast<size_t>(i)] * v.row(i).squaredNorm();
-        en.gravity -= mass[static_cast<size_t>(i)] * gravity.dot(row(x, i));
-        if (ground.enabled) {
-            const double pen = ground.height - ground.normal.dot(row(x, i));
-            if (pen > 0) en.ground += 0.5 * ground_k_at(i) * pen * pen;
+    const VertexSums vs = block_sum<VertexSums>(num_vertices(), threads, [&](Index begin, Index end) {
+        VertexSums p;
+        for (Index i = begin; i < end; ++i) {
+            if (fixed[static_cast<size_t>(i)]) continue;
+            p.kinetic += 0.5 * mass[static_cast<size_t>(i)] * v.row(i).squaredNorm();
+            p.gravity -= mass[static_cast<size_t>(i)] * gravity.dot(row(x, i));
+            if (ground.enabled) {
+                const double pen = ground.height - ground.normal.dot(row(x, i));
+                if (pen > 0) p.ground += 0.5 * ground_k_at(i) * pen * pen;
+            }
         }
-    }
-    for (Index e = 0; e < springs.edges.rows(); ++e) {
-        const double len = (row(x, springs.edges(e, 0)) - row(x, springs.edges(e, 1))).norm();
-        const double s = len - springs.rest[static_cast<size_t>(e)];
-        en.spring += 0.5 * springs.k[static_cast<size_t>(e)] * s * s;
-    }
+        return p;
+    });
+    en.kinetic = vs.kinetic;
+    en.gravity = vs.gravity;
+    en.ground = vs.ground;
+    en.spring = block_sum<double>(static_cast<Index>(springs.edges.rows()), threads, [&](Index begin, Index end) {
+        double sum = 0;
+        for (Index e = begin; e < end; ++e) {
+            const double len = (row(x, springs.edges(e, 0)) - row(x, springs.edges(e, 1))).norm();
+            const double s = len - springs.rest[static_cast<size_t>(e)];
+            sum += 0.5 * springs.k[static_cast<size_t>(e)] * s * s;
+        }
+        return sum;
+    });
     const PositionsRef xr(x);
-    for (Index t = 0; t < volumes.tets.rows(); ++t) {
-        const double vol =
-            signed_volume(xr, {volumes.tets(t, 0), volumes.tets(t, 1), volumes.tets(t, 2), volumes.tets(t, 3)});
-        const double v0 = volumes.rest[static_cast<size_t>(t)];
-        en.volume += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
-    }
+    en.volume = block_sum<double>(static_cast<Index>(volumes.tets.rows()), threads, [&](Index begin, Index end) {
+        double sum = 0;
+        for (Index t = begin; t < end; ++t) {
+            const double vol =
+                signed_volume(xr, {volumes.tets(t, 0), volumes.tets(t, 1), volumes.tets(t, 2), volumes.tets(t, 3)});
+            const double v0 = volumes.rest[static_cast<size_t>(t)];
+            sum += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
+        }
+        return sum;
+    });
     return en;
 }
 

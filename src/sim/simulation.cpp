@@ -549,7 +549,7 @@ void Simulation::step()
             continue;
         }
         if (bad.empty()) {
-            const Energy e = s.model.energy(x, s.v);
+            const Energy e = s.model.energy(x, s.v, s.threads_now);
             bad = s.failure.check_energy(e.internal() + s.contacts.energy());
             energy_now = e.total() + s.contacts.energy();
         }
@@ -575,7 +575,7 @@ void Simulation::step()
                 continue;
             }
         }
-        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now);
+        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now, s.threads_now);
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
         // stiff body, which can gain the scene a tenth of its energy in one such substep; docs/simulator.md): taken

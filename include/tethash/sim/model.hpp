@@ -120,8 +120,9 @@ struct Model {
     /// them).
     void add_forces(const Positions& x, const Positions& v, Positions& f) const { add_forces(x, v, f, ForceOptions{}); }
     void add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const;
-    /// Energies (contact left 0: see Simulation).
-    Energy energy(const Positions& x, const Positions& v) const;
+    /// Energies (contact left 0: see Simulation). Summed in blocks of a fixed size, the blocks split over `threads`
+    /// and added in order: the same bits at any thread count.
+    Energy energy(const Positions& x, const Positions& v, int threads = 1) const;
     /// Largest eigenvalue bound of M⁻¹K over springs and volume terms (Gershgorin, rest state): ω_max².
     double omega_max_sq(const Positions& x) const;
     /// Explicit (symplectic Euler) stability limit (s) per vertex from the Gershgorin bounds of ω² and of the
