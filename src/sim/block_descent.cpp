@@ -278,6 +278,7 @@ void BlockDescent::setup()
 #else
     m_threads = 1;
 #endif
+    m_coarse.set_threads(m_threads);
 }
 
 std::vector<std::int32_t> BlockDescent::colour_vertices(const detail::Incidences& springs_at)

@@ -4,6 +4,10 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#ifdef TETHASH_HAVE_OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
@@ -59,7 +63,6 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
     m_nodes = 0;
     m_cache.clear();
     m_blocks.clear();
-    m_block_index.clear();
     m_analysed = false;
     const size_t objects = model.object_mean_edge.size();
     std::vector<std::vector<std::int32_t>> members(objects);
@@ -157,6 +160,141 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
     m_factored_extra.clear();
     m_factored_h = 0;
     m_factored_age = 0;
+    if (m_nodes > 0) build_pattern();
+}
+
+std::int32_t CoarseSpace::block_at(std::int32_t bi, std::int32_t bj) const
+{
+    const size_t o = static_cast<size_t>(m_object[static_cast<size_t>(bi)]);
+    if (o == static_cast<size_t>(m_object[static_cast<size_t>(bj)])) {
+        const std::int32_t first = m_object_first[o], count = m_object_first[o + 1] - first;
+        return m_local_block[m_local_offset[o] + static_cast<size_t>(bi - first) * static_cast<size_t>(count) +
+                             static_cast<size_t>(bj - first)];
+    }
+    const auto it = m_cross_block.find(static_cast<std::int64_t>(bi) * m_nodes + bj);
+    return it == m_cross_block.end() ? -1 : it->second;
+}
+
+void CoarseSpace::build_pattern()
+{
+    const Model& model = *m_model;
+    const size_t un = model.mass.size();
+    // Per object a dense table node × node → block (its nodes are numbered one after the other), an object's at most
+    // 400 nodes; pairs across objects (an element joining two objects) in a map.
+    const size_t objects = m_objects.size();
+    m_object_first.assign(objects + 1, m_nodes);
+    for (std::int32_t node = m_nodes - 1; node >= 0; --node)
+        m_object_first[static_cast<size_t>(m_object[static_cast<size_t>(node)])] = node;
+    m_local_offset.assign(objects + 1, 0);
+    for (size_t o = 0; o < objects; ++o) {
+        const size_t count = static_cast<size_t>(m_object_first[o + 1] - m_object_first[o]);
+        m_local_offset[o + 1] = m_local_offset[o] + count * count;
+    }
+    m_local_block.assign(m_local_offset[objects], -1);
+    m_cross_block.clear();
+    m_blocks.clear();
+    auto add = [&](std::int32_t bi, std::int32_t bj) {
+        const size_t o = static_cast<size_t>(m_object[static_cast<size_t>(bi)]);
+        std::int32_t* slot = nullptr;
+        if (o == static_cast<size_t>(m_object[static_cast<size_t>(bj)])) {
+            const std::int32_t first = m_object_first[o], count = m_object_first[o + 1] - first;
+            slot = &m_local_block[m_local_offset[o] + static_cast<size_t>(bi - first) * static_cast<size_t>(count) +
+                                  static_cast<size_t>(bj - first)];
+        } else {
+            slot = &m_cross_block.emplace(static_cast<std::int64_t>(bi) * m_nodes + bj, -1).first->second;
+        }
+        if (*slot < 0) {
+            *slot = static_cast<std::int32_t>(m_blocks.size());
+            m_blocks.emplace_back(bi, bj);
+        }
+    };
+    for (std::int32_t node = 0; node < m_nodes; ++node)
+        add(node, node);
+    // Every pair of nodes an element (spring, tet) or a vertex couples: the blocks Pᵀ A P can touch.
+    std::vector<std::int32_t> nodes;
+    auto couple = [&](const Index* vs, int count) {
+        nodes.clear();
+        for (int a = 0; a < count; ++a) {
+            const size_t u = static_cast<size_t>(vs[a]);
+            if (m_node[8 * u] < 0) continue;
+            for (size_t k = 0; k < 8; ++k)
+                if (std::find(nodes.begin(), nodes.end(), m_node[8 * u + k]) == nodes.end())
+                    nodes.push_back(m_node[8 * u + k]);
+        }
+        for (const std::int32_t bi : nodes)
+            for (const std::int32_t bj : nodes)
+                add(bi, bj);
+    };
+    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
+        const Index vs[2] = {model.springs.edges(e, 0), model.springs.edges(e, 1)};
+        couple(vs, 2);
+    }
+    for (Index t = 0; t < model.volumes.tets.rows(); ++t) {
+        const Index vs[4] = {model.volumes.tets(t, 0), model.volumes.tets(t, 1), model.volumes.tets(t, 2),
+                             model.volumes.tets(t, 3)};
+        couple(vs, 4);
+    }
+    for (size_t i = 0; i < un; ++i) {
+        const Index v = static_cast<Index>(i);
+        couple(&v, 1);
+    }
+    m_vertex_blocks.assign(64 * un, -1);
+    for (size_t i = 0; i < un; ++i)
+        if (m_node[8 * i] >= 0)
+            for (size_t s = 0; s < 8; ++s)
+                for (size_t t = 0; t < 8; ++t)
+                    m_vertex_blocks[64 * i + 8 * s + t] = block_at(m_node[8 * i + s], m_node[8 * i + t]);
+    // The matrix's CSR pattern (column-major, rows sorted in each column) and each block's 9 positions in it.
+    std::vector<std::int32_t> column_count(3 * static_cast<size_t>(m_nodes), 0);
+    for (const auto& b : m_blocks)
+        for (int c = 0; c < 3; ++c)
+            column_count[3 * static_cast<size_t>(b.second) + static_cast<size_t>(c)] += 3;
+    m_matrix.resize(3 * m_nodes, 3 * m_nodes);
+    m_matrix.reserve(Eigen::Map<const Eigen::VectorXi>(column_count.data(), 3 * m_nodes));
+    std::vector<size_t> order(m_blocks.size());
+    for (size_t b = 0; b < order.size(); ++b)
+        order[b] = b;
+    std::sort(order.begin(), order.end(), [&](size_t p, size_t q) {
+        return std::make_pair(m_blocks[p].second, m_blocks[p].first) <
+               std::make_pair(m_blocks[q].second, m_blocks[q].first);
+    });
+    for (const size_t b : order)
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r)
+                m_matrix.insert(3 * m_blocks[b].first + r, 3 * m_blocks[b].second + c) = 0.0;
+    m_matrix.makeCompressed();
+    m_block_value.assign(9 * m_blocks.size(), -1);
+    for (size_t b = 0; b < m_blocks.size(); ++b) {
+        const std::int32_t bi = m_blocks[b].first, bj = m_blocks[b].second;
+        for (int c = 0; c < 3; ++c) {
+            const Index col = 3 * bj + c;
+            const int* rows = m_matrix.innerIndexPtr() + m_matrix.outerIndexPtr()[col];
+            const int* rows_end = m_matrix.innerIndexPtr() + m_matrix.outerIndexPtr()[col + 1];
+            const int* at = std::lower_bound(rows, rows_end, 3 * bi);
+            for (int r = 0; r < 3; ++r)
+                m_block_value[9 * b + static_cast<size_t>(3 * r + c)] =
+                    static_cast<std::int32_t>(at + r - m_matrix.innerIndexPtr());
+        }
+    }
+    // Per node the (vertex, weight) pairs of the free vertices it interpolates, in vertex order: the restriction
+    // Pᵀ r gathered node by node sums in the order a pass over the vertices would.
+    m_node_start.assign(static_cast<size_t>(m_nodes) + 1, 0);
+    for (size_t i = 0; i < un; ++i)
+        if (m_node[8 * i] >= 0 && !model.fixed[i])
+            for (size_t k = 0; k < 8; ++k)
+                ++m_node_start[static_cast<size_t>(m_node[8 * i + k]) + 1];
+    for (size_t node = 0; node < static_cast<size_t>(m_nodes); ++node)
+        m_node_start[node + 1] += m_node_start[node];
+    m_node_vertex.resize(static_cast<size_t>(m_node_start.back()));
+    m_node_weight.resize(m_node_vertex.size());
+    std::vector<std::int32_t> fill(m_node_start.begin(), m_node_start.end() - 1);
+    for (size_t i = 0; i < un; ++i)
+        if (m_node[8 * i] >= 0 && !model.fixed[i])
+            for (size_t k = 0; k < 8; ++k) {
+                const size_t at = static_cast<size_t>(fill[static_cast<size_t>(m_node[8 * i + k])]++);
+                m_node_vertex[at] = static_cast<std::int32_t>(i);
+                m_node_weight[at] = m_weight[8 * i + k];
+            }
 }
 
 const CoarseSpace::Cached& CoarseSpace::cached(double h)
@@ -164,118 +302,117 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
     for (const Cached& c : m_cache)
         if (c.h == h) return c;
     const Model& model = *m_model;
-    const Index n = model.num_vertices();
-    const size_t un = static_cast<size_t>(n);
-    // The fine matrix at the start positions: springs and volume terms (K + C / h; the ground is added per
-    // substep), masses / h², and a stiff hold on the pinned vertices of the dynamic objects.
-    Model elastic = model;
-    elastic.ground.enabled = false;
-    std::vector<Eigen::Triplet<double>> trip;
-    elastic.add_matrix_triplets(m_start, 1.0, 1.0 / h, trip);
-    // The volume terms' relative damping (the sweeps' Hessian has k (1 + damping / h) on them; the model's matrix
-    // damps the springs only).
+    const size_t un = model.mass.size();
+    // Pᵀ (K + C / h + M / h²) P at the start positions, assembled element by element on the lattice: an element's
+    // fine matrix is Dᵀ B D (a spring: D = [I, −I] on its two vertices, B its 3 × 3 block; a tet: D the 4 gradients
+    // gᵀ, B = s I), so its coarse part is (P D)ᵀ B (P D) with P D gathered on the element's few distinct nodes
+    // (its vertices share most of their cell corners). Pinned vertices drop out of D (their rows and columns of the
+    // fine matrix are empty) and get a stiff hold on their mass; the ground is added per substep.
+    Cached out{h, std::vector<double>(9 * m_blocks.size(), 0.0)};
+    double* values = out.values.data();
+    auto add_block = [&](std::int32_t bi, std::int32_t bj, const Eigen::Matrix3d& b) {
+        double* v = values + 9 * static_cast<size_t>(block_at(bi, bj));
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                v[3 * r + c] += b(r, c);
+    };
+    // An element's distinct nodes and per node its row of P D (a weight per vertex times the vertex's D).
+    std::vector<std::int32_t> nodes;
+    std::vector<Eigen::Vector3d> rows; // tets: Σ w g per node
+    std::vector<double> weights;       // springs: Σ ± w per node
+    auto slot = [&](std::int32_t node) {
+        const auto it = std::find(nodes.begin(), nodes.end(), node);
+        if (it != nodes.end()) return static_cast<size_t>(it - nodes.begin());
+        nodes.push_back(node);
+        rows.emplace_back(Eigen::Vector3d::Zero());
+        weights.push_back(0.0);
+        return nodes.size() - 1;
+    };
+    auto in_play = [&](Index v) {
+        return m_node[8 * static_cast<size_t>(v)] >= 0 && !model.fixed[static_cast<size_t>(v)];
+    };
+    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
+        const Index i = model.springs.edges(e, 0), j = model.springs.edges(e, 1);
+        const Eigen::Vector3d d = (m_start.row(i) - m_start.row(j)).transpose();
+        const double len = d.norm();
+        if (!(len > 0)) continue;
+        const Eigen::Vector3d u = d / len;
+        const Eigen::Matrix3d uu = u * u.transpose();
+        const size_t ue = static_cast<size_t>(e);
+        // −∂f/∂x of the spring, its transverse term clamped at 0 (as Model::add_matrix_triplets), and its damping.
+        const double tr = std::max(0.0, 1.0 - model.springs.rest[ue] / len);
+        const Eigen::Matrix3d b =
+            model.springs.k[ue] * (uu + tr * (Eigen::Matrix3d::Identity() - uu)) + model.springs.c[ue] / h * uu;
+        nodes.clear();
+        rows.clear();
+        weights.clear();
+        for (const auto& [v, sign] : {std::pair{i, 1.0}, std::pair{j, -1.0}})
+            if (in_play(v))
+                for (size_t k = 0; k < 8; ++k) {
+                    const size_t at = slot(m_node[8 * static_cast<size_t>(v) + k]);
+                    weights[at] += sign * m_weight[8 * static_cast<size_t>(v) + k];
+                }
+        for (size_t p = 0; p < nodes.size(); ++p)
+            for (size_t q = 0; q < nodes.size(); ++q)
+                add_block(nodes[p], nodes[q], (weights[p] * weights[q]) * b);
+    }
+    // The volume terms: k / 6V0 (g gᵀ) with the relative damping the sweeps give them (k (1 + damping / h); the
+    // model's matrix damps the springs only).
     const Tets& tets = model.volumes.tets;
     for (Index t = 0; t < tets.rows(); ++t) {
         const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(tets(t, 0))]);
         const double dh = (o < m_damping.size() ? m_damping[o] : 0.0) / h;
-        if (!(dh > 0)) continue;
         const Eigen::Vector3d a = m_start.row(tets(t, 0)).transpose(), b = m_start.row(tets(t, 1)).transpose(),
                               c = m_start.row(tets(t, 2)).transpose(), d = m_start.row(tets(t, 3)).transpose();
-        Eigen::Matrix<double, 4, 3> g;
-        g.row(1) = ((c - a).cross(d - a) / 6).transpose();
-        g.row(2) = ((d - a).cross(b - a) / 6).transpose();
-        g.row(3) = ((b - a).cross(c - a) / 6).transpose();
-        g.row(0) = -(g.row(1) + g.row(2) + g.row(3));
-        const double s = dh * model.volumes.k[static_cast<size_t>(t)] / model.volumes.rest[static_cast<size_t>(t)];
-        for (int p = 0; p < 4; ++p)
-            for (int q = 0; q < 4; ++q) {
-                const Index vp = tets(t, p), vq = tets(t, q);
-                if (model.fixed[static_cast<size_t>(vp)] || model.fixed[static_cast<size_t>(vq)]) continue;
-                for (int r = 0; r < 3; ++r)
-                    for (int cc = 0; cc < 3; ++cc)
-                        trip.emplace_back(3 * vp + r, 3 * vq + cc, s * g(p, r) * g(q, cc));
+        const Eigen::Vector3d ba = b - a, ca = c - a, da = d - a;
+        Eigen::Vector3d g[4];
+        g[1] = ca.cross(da) / 6.0;
+        g[2] = da.cross(ba) / 6.0;
+        g[3] = ba.cross(ca) / 6.0;
+        g[0] = -(g[1] + g[2] + g[3]);
+        const double k_v = model.volumes.k[static_cast<size_t>(t)] / model.volumes.rest[static_cast<size_t>(t)];
+        const double s = dh > 0 ? k_v + dh * k_v : k_v;
+        nodes.clear();
+        rows.clear();
+        weights.clear();
+        for (int p = 0; p < 4; ++p) {
+            const Index v = tets(t, p);
+            if (!in_play(v)) continue;
+            for (size_t k = 0; k < 8; ++k) {
+                const size_t at = slot(m_node[8 * static_cast<size_t>(v) + k]);
+                rows[at] += m_weight[8 * static_cast<size_t>(v) + k] * g[p];
             }
+        }
+        for (size_t p = 0; p < nodes.size(); ++p) {
+            const Eigen::Vector3d sp = s * rows[p];
+            for (size_t q = 0; q < nodes.size(); ++q)
+                add_block(nodes[p], nodes[q], sp * rows[q].transpose());
+        }
     }
+    // The masses / h² (pinned vertices of the dynamic objects held by 10⁴ times theirs).
     double mass_sum = 0;
-    for (Index i = 0; i < n; ++i) {
-        const size_t u = static_cast<size_t>(i);
+    for (size_t u = 0; u < un; ++u) {
         if (m_node[8 * u] < 0) continue;
         const double m = model.mass[u] / (h * h);
         mass_sum += model.mass[u];
-        for (int r = 0; r < 3; ++r)
-            trip.emplace_back(3 * i + r, 3 * i + r, model.fixed[u] ? 1e4 * m : m);
+        const double mh = model.fixed[u] ? 1e4 * m : m;
+        for (size_t p = 0; p < 8; ++p)
+            for (size_t q = 0; q < 8; ++q) {
+                double* v = values + 9 * static_cast<size_t>(m_vertex_blocks[64 * u + 8 * p + q]);
+                const double w = mh * m_weight[8 * u + p] * m_weight[8 * u + q];
+                v[0] += w;
+                v[4] += w;
+                v[8] += w;
+            }
     }
-    Eigen::SparseMatrix<double> a(3 * n, 3 * n);
-    a.setFromTriplets(trip.begin(), trip.end());
-    std::vector<Eigen::Triplet<double>> ptrip;
-    for (size_t i = 0; i < un; ++i)
-        for (size_t k = 0; k < 8; ++k) {
-            const std::int32_t node = m_node[8 * i + k];
-            if (node < 0 || !(m_weight[8 * i + k] > 0)) continue;
-            for (int r = 0; r < 3; ++r)
-                ptrip.emplace_back(static_cast<Index>(3 * i) + r, 3 * node + r, m_weight[8 * i + k]);
-        }
-    Eigen::SparseMatrix<double> p(3 * n, 3 * m_nodes);
-    p.setFromTriplets(ptrip.begin(), ptrip.end());
-    Eigen::SparseMatrix<double> ac = p.transpose() * (a * p);
     // A node that only vertices far in its cell reach has a tiny diagonal: a small mass term on every node keeps
     // the coarse matrix well conditioned.
     const double floor = 1e-6 * mass_sum / (h * h) / std::max<std::int32_t>(1, m_nodes);
-
-    if (m_blocks.empty()) {
-        // The block pattern, once: every 3 × 3 block the product touches, and the 8 × 8 blocks of each vertex.
-        auto block_of = [&](std::int32_t bi, std::int32_t bj) {
-            const std::int64_t key = static_cast<std::int64_t>(bi) * m_nodes + bj;
-            auto [it, inserted] = m_block_index.emplace(key, static_cast<std::int32_t>(m_blocks.size()));
-            if (inserted) m_blocks.emplace_back(bi, bj);
-            return it->second;
-        };
-        for (std::int32_t node = 0; node < m_nodes; ++node)
-            block_of(node, node);
-        for (int c = 0; c < ac.outerSize(); ++c)
-            for (Eigen::SparseMatrix<double>::InnerIterator it(ac, c); it; ++it)
-                block_of(static_cast<std::int32_t>(it.row() / 3), static_cast<std::int32_t>(it.col() / 3));
-        m_vertex_blocks.assign(64 * un, -1);
-        for (size_t i = 0; i < un; ++i)
-            if (m_node[8 * i] >= 0)
-                for (size_t s = 0; s < 8; ++s)
-                    for (size_t t = 0; t < 8; ++t)
-                        m_vertex_blocks[64 * i + 8 * s + t] = block_of(m_node[8 * i + s], m_node[8 * i + t]);
-        std::vector<Eigen::Triplet<double>> pattern;
-        for (const auto& [bi, bj] : m_blocks)
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c)
-                    pattern.emplace_back(3 * bi + r, 3 * bj + c, 1.0);
-        m_matrix.resize(3 * m_nodes, 3 * m_nodes);
-        m_matrix.setFromTriplets(pattern.begin(), pattern.end());
-        m_matrix.makeCompressed();
-        m_block_value.assign(9 * m_blocks.size(), -1);
-        std::unordered_map<std::int64_t, std::int32_t> position;
-        for (int c = 0; c < m_matrix.outerSize(); ++c)
-            for (Eigen::SparseMatrix<double>::InnerIterator it(m_matrix, c); it; ++it)
-                position.emplace(static_cast<std::int64_t>(it.row()) * 3 * m_nodes + it.col(),
-                                 static_cast<std::int32_t>(&it.value() - m_matrix.valuePtr()));
-        for (size_t b = 0; b < m_blocks.size(); ++b)
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c)
-                    m_block_value[9 * b + static_cast<size_t>(3 * r + c)] =
-                        position.at(static_cast<std::int64_t>(3 * m_blocks[b].first + r) * 3 * m_nodes +
-                                    3 * m_blocks[b].second + c);
-    }
-    Cached out{h, std::vector<double>(9 * m_blocks.size(), 0.0)};
-    {
-        const auto& index = m_block_index;
-        for (int c = 0; c < ac.outerSize(); ++c)
-            for (Eigen::SparseMatrix<double>::InnerIterator it(ac, c); it; ++it) {
-                const std::int32_t b = index.at(static_cast<std::int64_t>(it.row() / 3) * m_nodes + it.col() / 3);
-                out.values[9 * static_cast<size_t>(b) + static_cast<size_t>(3 * (it.row() % 3) + it.col() % 3)] +=
-                    it.value();
-            }
-        for (std::int32_t node = 0; node < m_nodes; ++node) {
-            const size_t b = static_cast<size_t>(index.at(static_cast<std::int64_t>(node) * m_nodes + node));
-            for (int r = 0; r < 3; ++r)
-                out.values[9 * b + static_cast<size_t>(4 * r)] += floor;
-        }
+    for (std::int32_t node = 0; node < m_nodes; ++node) {
+        double* v = values + 9 * static_cast<size_t>(block_at(node, node));
+        v[0] += floor;
+        v[4] += floor;
+        v[8] += floor;
     }
     m_cache.push_back(std::move(out));
     return m_cache.back();
@@ -338,28 +475,47 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
     m_factored_h = h;
     m_factored_extra = with_extra;
     m_factored_rotation = m_rotation;
+    // Each thread owns the blocks of a range of the matrix's block rows: it turns them, then adds the ground's and
+    // contacts' terms that fall in them, vertex by vertex (every entry sums in vertex order at any thread count).
     double* values = m_matrix.valuePtr();
-    for (size_t b = 0; b < m_blocks.size(); ++b) {
-        const Eigen::Matrix3d& r = m_rotation[static_cast<size_t>(m_object[static_cast<size_t>(m_blocks[b].first)])];
-        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> b0(base.values.data() + 9 * b);
-        const Eigen::Matrix3d turned = r * b0 * r.transpose();
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                values[m_block_value[9 * b + static_cast<size_t>(3 * i + j)]] = turned(i, j);
-    }
-    for (const std::int32_t v : with_extra) {
-        const size_t u = static_cast<size_t>(v);
-        if (m_node[8 * u] < 0) continue;
-        const double* e = extra.data() + 6 * u;
-        const double blk[9] = {e[0], e[3], e[4], e[3], e[1], e[5], e[4], e[5], e[2]};
-        for (size_t s = 0; s < 8; ++s)
-            for (size_t t = 0; t < 8; ++t) {
-                const double w = m_weight[8 * u + s] * m_weight[8 * u + t];
-                if (w == 0) continue;
-                const size_t b = static_cast<size_t>(m_vertex_blocks[64 * u + 8 * s + t]);
-                for (size_t q = 0; q < 9; ++q)
-                    values[m_block_value[9 * b + q]] += w * blk[q];
+    const bool parallel = m_threads > 1 && m_blocks.size() > 2048;
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel num_threads(m_threads) if (parallel)
+#endif
+    {
+        std::int32_t lo = 0, hi = m_nodes;
+#ifdef TETHASH_HAVE_OPENMP
+        const std::int32_t part = omp_get_thread_num(), parts = omp_get_num_threads();
+        lo = static_cast<std::int32_t>(static_cast<std::int64_t>(m_nodes) * part / parts);
+        hi = static_cast<std::int32_t>(static_cast<std::int64_t>(m_nodes) * (part + 1) / parts);
+#endif
+        for (size_t b = 0; b < m_blocks.size(); ++b) {
+            const std::int32_t row = m_blocks[b].first;
+            if (row < lo || row >= hi) continue;
+            const Eigen::Matrix3d& r = m_rotation[static_cast<size_t>(m_object[static_cast<size_t>(row)])];
+            const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> b0(base.values.data() + 9 * b);
+            const Eigen::Matrix3d turned = r * b0 * r.transpose();
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    values[m_block_value[9 * b + static_cast<size_t>(3 * i + j)]] = turned(i, j);
+        }
+        for (const std::int32_t v : with_extra) {
+            const size_t u = static_cast<size_t>(v);
+            if (m_node[8 * u] < 0) continue;
+            const double* e = extra.data() + 6 * u;
+            const double blk[9] = {e[0], e[3], e[4], e[3], e[1], e[5], e[4], e[5], e[2]};
+            for (size_t s = 0; s < 8; ++s) {
+                const std::int32_t row = m_node[8 * u + s];
+                if (row < lo || row >= hi) continue;
+                for (size_t t = 0; t < 8; ++t) {
+                    const double w = m_weight[8 * u + s] * m_weight[8 * u + t];
+                    if (w == 0) continue;
+                    const size_t b = static_cast<size_t>(m_vertex_blocks[64 * u + 8 * s + t]);
+                    for (size_t q = 0; q < 9; ++q)
+                        values[m_block_value[9 * b + q]] += w * blk[q];
+                }
             }
+        }
     }
     if (!m_analysed) {
         m_solver.analyzePattern(m_matrix);
@@ -369,28 +525,79 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
     return m_solver.info() == Eigen::Success;
 }
 
+Eigen::MatrixXd CoarseSpace::start_matrix(double h)
+{
+    Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * m_nodes, 3 * m_nodes);
+    if (m_nodes == 0) return out;
+    const Cached& base = cached(h);
+    for (size_t b = 0; b < m_blocks.size(); ++b)
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                out(3 * m_blocks[b].first + r, 3 * m_blocks[b].second + c) =
+                    base.values[9 * b + static_cast<size_t>(3 * r + c)];
+    return out;
+}
+
+Eigen::SparseMatrix<double> CoarseSpace::prolongation() const
+{
+    const size_t un = m_node.size() / 8;
+    std::vector<Eigen::Triplet<double>> trip;
+    for (size_t i = 0; i < un; ++i)
+        for (size_t k = 0; k < 8; ++k)
+            if (m_node[8 * i + k] >= 0)
+                for (int r = 0; r < 3; ++r)
+                    trip.emplace_back(static_cast<Index>(3 * i) + r, 3 * m_node[8 * i + k] + r, m_weight[8 * i + k]);
+    Eigen::SparseMatrix<double> p(static_cast<Index>(3 * un), 3 * m_nodes);
+    p.setFromTriplets(trip.begin(), trip.end());
+    return p;
+}
+
 void CoarseSpace::correct(const std::vector<double>& r, std::vector<double>& dx)
 {
     const Model& model = *m_model;
     const size_t un = model.mass.size();
-    // Each free vertex in a lattice with each of its 8 nodes and weights: restriction Pᵀ r, then prolongation P dc.
-    auto each_weight = [&](auto f) {
-        for (size_t i = 0; i < un; ++i)
-            if (m_node[8 * i] >= 0 && !model.fixed[i])
-                for (size_t k = 0; k < 8; ++k)
-                    f(3 * i, 3 * static_cast<Index>(m_node[8 * i + k]), m_weight[8 * i + k]);
-    };
-    m_rc.setZero(3 * m_nodes);
-    each_weight([&](size_t v, Index node, double w) {
-        for (Index q = 0; q < 3; ++q)
-            m_rc[node + q] += w * r[v + static_cast<size_t>(q)];
-    });
-    m_dc = m_solver.solve(m_rc);
-    dx.assign(3 * un, 0.0);
-    each_weight([&](size_t v, Index node, double w) {
-        for (Index q = 0; q < 3; ++q)
-            dx[v + static_cast<size_t>(q)] += w * m_dc[node + q];
-    });
+    // Restriction Pᵀ r node by node (each node's sum over its vertices in vertex order, whatever the threads), the
+    // lattice's solve, then the prolongation P dc vertex by vertex (each vertex's 8 nodes in order).
+    m_rc.resize(3 * m_nodes);
+    m_dc.resize(3 * m_nodes);
+    dx.resize(3 * un);
+    const std::int32_t nodes = m_nodes;
+    const std::int64_t vertices = static_cast<std::int64_t>(un);
+    const bool parallel = m_threads > 1 && un > 4096;
+    double* rc = m_rc.data();
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(m_threads) schedule(static) if (parallel)
+#endif
+    for (std::int32_t node = 0; node < nodes; ++node) {
+        double s[3] = {0.0, 0.0, 0.0};
+        for (std::int32_t at = m_node_start[static_cast<size_t>(node)];
+             at < m_node_start[static_cast<size_t>(node) + 1]; ++at) {
+            const size_t v = 3 * static_cast<size_t>(m_node_vertex[static_cast<size_t>(at)]);
+            const double w = m_node_weight[static_cast<size_t>(at)];
+            for (size_t q = 0; q < 3; ++q)
+                s[q] += w * r[v + q];
+        }
+        for (size_t q = 0; q < 3; ++q)
+            rc[3 * static_cast<size_t>(node) + q] = s[q];
+    }
+    m_dc.noalias() = m_solver.solve(m_rc);
+    const double* dc = m_dc.data();
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(m_threads) schedule(static) if (parallel)
+#endif
+    for (std::int64_t iv = 0; iv < vertices; ++iv) {
+        const size_t i = static_cast<size_t>(iv);
+        double s[3] = {0.0, 0.0, 0.0};
+        if (m_node[8 * i] >= 0 && !model.fixed[i])
+            for (size_t k = 0; k < 8; ++k) {
+                const size_t node = 3 * static_cast<size_t>(m_node[8 * i + k]);
+                const double w = m_weight[8 * i + k];
+                for (size_t q = 0; q < 3; ++q)
+                    s[q] += w * dc[node + q];
+            }
+        for (size_t q = 0; q < 3; ++q)
+            dx[3 * i + q] = s[q];
+    }
 }
 
 } // namespace tethash::sim::detail

@@ -30,6 +30,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
+#include <algorithm>
 #include <cstdint>
 #include <unordered_map>
 #include <utility>
@@ -60,6 +61,16 @@ class CoarseSpace {
     bool prepare(double h, const double* x4, const std::vector<double>& extra,
                  const std::vector<std::int32_t>& with_extra);
 
+    /// Threads for the restriction, the prolongation and the matrix's refresh (the result is the same at any count).
+    void set_threads(int threads) { m_threads = std::max(1, threads); }
+
+    /// The start-state matrix Pᵀ (K + C/h + M/h²) P of substep length h (dense; for tests).
+    Eigen::MatrixXd start_matrix(double h);
+    /// P (3n × 3 nodes): the trilinear weights of each vertex in a lattice on its 8 nodes (for tests).
+    Eigen::SparseMatrix<double> prolongation() const;
+    /// The matrix of the last prepare() that factorised (for tests).
+    const Eigen::SparseMatrix<double>& matrix() const { return m_matrix; }
+
     /// The lattice's Newton step for the residual r (flat 3n, per vertex −∇G), interpolated to the vertices: dx
     /// (flat 3n; fixed vertices 0).
     void correct(const std::vector<double>& r, std::vector<double>& dx);
@@ -83,10 +94,18 @@ class CoarseSpace {
         double mass = 0;
     };
     std::vector<Object> m_objects;
-    // Block pattern: blocks (I, J) of the coarse matrix, the scalar positions of each in the CSR matrix.
+    // Block pattern (once per lattice): blocks (I, J) of the coarse matrix, the scalar positions of each in the CSR
+    // matrix, found per object in a dense node × node table.
     std::vector<std::pair<std::int32_t, std::int32_t>> m_blocks;
-    std::vector<std::int32_t> m_block_value;                      ///< 9 per block: index into the matrix's value array
-    std::unordered_map<std::int64_t, std::int32_t> m_block_index; ///< node I · nodes + node J → its block
+    std::vector<std::int32_t> m_block_value;  ///< 9 per block: index into the matrix's value array
+    std::vector<std::int32_t> m_object_first; ///< per object its first node (nodes of an object are consecutive); +1
+    std::vector<size_t> m_local_offset;       ///< per object: start of its table in m_local_block; +1
+    std::vector<std::int32_t> m_local_block;  ///< per object: (I − first) · count + (J − first) → block, or −1
+    std::unordered_map<std::int64_t, std::int32_t> m_cross_block; ///< I · nodes + J → block, I and J of two objects
+    // Per node the free vertices it interpolates, in vertex order, and their weights (the restriction Pᵀ r).
+    std::vector<std::int32_t> m_node_start, m_node_vertex;
+    std::vector<double> m_node_weight;
+    int m_threads = 1;
     std::vector<std::int32_t> m_vertex_blocks; ///< 64 per vertex: the block of (node a, node b) of its 8 × 8
     Eigen::SparseMatrix<double> m_matrix;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_solver;
@@ -100,6 +119,8 @@ class CoarseSpace {
     Eigen::VectorXd m_rc, m_dc;
 
     const Cached& cached(double h);
+    void build_pattern();
+    std::int32_t block_at(std::int32_t bi, std::int32_t bj) const; ///< −1: not in the pattern
 };
 
 } // namespace tethash::sim::detail
