@@ -40,6 +40,9 @@ void grow(Box& b, const Box& c)
     }
 }
 
+/// The grids' cell size in mean boundary edges (before the doubling of a fast step).
+constexpr double cell_edges = 3;
+
 /// The threads a parallel loop asked for `threads` (0: all) runs on.
 int thread_slots(int threads)
 {
@@ -252,15 +255,18 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
         s.edge_moving[e] = is_moving(edges(ei, 0)) || is_moving(edges(ei, 1));
         length += (x0.row(edges(ei, 0)) - x0.row(edges(ei, 1))).norm();
     }
-    // Cell size: the mean boundary edge at the start (every primitive queries the grids), doubled while the swept boxes
-    // would cover more than 64 cells each on average (a fast step), and at least 2^-20 of the extent.
+    // Cell size: three mean boundary edges at the start (every primitive queries the grids), doubled while the swept
+    // boxes would cover more than 64 cells each on average (a fast step), and at least 2^-20 of the extent. Cells of
+    // one edge put a swept box in 4-8 cells, and a query met most of its boxes in several of them (a stamp each): on
+    // the hand's sweeps at 1/60 cells of three edges took the sweep from 11.8 to 7.6 ms of CPU time, at 1/240 from
+    // 3.0 to 2.6 ms (four edges: the same within 2 %).
     Box all = s.face_box[0];
     for (const Box& b : s.face_box)
         grow(all, b);
     double extent = 0;
     for (int k = 0; k < 3; ++k)
         extent = std::max(extent, all.hi[k] - all.lo[k]);
-    double cell = ne > 0 ? length / static_cast<double>(ne) : 0;
+    double cell = ne > 0 ? cell_edges * length / static_cast<double>(ne) : 0;
     cell = std::max(cell, std::ldexp(extent, -20));
     if (!(cell > 0) || !std::isfinite(cell)) cell = 1;
     // The grids hold the moving primitives (every one without a mask) and every primitive queries them: a pair is a
@@ -348,7 +354,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
             s.face_grid.query(vb.lo, vb.hi, w.stamp.data(), static_cast<std::int32_t>(i), w.hits, false,
                               [&](std::int32_t k) {
                                   const Index f = s.face_ids[static_cast<std::size_t>(k)];
-                                  if (!overlap(vb, s.face_box[static_cast<std::size_t>(f)]) || shares_face(v, f))
+                                  if (shares_face(v, f) || !overlap(vb, s.face_box[static_cast<std::size_t>(f)]))
                                       return;
                                   vertex_face(v, f);
                               });
@@ -378,17 +384,17 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
             const bool e_moving = s.edge_moving[static_cast<std::size_t>(e)] != 0;
             const Box& eb = s.edge_box[static_cast<std::size_t>(e)];
             if (masked && !e_moving && !s.edge_cells.meets(eb)) continue;
-            s.edge_grid.query(
-                eb.lo, eb.hi, w.stamp.data(), static_cast<std::int32_t>(e), w.hits, false, [&](std::int32_t k) {
-                    const Index g = s.edge_ids[static_cast<std::size_t>(k)];
-                    if (g == e || (e_moving && g < e) || !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]) ||
-                        shares_edge(static_cast<Index>(e), g))
-                        return;
-                    if (g > e)
-                        edge_edge(static_cast<Index>(e), g);
-                    else
-                        edge_edge(g, static_cast<Index>(e));
-                });
+            s.edge_grid.query(eb.lo, eb.hi, w.stamp.data(), static_cast<std::int32_t>(e), w.hits, false,
+                              [&](std::int32_t k) {
+                                  const Index g = s.edge_ids[static_cast<std::size_t>(k)];
+                                  if (g == e || (e_moving && g < e) || shares_edge(static_cast<Index>(e), g) ||
+                                      !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]))
+                                      return;
+                                  if (g > e)
+                                      edge_edge(static_cast<Index>(e), g);
+                                  else
+                                      edge_edge(g, static_cast<Index>(e));
+                              });
         }
     }
     for (int r = 0; r < threads; ++r) {
