@@ -87,16 +87,16 @@ TEST(CoreBoxGrid, QueryMeetsEachMeetingBoxOnce)
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> where(-3.0, 3.0), size(0.0, 1.5);
     std::vector<std::array<double, 6>> boxes(300);
-    detail::BoxGrid grid;
-    grid.begin(0.5, 64, boxes.size());
-    for (auto& b : boxes) {
+    for (auto& b : boxes)
         for (int k = 0; k < 3; ++k) {
             b[static_cast<size_t>(k)] = where(rng);
             b[static_cast<size_t>(3 + k)] = b[static_cast<size_t>(k)] + (rng() % 4 == 0 ? 0.0 : size(rng));
         }
-        grid.add(b.data(), b.data() + 3);
-    }
-    grid.finish();
+    detail::BoxGrid grid;
+    grid.build(0.5, 64, boxes.size(), [&](std::int32_t i, double lo[3], double hi[3]) {
+        std::copy(boxes[static_cast<size_t>(i)].begin(), boxes[static_cast<size_t>(i)].begin() + 3, lo);
+        std::copy(boxes[static_cast<size_t>(i)].begin() + 3, boxes[static_cast<size_t>(i)].end(), hi);
+    });
     std::vector<std::int32_t> stamp(boxes.size(), -1), hits;
     int met = 0;
     for (std::int32_t query = 0; query < 400; ++query) {
@@ -136,8 +136,9 @@ TEST(CoreBoxGrid, QueryMeetsEachMeetingBoxOnce)
 TEST(CoreBoxGrid, TeamBuildIsTheGridOfOneThread)
 {
     // The grid built by teams of 1, 2 and 3 threads (each its part of the boxes, counts, cursors, scatter) visits
-    // every query's boxes in the same order as the grid of begin/add/finish: the same buckets holding the same
-    // boxes in the same order. Also with fewer boxes than threads, and none.
+    // every query's boxes in the same order as the grid one thread builds alone: the same buckets holding the same
+    // boxes in the same order. Also with fewer boxes than threads, and none; and grids built alone by each thread of
+    // a region (a caller inside someone else's team) are that grid too.
     std::mt19937 rng(17);
     std::uniform_real_distribution<double> where(-3.0, 3.0), size(0.0, 1.5);
     for (const std::size_t count : {std::size_t{500}, std::size_t{2}, std::size_t{0}}) {
@@ -147,24 +148,24 @@ TEST(CoreBoxGrid, TeamBuildIsTheGridOfOneThread)
                 b[static_cast<size_t>(k)] = where(rng);
                 b[static_cast<size_t>(3 + k)] = b[static_cast<size_t>(k)] + (rng() % 4 == 0 ? 0.0 : size(rng));
             }
-        detail::BoxGrid serial;
-        serial.begin(0.5, 128, boxes.size());
-        for (const auto& b : boxes)
-            serial.add(b.data(), b.data() + 3);
-        serial.finish();
         const auto box_of = [&](std::int32_t i, double lo[3], double hi[3]) {
             for (int k = 0; k < 3; ++k) {
                 lo[k] = boxes[static_cast<size_t>(i)][static_cast<size_t>(k)];
                 hi[k] = boxes[static_cast<size_t>(i)][static_cast<size_t>(3 + k)];
             }
         };
+        detail::BoxGrid serial;
+        serial.build(0.5, 128, boxes.size(), box_of);
+        detail::BoxGrid alone[2];
+#pragma omp parallel num_threads(2)
+        alone[detail::team_rank() % 2].build(0.5, 128, boxes.size(), box_of);
         for (const int threads : {1, 2, 3}) {
             detail::BoxGrid team;
             for (int round = 0; round < 2; ++round) { // a second build reuses the parts' buffers
                 int team_size = 1;
 #pragma omp parallel num_threads(threads)
                 {
-                    team.build_team(0.5, 128, boxes.size(), box_of);
+                    team.build(0.5, 128, boxes.size(), box_of, detail::team_rank(), detail::team_size());
 #pragma omp single
                     team_size = detail::team_size();
                 }
@@ -182,6 +183,11 @@ TEST(CoreBoxGrid, TeamBuildIsTheGridOfOneThread)
                     std::vector<std::int32_t> a, b;
                     serial.query(lo, hi, stamp_a.data(), query, hits, false, [&](std::int32_t i) { a.push_back(i); });
                     team.query(lo, hi, stamp_b.data(), query, hits, false, [&](std::int32_t i) { b.push_back(i); });
+                    for (const detail::BoxGrid& own : alone) {
+                        std::vector<std::int32_t> c, stamp_c(boxes.size() + 1, -1);
+                        own.query(lo, hi, stamp_c.data(), query, hits, false, [&](std::int32_t i) { c.push_back(i); });
+                        EXPECT_EQ(a, c) << count << " boxes, a grid built alone in a region, query " << query;
+                    }
                     EXPECT_EQ(a, b) << count << " boxes, " << threads << " threads, round " << round << ", query "
                                     << query;
                     visits += static_cast<int>(a.size());

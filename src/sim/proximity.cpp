@@ -197,14 +197,16 @@ void Proximity::hash_faces(const Positions& x)
     size_t buckets = 1;
     while (buckets < 2 * nf)
         buckets <<= 1;
-    m_grid.build_team(cell_edges * m_edge, buckets, nf, [&](std::int32_t i, double lo[3], double hi[3]) {
+    // Called alone or by every thread of the update's region: each its part of the faces.
+    const auto box_of = [&](std::int32_t i, double lo[3], double hi[3]) {
         const Face& fc = m_faces[static_cast<size_t>(i)];
         const double grow = face_reach(m_reach, fc) + m_margin_max;
         for (int k = 0; k < 3; ++k) {
             lo[k] = std::min({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) - grow;
             hi[k] = std::max({x(fc.v[0], k), x(fc.v[1], k), x(fc.v[2], k)}) + grow;
         }
-    });
+    };
+    m_grid.build(cell_edges * m_edge, buckets, nf, box_of, tethash::detail::team_rank(), tethash::detail::team_size());
 }
 
 // Inlined into query_cells' loop: the query's fields stay in registers, as in one function.

@@ -305,16 +305,9 @@ bool SimulationImpl::entered_unseen()
     watched.clear();
     for (const Contact& c : contacts.contacts())
         if (c.tet >= 0) watched.emplace_back(c.vertex, c.tet_object);
-    const auto middle = static_cast<std::ptrdiff_t>(watched.size());
     for (const Contact& c : contacts.margin_contacts())
         watched.emplace_back(c.vertex, c.tet_object);
-    // Both parts come sorted (contacts by vertex then tet, an object's tets in one run; margin contacts by vertex
-    // then object): merged in linear time; sorted whole where a part is not.
-    const auto mid = watched.begin() + middle;
-    if (std::is_sorted(watched.begin(), mid) && std::is_sorted(mid, watched.end()))
-        std::inplace_merge(watched.begin(), mid, watched.end());
-    else
-        std::sort(watched.begin(), watched.end());
+    std::sort(watched.begin(), watched.end());
     return unseen;
 }
 
@@ -512,9 +505,9 @@ void Simulation::step()
                 break;
             }
             // A far part entered within the last substep, unseen by its contacts: the step again in more substeps.
-            // (The watch is kept for the sweep too.)
-            const bool watch = s.scene.crossing_check || sweeping;
-            if (watch && s.entered_unseen() && s.scene.crossing_check && sub > 0 && substeps * 2 <= max_substeps) {
+            // (entered_unseen also refreshes the watched pairs, which the sweep reads.)
+            const bool unseen = (s.scene.crossing_check || sweeping) && s.entered_unseen();
+            if (unseen && s.scene.crossing_check && sub > 0 && substeps * 2 <= max_substeps) {
                 crossed = true;
                 break;
             }

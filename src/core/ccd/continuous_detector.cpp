@@ -71,10 +71,11 @@ void fill_grid(detail::BoxGrid& grid, double cell, const std::vector<Box>& boxes
 {
     const std::int64_t total = cells_of(boxes, ids, 1 / cell);
     const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
-    grid.begin(cell, static_cast<std::size_t>(buckets), ids.size());
-    for (const std::int32_t i : ids)
-        grid.add(boxes[static_cast<std::size_t>(i)].lo, boxes[static_cast<std::size_t>(i)].hi);
-    grid.finish();
+    grid.build(cell, static_cast<std::size_t>(buckets), ids.size(), [&](std::int32_t k, double lo[3], double hi[3]) {
+        const Box& b = boxes[static_cast<std::size_t>(ids[static_cast<std::size_t>(k)])];
+        std::copy(b.lo, b.lo + 3, lo);
+        std::copy(b.hi, b.hi + 3, hi);
+    });
 }
 
 /// Which coarse cells (cell size `coarse`) some box of a grid meets, as bits hashed from the cells: a query box none

@@ -116,10 +116,11 @@ class FaceGrid {
             cell *= 2;
         }
         const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
-        m_grid.begin(cell, static_cast<std::size_t>(buckets), nf);
-        for (const Box& b : m_box)
-            m_grid.add(b.lo, b.hi);
-        m_grid.finish();
+        m_grid.build(cell, static_cast<std::size_t>(buckets), nf, [&](std::int32_t i, double lo[3], double hi[3]) {
+            const Box& b = m_box[static_cast<std::size_t>(i)];
+            std::copy(b.lo, b.lo + 3, lo);
+            std::copy(b.hi, b.hi + 3, hi);
+        });
     }
 
     /// Calls visit(f) once for every triangle whose box meets the box lo..hi. `stamp`, `tag` and `hits` as

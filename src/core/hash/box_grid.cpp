@@ -81,16 +81,6 @@ const char* box_filter_name()
     return chosen_box_filter == box_filter_scalar ? "scalar" : "avx2";
 }
 
-void BoxGrid::begin(double cell, std::size_t buckets, std::size_t boxes)
-{
-    m_inv = 1.0 / cell;
-    m_mask = static_cast<std::uint32_t>(buckets - 1);
-    m_box.clear();
-    m_box.reserve(boxes);
-    m_entries.clear();
-    m_start.assign(buckets + 1, 0);
-}
-
 void BoxGrid::lay_out(std::size_t entries)
 {
     for (int k = 0; k < 3; ++k) {
@@ -102,19 +92,6 @@ void BoxGrid::lay_out(std::size_t entries)
                   -std::numeric_limits<float>::infinity());
     }
     m_item.resize(entries);
-}
-
-void BoxGrid::finish()
-{
-    for (const auto& e : m_entries)
-        ++m_start[e.first + 1];
-    const std::size_t buckets = m_start.size() - 1;
-    for (std::size_t b = 0; b < buckets; ++b)
-        m_start[b + 1] += m_start[b];
-    lay_out(m_entries.size());
-    m_cursor.assign(m_start.begin(), m_start.end() - 1);
-    for (const auto& [b, i] : m_entries)
-        place(static_cast<std::size_t>(m_cursor[b]++), i);
 }
 
 } // namespace tethash::detail

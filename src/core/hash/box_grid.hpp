@@ -52,27 +52,20 @@ class BoxGrid {
     /// The cell of coordinate v, with inv = 1 / cell size.
     static std::int64_t cell_of(double v, double inv) { return static_cast<std::int64_t>(std::floor(v * inv)); }
 
-    /// Starts a build: cells of size `cell`, `buckets` buckets (a power of two), room for `boxes` boxes.
-    void begin(double cell, std::size_t buckets, std::size_t boxes);
-    /// The next box (0, 1, ... in the order added): entered in every cell it meets.
-    void add(const double lo[3], const double hi[3])
+    /// Builds the grid of boxes 0, 1, ..., count − 1 (cells of size `cell`, `buckets` buckets, a power of two).
+    /// box_of(i, lo, hi) writes box i's corners, once per box. Alone (rank 0 of 1 part) the calling thread builds it
+    /// all; split over a team, every thread of an OpenMP region calls it with the same arguments, its `rank` and the
+    /// team's size as `parts`, fills the boxes of its contiguous part of [0, count), counts its
+    /// entries per bucket, turns the counts into cursors for its share of the buckets and scatters its own entries:
+    /// a bucket holds its boxes in box order whatever the split, and the grid is complete for every thread on return.
+    /// (The split is the caller's to give, not read from the enclosing team: a caller inside someone else's region
+    /// builds its grid alone.)
+    template <class BoxOf>
+    void build(double cell, std::size_t buckets, std::size_t count, BoxOf&& box_of, int rank = 0, int parts = 1)
     {
-        const auto i = static_cast<std::int32_t>(m_box.size());
-        m_box.emplace_back();
-        enter(i, lo, hi, m_entries);
-    }
-    /// Counting-sorts the entries by bucket and lays out the buckets' boxes: the grid is ready for queries.
-    void finish();
-
-    /// The same grid as begin(cell, buckets, count), add() of boxes 0, 1, ..., count − 1 in order and finish(),
-    /// built by the current team (every thread of an OpenMP region calls it with the same arguments; outside a
-    /// region, one thread builds it all). box_of(i, lo, hi) writes box i's corners, once per box, from the thread
-    /// whose contiguous part of [0, count) holds i. Each part's entries are counted per bucket, the counts turned
-    /// into each part's cursors (buckets split over the team), and each part scatters its own entries: a bucket
-    /// holds its boxes in box order whatever the team's size. The grid is complete for every thread on return.
-    template <class BoxOf> void build_team(double cell, std::size_t buckets, std::size_t count, BoxOf&& box_of)
-    {
-        const int rank = team_rank(), parts = team_size();
+        const auto barrier = [parts] {
+            if (parts > 1) team_barrier();
+        };
         if (rank == 0) {
             m_inv = 1.0 / cell;
             m_mask = static_cast<std::uint32_t>(buckets - 1);
@@ -80,7 +73,7 @@ class BoxGrid {
             m_part.resize(static_cast<std::size_t>(parts));
             m_start.resize(buckets + 1);
         }
-        team_barrier();
+        barrier();
         Part& mine = m_part[static_cast<std::size_t>(rank)];
         mine.entries.clear();
         mine.count.assign(buckets, 0);
@@ -93,7 +86,7 @@ class BoxGrid {
         }
         for (const auto& e : mine.entries)
             ++mine.count[e.first];
-        team_barrier();
+        barrier();
         // This thread's buckets: their sizes summed over the parts; then, from the sums of the buckets before them,
         // where each part's entries of each bucket go.
         std::int64_t b0 = 0, b1 = 0;
@@ -103,7 +96,7 @@ class BoxGrid {
             for (const Part& part : m_part)
                 sum += part.count[b];
         mine.bucket_sum = sum;
-        team_barrier();
+        barrier();
         std::int32_t at = 0;
         for (int r = 0; r < rank; ++r)
             at += m_part[static_cast<std::size_t>(r)].bucket_sum;
@@ -119,10 +112,10 @@ class BoxGrid {
             m_start[buckets] = at;
             lay_out(static_cast<std::size_t>(at));
         }
-        team_barrier();
+        barrier();
         for (const auto& [b, i] : mine.entries)
             place(static_cast<std::size_t>(mine.count[b]++), i);
-        team_barrier();
+        barrier();
     }
 
     /// Calls visit(i) once for every box i whose box meets lo..hi (in single precision: a filter), bucket by bucket
@@ -205,7 +198,7 @@ class BoxGrid {
         }
         m_item[at] = i;
     }
-    /// One thread's part of a team build: its entries, then its count per bucket, then its cursor per bucket.
+    /// One thread's part of a split build: its entries, then its count per bucket, then its cursor per bucket.
     struct Part {
         Entries entries;
         std::vector<std::int32_t> count;
@@ -215,13 +208,11 @@ class BoxGrid {
     double m_inv = 1;
     std::uint32_t m_mask = 0;
     std::vector<Box> m_box;            ///< per box, rounded outwards
-    Entries m_entries;                 ///< (bucket, box) in the order entered
     std::vector<std::int32_t> m_start; ///< per bucket + 1: its entries' range
     /// Per entry, in bucket order, column by column (lo x, y, z, hi x, y, z), padded by eight entries that no box
     /// meets.
     std::vector<float> m_column[6];
-    std::vector<std::int32_t> m_item;   ///< per entry: its box
-    std::vector<std::int32_t> m_cursor; ///< scratch of finish: the fill cursor per bucket
+    std::vector<std::int32_t> m_item; ///< per entry: its box
 };
 
 } // namespace tethash::detail
