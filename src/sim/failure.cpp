@@ -1,5 +1,7 @@
 #include "failure.hpp"
 
+#include "block_sum.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -85,36 +87,32 @@ void FailureCheck::setup(const Model& model, const Positions& x, const Positions
 std::int64_t find_inverted_tets(const Model& model, const Positions& x, std::vector<std::int32_t>& out, double* volume,
                                 int threads)
 {
-    (void)threads; // without OpenMP every block runs on the calling thread
-    // Blocks of a fixed size, each with its own list and sum, joined in block order: the same at any thread count.
-    constexpr Index block = 4096;
-    const Index nt = static_cast<Index>(model.volumes.tets.rows());
-    const Index blocks = (nt + block - 1) / block;
-    std::vector<std::vector<std::int32_t>> lists(static_cast<size_t>(blocks));
-    std::vector<double> sums(static_cast<size_t>(blocks), 0.0);
-#ifdef TETHASH_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
-#endif
-    for (Index b = 0; b < blocks; ++b) {
+    // Per block of tets its list and its sum, joined in block order.
+    struct Found {
+        std::vector<std::int32_t> tets;
         double six_volume = 0;
-        std::vector<std::int32_t>& list = lists[static_cast<size_t>(b)];
-        for (Index t = b * block; t < std::min(nt, (b + 1) * block); ++t) {
+        Found& operator+=(const Found& o)
+        {
+            tets.insert(tets.end(), o.tets.begin(), o.tets.end());
+            six_volume += o.six_volume;
+            return *this;
+        }
+    };
+    const Index nt = static_cast<Index>(model.volumes.tets.rows());
+    Found found = detail::block_sum<Found>(nt, threads, [&](Index begin, Index end) {
+        Found part;
+        for (Index t = begin; t < end; ++t) {
             const auto tet = model.volumes.tets.row(t);
             const Eigen::Vector3d a = x.row(tet(0)).transpose();
             const double w = (x.row(tet(1)).transpose() - a)
                                  .dot((x.row(tet(2)).transpose() - a).cross(x.row(tet(3)).transpose() - a));
-            six_volume += w;
-            if (!(w > 0)) list.push_back(static_cast<std::int32_t>(t));
+            part.six_volume += w;
+            if (!(w > 0)) part.tets.push_back(static_cast<std::int32_t>(t));
         }
-        sums[static_cast<size_t>(b)] = six_volume;
-    }
-    out.clear();
-    double six_volume = 0;
-    for (Index b = 0; b < blocks; ++b) {
-        out.insert(out.end(), lists[static_cast<size_t>(b)].begin(), lists[static_cast<size_t>(b)].end());
-        six_volume += sums[static_cast<size_t>(b)];
-    }
-    if (volume) *volume = six_volume / 6;
+        return part;
+    });
+    out.swap(found.tets);
+    if (volume) *volume = found.six_volume / 6;
     return static_cast<std::int64_t>(out.size());
 }
 

@@ -1,5 +1,7 @@
 #include "tethash/sim/model.hpp"
 
+#include "block_sum.hpp"
+
 #include "tethash/error.hpp"
 
 #include <Eigen/Geometry>
@@ -334,24 +336,6 @@ void Model::add_forces(const Positions& x, const Positions& v, Positions& f, con
 
 namespace {
 
-/// Sums f(begin, end) over [0, n) in blocks of a fixed size, each block's partial kept and the partials added in
-/// block order: the same bits whatever the number of threads that computed the blocks.
-template <class T, class F> T block_sum(Index n, int threads, F&& f)
-{
-    constexpr Index block = 4096;
-    const Index blocks = (n + block - 1) / block;
-    std::vector<T> part(static_cast<size_t>(blocks));
-#ifdef TETHASH_HAVE_OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && blocks > 1)
-#endif
-    for (Index b = 0; b < blocks; ++b)
-        part[static_cast<size_t>(b)] = f(b * block, std::min(n, (b + 1) * block));
-    T sum{};
-    for (const T& p : part)
-        sum += p;
-    return sum;
-}
-
 struct VertexSums {
     double kinetic = 0, gravity = 0, ground = 0;
     VertexSums& operator+=(const VertexSums& o)
@@ -367,7 +351,7 @@ struct VertexSums {
 
 Energy Model::energy(const Positions& x, const Positions& v, int threads) const
 {
-    (void)threads; // without OpenMP every block runs on the calling thread
+    using detail::block_sum;
     Energy en;
     const VertexSums vs = block_sum<VertexSums>(num_vertices(), threads, [&](Index begin, Index end) {
         VertexSums p;
