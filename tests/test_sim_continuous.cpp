@@ -63,17 +63,14 @@ ObjectSpec bar(const Eigen::Vector3d& size, const Eigen::Vector3d& at)
                 x.emplace_back(i - 0.5, j - 0.5, k - 0.5);
     const auto id = [](int i, int j, int k) { return static_cast<Index>(i + 2 * (j + 2 * k)); };
     const auto tets = kuhn_tets(0, 0, 0, id);
-    ObjectSpec o;
+    // The shared test box's material and options, with this mesh in place of the generated one.
+    ObjectSpec o = test::box_object(1.0, at);
+    o.generate.reset();
     TetMesh m;
     m.positions = matrix_of<Positions>(x);
     m.tets = matrix_of<Tets>(std::vector<std::array<Index, 4>>(tets.begin(), tets.end()));
     o.data = m;
     o.scale = size;
-    o.translate = at;
-    o.material.density = 100;
-    o.material.young = 1e4;
-    o.material.damping = 0.01;
-    o.self_collision = false;
     return o;
 }
 
