@@ -133,6 +133,44 @@ TEST(CoreBoxGrid, QueryMeetsEachMeetingBoxOnce)
     EXPECT_GT(met, 200);
 }
 
+TEST(CoreBoxGrid, QueryAboveMeetsTheHigherBoxesOnly)
+{
+    // Boxes of the grid querying it with query_above(their own index): each box meets the boxes above it that meet
+    // its box, once, and never itself or a box below (each pair once, from its lower box).
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> where(-2.0, 2.0), size(0.0, 1.2);
+    std::vector<std::array<double, 6>> boxes(250);
+    for (auto& b : boxes)
+        for (int k = 0; k < 3; ++k) {
+            b[static_cast<size_t>(k)] = where(rng);
+            b[static_cast<size_t>(3 + k)] = b[static_cast<size_t>(k)] + (rng() % 4 == 0 ? 0.0 : size(rng));
+        }
+    const auto meet = [](const std::array<double, 6>& a, const std::array<double, 6>& b) {
+        return a[0] <= b[3] && a[1] <= b[4] && a[2] <= b[5] && b[0] <= a[3] && b[1] <= a[4] && b[2] <= a[5];
+    };
+    detail::BoxGrid grid;
+    grid.build(0.5, 64, boxes.size(), [&](std::int32_t i, double lo[3], double hi[3]) {
+        std::copy(boxes[static_cast<size_t>(i)].begin(), boxes[static_cast<size_t>(i)].begin() + 3, lo);
+        std::copy(boxes[static_cast<size_t>(i)].begin() + 3, boxes[static_cast<size_t>(i)].end(), hi);
+    });
+    std::vector<std::int32_t> stamp(boxes.size(), -1), hits;
+    int pairs = 0;
+    for (std::int32_t q = 0; q < static_cast<std::int32_t>(boxes.size()); ++q) {
+        const auto& b = boxes[static_cast<size_t>(q)];
+        std::vector<std::int32_t> want, got;
+        for (std::int32_t i = q + 1; i < static_cast<std::int32_t>(boxes.size()); ++i)
+            if (meet(b, boxes[static_cast<size_t>(i)])) want.push_back(i);
+        grid.query_above(q, b.data(), b.data() + 3, stamp.data(), q, hits, false, [&](std::int32_t i) {
+            EXPECT_GT(i, q) << "query " << q;
+            if (meet(b, boxes[static_cast<size_t>(i)])) got.push_back(i);
+        });
+        std::sort(got.begin(), got.end());
+        EXPECT_EQ(got, want) << "query " << q;
+        pairs += static_cast<int>(want.size());
+    }
+    EXPECT_GT(pairs, 100);
+}
+
 TEST(CoreBoxGrid, TeamBuildIsTheGridOfOneThread)
 {
     // The grid built by teams of 1, 2 and 3 threads (each its part of the boxes, counts, cursors, scatter) visits

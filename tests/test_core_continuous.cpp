@@ -299,3 +299,58 @@ TEST(CoreContinuous, KeptDetectorMovingMaskAndFilter)
     // Positions of another size are refused.
     test::expect_error([&] { d.detect(s.x0.topRows(n - 1), s.x1); }, {"start", "rows"});
 }
+
+TEST(CoreContinuous, KeptDetectorMeetsEachPairOnce)
+{
+    // The broad phase's work: the pairs its grid meets are at most the pairs whose boxes (grown by the grid's
+    // single-precision rounding) meet, each once (a moving edge does not meet the other half of a moving pair, nor
+    // itself), and at least the candidates; without a mask and with one (pairs with a moving primitive only).
+    const Scene s = two_blocks({1.6, 0.3, 0.2}, {-1.5, 0.2, -0.1}, 0.05, 3);
+    const auto n = static_cast<Index>(s.x0.rows());
+    ContinuousDetector d;
+    d.set_topology(s.tets, n);
+    const Triangles& faces = d.faces();
+    const Edges& edges = d.edges();
+    using Box = std::pair<Eigen::Array3d, Eigen::Array3d>;
+    const auto box = [&](std::initializer_list<Index> ids) {
+        Box b{Eigen::Array3d::Constant(INFINITY), Eigen::Array3d::Constant(-INFINITY)};
+        for (const Index v : ids)
+            for (const Positions* x : {&s.x0, &s.x1}) {
+                b.first = b.first.min(x->row(v).transpose().array());
+                b.second = b.second.max(x->row(v).transpose().array());
+            }
+        const Eigen::Array3d grow = 1e-6 * b.first.abs().max(b.second.abs()) + 1e-29;
+        return Box{b.first - grow, b.second + grow};
+    };
+    const auto meet = [](const Box& a, const Box& b) {
+        return !((a.first > b.second).any() || (b.first > a.second).any());
+    };
+    std::vector<Index> vertices(faces.data(), faces.data() + faces.size());
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    for (const bool masked : {false, true}) {
+        std::vector<unsigned char> moving(static_cast<std::size_t>(n), 1);
+        if (masked)
+            for (Index v = 0; v < n / 2; ++v) // block A still
+                moving[static_cast<std::size_t>(v)] = 0;
+        const auto mv = [&](Index v) { return moving[static_cast<std::size_t>(v)] != 0; };
+        std::int64_t bound = 0;
+        for (const Index v : vertices)
+            for (Index f = 0; f < faces.rows(); ++f)
+                bound += (mv(v) || mv(faces(f, 0)) || mv(faces(f, 1)) || mv(faces(f, 2))) &&
+                         meet(box({v}), box({faces(f, 0), faces(f, 1), faces(f, 2)}));
+        for (Index e = 0; e < edges.rows(); ++e)
+            for (Index g = e + 1; g < edges.rows(); ++g)
+                bound += (mv(edges(e, 0)) || mv(edges(e, 1)) || mv(edges(g, 0)) || mv(edges(g, 1))) &&
+                         meet(box({edges(e, 0), edges(e, 1)}), box({edges(g, 0), edges(g, 1)}));
+        for (int threads : {1, 2}) {
+            ContinuousParams p;
+            p.threads = threads;
+            const ContinuousResult& r = masked ? d.detect(s.x0, s.x1, p, moving) : d.detect(s.x0, s.x1, p);
+            const std::string what = (masked ? "masked, " : "") + std::to_string(threads) + " threads";
+            EXPECT_LE(r.broad_phase_pairs, bound) << what;
+            EXPECT_GE(r.broad_phase_pairs, r.vertex_face_candidates + r.edge_edge_candidates) << what;
+            EXPECT_GT(r.edge_edge_candidates, 100) << what;
+        }
+    }
+}

@@ -52,6 +52,10 @@ struct ContinuousResult {
     /// Pairs whose swept boxes overlap and that share no vertex: those handed to the narrow phase.
     std::int64_t vertex_face_candidates = 0;
     std::int64_t edge_edge_candidates = 0;
+    /// ContinuousDetector::detect only (0 elsewhere): the pairs its grid met, those whose boxes passed the grid's
+    /// single-precision test, before the exact box test, the shared-vertex and locality rules and the filter; each
+    /// pair once. The broad phase's work, for studying it.
+    std::int64_t broad_phase_pairs = 0;
 };
 
 /// Continuous detection of the step x0 → x1 (n × 3 each, the same n) of the meshes `tets` (vertex ids into both).

@@ -66,10 +66,10 @@ std::int64_t cells_of(const std::vector<Box>& boxes, const std::vector<std::int3
     return total;
 }
 
-/// The boxes `boxes[i]` (i in `ids`, in order) into `grid` of cell size `cell`.
-void fill_grid(detail::BoxGrid& grid, double cell, const std::vector<Box>& boxes, const std::vector<std::int32_t>& ids)
+/// The boxes `boxes[i]` (i in `ids`, in order) into `grid` of cell size `cell`; `total`: their cells (cells_of).
+void fill_grid(detail::BoxGrid& grid, double cell, const std::vector<Box>& boxes, const std::vector<std::int32_t>& ids,
+               std::int64_t total)
 {
-    const std::int64_t total = cells_of(boxes, ids, 1 / cell);
     const std::int64_t buckets = std::min(next_power_of_two(std::max<std::int64_t>(2 * total, 1)), max_table_size);
     grid.build(cell, static_cast<std::size_t>(buckets), ids.size(), [&](std::int32_t k, double lo[3], double hi[3]) {
         const Box& b = boxes[static_cast<std::size_t>(ids[static_cast<std::size_t>(k)])];
@@ -150,12 +150,13 @@ struct ContinuousDetector::State {
     std::vector<Box> vertex_box, face_box, edge_box;
     detail::BoxGrid face_grid, edge_grid, vertex_grid;
     std::vector<std::int32_t> face_ids, edge_ids, vertex_ids; ///< per grid box: its face, edge, boundary vertex
+    std::vector<std::int32_t> edge_slot;                      ///< per edge: its box in edge_grid, or −1
     Occupancy face_cells, edge_cells, vertex_cells;           ///< the grids' coarse cells (with a mask)
     std::vector<unsigned char> face_moving, edge_moving;
     struct Scratch {
         std::vector<std::int32_t> stamp, hits;
         std::vector<ContinuousContact> found;
-        std::int64_t vf = 0, ee = 0;
+        std::int64_t vf = 0, ee = 0, met = 0;
     };
     std::vector<Scratch> scratch;
 };
@@ -221,7 +222,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
 
     ContinuousResult& result = s.result;
     result.contacts.clear();
-    result.vertex_face_candidates = result.edge_edge_candidates = 0;
+    result.vertex_face_candidates = result.edge_edge_candidates = result.broad_phase_pairs = 0;
     const Triangles& faces = result.faces;
     const Edges& edges = result.edges;
     const auto nf = static_cast<std::size_t>(faces.rows()), ne = static_cast<std::size_t>(edges.rows());
@@ -277,19 +278,27 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
     for (std::size_t f = 0; f < nf; ++f)
         if (s.face_moving[f]) s.face_ids.push_back(static_cast<std::int32_t>(f));
     s.edge_ids.clear();
+    s.edge_slot.assign(ne, -1);
     for (std::size_t e = 0; e < ne; ++e)
-        if (s.edge_moving[e]) s.edge_ids.push_back(static_cast<std::int32_t>(e));
-    while (cells_of(s.face_box, s.face_ids, 1 / cell) + cells_of(s.edge_box, s.edge_ids, 1 / cell) >
-           64 * static_cast<std::int64_t>(s.face_ids.size() + s.edge_ids.size()))
+        if (s.edge_moving[e]) {
+            s.edge_slot[e] = static_cast<std::int32_t>(s.edge_ids.size());
+            s.edge_ids.push_back(static_cast<std::int32_t>(e));
+        }
+    std::int64_t face_cells = 0, edge_cells = 0;
+    for (;;) {
+        face_cells = cells_of(s.face_box, s.face_ids, 1 / cell);
+        edge_cells = cells_of(s.edge_box, s.edge_ids, 1 / cell);
+        if (face_cells + edge_cells <= 64 * static_cast<std::int64_t>(s.face_ids.size() + s.edge_ids.size())) break;
         cell *= 2;
-    fill_grid(s.face_grid, cell, s.face_box, s.face_ids);
-    fill_grid(s.edge_grid, cell, s.edge_box, s.edge_ids);
+    }
+    fill_grid(s.face_grid, cell, s.face_box, s.face_ids, face_cells);
+    fill_grid(s.edge_grid, cell, s.edge_box, s.edge_ids, edge_cells);
     // With a mask, the faces that do not move also meet the moving vertices.
     s.vertex_ids.clear();
     if (masked) {
         for (const Index v : s.vertices)
             if (is_moving(v)) s.vertex_ids.push_back(static_cast<std::int32_t>(v));
-        fill_grid(s.vertex_grid, cell, s.vertex_box, s.vertex_ids);
+        fill_grid(s.vertex_grid, cell, s.vertex_box, s.vertex_ids, cells_of(s.vertex_box, s.vertex_ids, 1 / cell));
         // Coarse cells of four grid cells: most queries of a few moving primitives end here.
         s.face_cells.clear(4 * cell);
         s.edge_cells.clear(4 * cell);
@@ -306,7 +315,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
     s.scratch.resize(std::max(s.scratch.size(), static_cast<std::size_t>(threads)));
     for (State::Scratch& w : s.scratch) { // a team smaller than asked leaves some unused
         w.found.clear();
-        w.vf = w.ee = 0;
+        w.vf = w.ee = w.met = 0;
     }
     const auto nv = static_cast<std::int64_t>(s.vertices.size());
     const auto shares_face = [&](Index v, Index f) { return faces(f, 0) == v || faces(f, 1) == v || faces(f, 2) == v; };
@@ -354,6 +363,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
             if (masked && !s.face_cells.meets(vb)) continue;
             s.face_grid.query(vb.lo, vb.hi, w.stamp.data(), static_cast<std::int32_t>(i), w.hits, false,
                               [&](std::int32_t k) {
+                                  ++w.met;
                                   const Index f = s.face_ids[static_cast<std::size_t>(k)];
                                   if (shares_face(v, f) || !overlap(vb, s.face_box[static_cast<std::size_t>(f)]))
                                       return;
@@ -370,6 +380,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                 if (!s.vertex_cells.meets(fb)) continue;
                 s.vertex_grid.query(fb.lo, fb.hi, w.stamp.data(), static_cast<std::int32_t>(f), w.hits, false,
                                     [&](std::int32_t k) {
+                                        ++w.met;
                                         const Index v = s.vertex_ids[static_cast<std::size_t>(k)];
                                         if (!overlap(fb, s.vertex_box[static_cast<std::size_t>(v)]) ||
                                             shares_face(v, static_cast<Index>(f)))
@@ -378,24 +389,25 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                                     });
             }
         }
-        // Every edge against the moving edges, each pair once (from its lower edge when both move).
+        // Every edge against the moving edges, each pair once: a moving edge queries only the grid's boxes above its
+        // own (the edges' order), so neither the other half of a moving pair nor the edge itself is met.
         std::fill(w.stamp.begin(), w.stamp.end(), -1);
         detail::team_split(static_cast<std::int64_t>(ne), rank, size, begin, end);
         for (std::int64_t e = begin; e < end; ++e) {
-            const bool e_moving = s.edge_moving[static_cast<std::size_t>(e)] != 0;
+            const std::int32_t slot = s.edge_slot[static_cast<std::size_t>(e)];
             const Box& eb = s.edge_box[static_cast<std::size_t>(e)];
-            if (masked && !e_moving && !s.edge_cells.meets(eb)) continue;
-            s.edge_grid.query(eb.lo, eb.hi, w.stamp.data(), static_cast<std::int32_t>(e), w.hits, false,
-                              [&](std::int32_t k) {
-                                  const Index g = s.edge_ids[static_cast<std::size_t>(k)];
-                                  if (g == e || (e_moving && g < e) || shares_edge(static_cast<Index>(e), g) ||
-                                      !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]))
-                                      return;
-                                  if (g > e)
-                                      edge_edge(static_cast<Index>(e), g);
-                                  else
-                                      edge_edge(g, static_cast<Index>(e));
-                              });
+            if (masked && slot < 0 && !s.edge_cells.meets(eb)) continue;
+            s.edge_grid.query_above(
+                slot, eb.lo, eb.hi, w.stamp.data(), static_cast<std::int32_t>(e), w.hits, false, [&](std::int32_t k) {
+                    ++w.met;
+                    const Index g = s.edge_ids[static_cast<std::size_t>(k)];
+                    if (shares_edge(static_cast<Index>(e), g) || !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]))
+                        return;
+                    if (g > e)
+                        edge_edge(static_cast<Index>(e), g);
+                    else
+                        edge_edge(g, static_cast<Index>(e));
+                });
         }
     }
     for (int r = 0; r < threads; ++r) {
@@ -403,6 +415,7 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
         result.contacts.insert(result.contacts.end(), w.found.begin(), w.found.end());
         result.vertex_face_candidates += w.vf;
         result.edge_edge_candidates += w.ee;
+        result.broad_phase_pairs += w.met;
     }
     std::sort(result.contacts.begin(), result.contacts.end(),
               [](const ContinuousContact& p, const ContinuousContact& q) {

@@ -14,6 +14,7 @@
 #include "../team.hpp"
 #include "hash_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -50,7 +51,14 @@ inline float round_up(double v)
 class BoxGrid {
   public:
     /// The cell of coordinate v, with inv = 1 / cell size.
-    static std::int64_t cell_of(double v, double inv) { return static_cast<std::int64_t>(std::floor(v * inv)); }
+    /// (floor(v · inv) by truncation and a correction: the same cell, without a call to the library's floor where
+    /// the processor's rounding instruction is not assumed.)
+    static std::int64_t cell_of(double v, double inv)
+    {
+        const double p = v * inv;
+        const auto i = static_cast<std::int64_t>(p);
+        return i - static_cast<std::int64_t>(p < static_cast<double>(i));
+    }
 
     /// Builds the grid of boxes 0, 1, ..., count − 1 (cells of size `cell`, `buckets` buckets, a power of two).
     /// box_of(i, lo, hi) writes box i's corners, once per box. Alone (rank 0 of 1 part) the calling thread builds it
@@ -126,6 +134,15 @@ class BoxGrid {
     void query(const double lo[3], const double hi[3], std::int32_t* stamp, std::int32_t tag,
                std::vector<std::int32_t>& hits, bool repeats_harmless, Visit&& visit) const
     {
+        query_above(-1, lo, hi, stamp, tag, hits, repeats_harmless, visit);
+    }
+
+    /// query() over the boxes i > `above` only: a bucket holds its boxes in increasing order, so its lower ones are
+    /// passed over before the box test (a box of the grid that queries it meets each pair once, and never itself).
+    template <class Visit>
+    void query_above(std::int32_t above, const double lo[3], const double hi[3], std::int32_t* stamp, std::int32_t tag,
+                     std::vector<std::int32_t>& hits, bool repeats_harmless, Visit&& visit) const
+    {
         if (m_box.empty()) return;
         std::int64_t c0[3], c1[3];
         float q[6]; // lo x, y, z, hi x, y, z, rounded outwards like the boxes
@@ -142,7 +159,11 @@ class BoxGrid {
             for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy)
                 for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz) {
                     const std::uint32_t b = bucket(cx, cy, cz);
-                    const std::int32_t first = m_start[b], last = m_start[b + 1];
+                    std::int32_t first = m_start[b];
+                    const std::int32_t last = m_start[b + 1];
+                    if (above >= 0)
+                        first = static_cast<std::int32_t>(
+                            std::upper_bound(m_item.begin() + first, m_item.begin() + last, above) - m_item.begin());
                     if (hits.size() < static_cast<std::size_t>(last - first))
                         hits.resize(static_cast<std::size_t>(last - first));
                     const std::int32_t met = chosen_box_filter(columns, first, last, q, hits.data());
