@@ -97,6 +97,16 @@ class ContinuousDetector {
     const Triangles& faces() const;
     const Edges& edges() const;
 
+    /// A locality rule that detect() applies in its broad phase, before the exact box test: a pair is local, and
+    /// left out, when the first vertices of its two primitives are of one group g and some vertex of one and some
+    /// vertex of the other lie nearer than the group's reach in `rest`: (rest.row(u) − rest.row(w)).squaredNorm() <
+    /// reach_sq[g]. (A simulator's parts that the elastic terms keep apart: neighbours on the surface, a fold of a
+    /// few edges.) `rest`: num_vertices × 3; `vertex_group`: one group per vertex, in [0, reach_sq.size());
+    /// `reach_sq`: per group, ≥ 0 (0: no pair of it is local). Replaces the rule set before; set_topology clears it.
+    /// Throws Error naming the input and the entry when a size differs, a group is out of range or a reach or a rest
+    /// coordinate is not finite (or a reach negative).
+    void set_locality(const PositionsRef& rest, std::span<const Index> vertex_group, std::span<const double> reach_sq);
+
     /// Decides before the narrow phase whether a candidate pair is tested (kind, then a and b as in
     /// ContinuousContact). Called from several threads at once when params.threads > 1.
     using PairFilter = std::function<bool(ContinuousKind, Index, Index)>;
@@ -104,7 +114,8 @@ class ContinuousDetector {
     /// Continuous detection of the step x0 → x1 (num_vertices × 3 each): detect_continuous's result (the faces and
     /// edges those above). `moving` (empty, or one entry per vertex): only pairs with a vertex whose entry is nonzero
     /// are candidates (a caller that knows where nothing moved enough to meet anything); `keep` (may be empty): only
-    /// pairs it accepts reach the narrow phase and the candidate counts. The result stays valid until the next call.
+    /// pairs it accepts reach the narrow phase and the candidate counts (pairs the locality rule left out never reach
+    /// it). The result stays valid until the next call.
     /// Throws Error as detect_continuous does.
     const ContinuousResult& detect(const PositionsRef& x0, const PositionsRef& x1, const ContinuousParams& params = {},
                                    std::span<const unsigned char> moving = {}, const PairFilter& keep = {});

@@ -14,7 +14,6 @@ void SweepCheck::setup(const TetMesh& mesh, const Model& model, const std::vecto
                        const std::vector<std::pair<Index, Index>>& object_vertices, double local_edges, double margin)
 {
     m_detector.set_topology(mesh.tets, mesh.num_vertices());
-    m_rest = mesh.rest();
     m_object = model.vertex_object;
     const size_t objects = object_vertices.size();
     m_local_sq.assign(objects, 0.0);
@@ -32,6 +31,8 @@ void SweepCheck::setup(const TetMesh& mesh, const Model& model, const std::vecto
         }
     }
     m_moving.assign(static_cast<size_t>(mesh.num_vertices()), 0);
+    // The contacts' locality rule, applied in the detector's broad phase: most pairs its grid meets are neighbours.
+    m_detector.set_locality(mesh.rest(), m_object, m_local_sq);
 }
 
 bool SweepCheck::crossed(const Positions& x0, const Positions& x1, const std::vector<std::pair<Index, Index>>& watched,
@@ -113,10 +114,7 @@ bool SweepCheck::crossed(const Positions& x0, const Positions& x1, const std::ve
         const Index oa = m_object[static_cast<size_t>(a[0])], ob = m_object[static_cast<size_t>(b[0])];
         const auto ua = static_cast<size_t>(oa), ub = static_cast<size_t>(ob);
         if (oa == ob) {
-            if (!m_self[ua]) return false;
-            for (int i = 0; i < na; ++i)
-                for (int k = 0; k < nb; ++k)
-                    if ((m_rest.row(a[i]) - m_rest.row(b[k])).squaredNorm() < m_local_sq[ua]) return false;
+            if (!m_self[ua]) return false; // (local pairs are left out by the detector: set_locality)
         } else if (m_static[ua] && m_static[ub]) {
             return false;
         }

@@ -37,7 +37,6 @@ class SweepCheck {
 
   private:
     ccd::ContinuousDetector m_detector;
-    Positions m_rest;
     std::vector<Index> m_object;                  ///< per vertex
     std::vector<double> m_local_sq;               ///< per object: (local_edges × mean edge)²
     std::vector<double> m_margin;                 ///< per object: the contacts' margin (length)

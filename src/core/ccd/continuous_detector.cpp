@@ -153,6 +153,10 @@ struct ContinuousDetector::State {
     std::vector<std::int32_t> edge_slot;                      ///< per edge: its box in edge_grid, or −1
     Occupancy face_cells, edge_cells, vertex_cells;           ///< the grids' coarse cells (with a mask)
     std::vector<unsigned char> face_moving, edge_moving;
+    /// set_locality: rest positions, a group per vertex, a squared reach per group (empty: no rule).
+    Positions rest;
+    std::vector<Index> group;
+    std::vector<double> reach_sq;
     struct Scratch {
         std::vector<std::int32_t> stamp, hits;
         std::vector<ContinuousContact> found;
@@ -176,6 +180,9 @@ void ContinuousDetector::set_topology(const TetsRef& tets, Index num_vertices)
     State& s = *m_state;
     s.num_vertices = num_vertices;
     s.result = ContinuousResult{};
+    s.rest.resize(0, 3);
+    s.group.clear();
+    s.reach_sq.clear();
     s.result.faces = boundary_faces(tets);
     s.result.edges = detail::edges_of_faces(s.result.faces);
     s.vertices.assign(s.result.faces.data(), s.result.faces.data() + s.result.faces.size());
@@ -184,6 +191,33 @@ void ContinuousDetector::set_topology(const TetsRef& tets, Index num_vertices)
     s.vertex_box.assign(static_cast<std::size_t>(num_vertices), Box{});
     s.face_box.resize(static_cast<std::size_t>(s.result.faces.rows()));
     s.edge_box.resize(static_cast<std::size_t>(s.result.edges.rows()));
+}
+
+void ContinuousDetector::set_locality(const PositionsRef& rest, std::span<const Index> vertex_group,
+                                      std::span<const double> reach_sq)
+{
+    State& s = *m_state;
+    const std::string where = "ContinuousDetector::set_locality: ";
+    if (rest.rows() != s.num_vertices || static_cast<Index>(vertex_group.size()) != s.num_vertices)
+        throw Error(where + "the rest positions have " + std::to_string(rest.rows()) + " rows and the groups " +
+                    std::to_string(vertex_group.size()) + " entries, the topology " + std::to_string(s.num_vertices) +
+                    " vertices");
+    for (std::size_t g = 0; g < reach_sq.size(); ++g)
+        if (!(reach_sq[g] >= 0 && reach_sq[g] < std::numeric_limits<double>::infinity()))
+            throw Error(where + "the squared reach of group " + std::to_string(g) + " is negative or not finite");
+    for (Index v = 0; v < s.num_vertices; ++v) {
+        const Index g = vertex_group[static_cast<std::size_t>(v)];
+        if (g < 0 || static_cast<std::size_t>(g) >= reach_sq.size())
+            throw Error(where + "vertex " + std::to_string(v) + " is in group " + std::to_string(g) + ", outside [0, " +
+                        std::to_string(reach_sq.size()) + ")");
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(rest(v, k)))
+                throw Error(where + "rest coordinate " + std::to_string(k) + " of vertex " + std::to_string(v) +
+                            " is not finite");
+    }
+    s.rest = rest;
+    s.group.assign(vertex_group.begin(), vertex_group.end());
+    s.reach_sq.assign(reach_sq.begin(), reach_sq.end());
 }
 
 const Triangles& ContinuousDetector::faces() const
@@ -324,6 +358,26 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                edges(e, 1) == edges(g, 1);
     };
     auto row = [](const PositionsRef& x, Index v) { return Vec3(x(v, 0), x(v, 1), x(v, 2)); };
+    // The locality rule (set_locality): the primitives' first vertices in one group, some two of their vertices
+    // nearer than its reach at rest.
+    const bool with_locality = !s.group.empty();
+    const auto local = [&](const Index* a, int na, const Index* b, int nb) {
+        const Index g = s.group[static_cast<std::size_t>(a[0])];
+        if (g != s.group[static_cast<std::size_t>(b[0])]) return false;
+        const double reach_sq = s.reach_sq[static_cast<std::size_t>(g)];
+        for (int i = 0; i < na; ++i)
+            for (int k = 0; k < nb; ++k)
+                if ((s.rest.row(a[i]) - s.rest.row(b[k])).squaredNorm() < reach_sq) return true;
+        return false;
+    };
+    const auto local_vertex_face = [&](Index v, Index f) {
+        const Index fv[3] = {faces(f, 0), faces(f, 1), faces(f, 2)};
+        return with_locality && local(&v, 1, fv, 3);
+    };
+    const auto local_edge_edge = [&](Index e, Index g) {
+        const Index ev[2] = {edges(e, 0), edges(e, 1)}, gv[2] = {edges(g, 0), edges(g, 1)};
+        return with_locality && local(ev, 2, gv, 2);
+    };
     std::atomic<bool> met{false}; // params.first_only: some pair met
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel num_threads(threads) if (threads > 1)
@@ -365,7 +419,8 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                               [&](std::int32_t k) {
                                   ++w.met;
                                   const Index f = s.face_ids[static_cast<std::size_t>(k)];
-                                  if (shares_face(v, f) || !overlap(vb, s.face_box[static_cast<std::size_t>(f)]))
+                                  if (shares_face(v, f) || local_vertex_face(v, f) ||
+                                      !overlap(vb, s.face_box[static_cast<std::size_t>(f)]))
                                       return;
                                   vertex_face(v, f);
                               });
@@ -378,15 +433,15 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                 if (s.face_moving[static_cast<std::size_t>(f)]) continue;
                 const Box& fb = s.face_box[static_cast<std::size_t>(f)];
                 if (!s.vertex_cells.meets(fb)) continue;
-                s.vertex_grid.query(fb.lo, fb.hi, w.stamp.data(), static_cast<std::int32_t>(f), w.hits, false,
-                                    [&](std::int32_t k) {
-                                        ++w.met;
-                                        const Index v = s.vertex_ids[static_cast<std::size_t>(k)];
-                                        if (!overlap(fb, s.vertex_box[static_cast<std::size_t>(v)]) ||
-                                            shares_face(v, static_cast<Index>(f)))
-                                            return;
-                                        vertex_face(v, static_cast<Index>(f));
-                                    });
+                s.vertex_grid.query(
+                    fb.lo, fb.hi, w.stamp.data(), static_cast<std::int32_t>(f), w.hits, false, [&](std::int32_t k) {
+                        ++w.met;
+                        const Index v = s.vertex_ids[static_cast<std::size_t>(k)];
+                        if (shares_face(v, static_cast<Index>(f)) || local_vertex_face(v, static_cast<Index>(f)) ||
+                            !overlap(fb, s.vertex_box[static_cast<std::size_t>(v)]))
+                            return;
+                        vertex_face(v, static_cast<Index>(f));
+                    });
             }
         }
         // Every edge against the moving edges, each pair once: a moving edge queries only the grid's boxes above its
@@ -401,7 +456,8 @@ const ContinuousResult& ContinuousDetector::detect(const PositionsRef& x0, const
                 slot, eb.lo, eb.hi, w.stamp.data(), static_cast<std::int32_t>(e), w.hits, false, [&](std::int32_t k) {
                     ++w.met;
                     const Index g = s.edge_ids[static_cast<std::size_t>(k)];
-                    if (shares_edge(static_cast<Index>(e), g) || !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]))
+                    if (shares_edge(static_cast<Index>(e), g) || local_edge_edge(static_cast<Index>(e), g) ||
+                        !overlap(eb, s.edge_box[static_cast<std::size_t>(g)]))
                         return;
                     if (g > e)
                         edge_edge(static_cast<Index>(e), g);
