@@ -88,9 +88,11 @@ class Occupancy {
         m_inv = 1 / coarse;
         m_bits.assign(words, 0);
         m_everywhere = false;
+        m_bound = Box{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     }
     void mark(const Box& b)
     {
+        grow(m_bound, b);
         std::int64_t c0[3], c1[3];
         if (!cells(b, c0, c1)) {
             m_everywhere = true; // a box over very many coarse cells: every query goes on to the grid
@@ -105,6 +107,8 @@ class Occupancy {
     }
     bool meets(const Box& b) const
     {
+        // First the box of every marked box: where few primitives move, in one region, most queries end here.
+        if (!overlap(b, m_bound)) return false;
         std::int64_t c0[3], c1[3];
         if (m_everywhere || !cells(b, c0, c1)) return true;
         for (std::int64_t x = c0[0]; x <= c1[0]; ++x)
@@ -139,6 +143,7 @@ class Occupancy {
     double m_inv = 1;
     std::vector<std::uint64_t> m_bits;
     bool m_everywhere = false;
+    Box m_bound{}; ///< the box of the marked boxes
 };
 
 } // namespace
