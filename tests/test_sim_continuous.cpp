@@ -127,6 +127,33 @@ TEST(SimContinuous, EdgeThroughFaceWithNoVertexInside)
     }
 }
 
+TEST(SimContinuous, RetakesAreCappedAndWhatIsLeftIsReported)
+{
+    // At 60 m/s the plate crosses the lower plate within a quarter of a step: the sweep takes the step again twice
+    // (four substeps), no more, though max_substeps would allow more; the impact left in the last attempt is reported
+    // in the step's stats, the run's health and its problems.
+    Scene s = plates(60.0, true);
+    s.max_substeps = 64;
+    Simulation sim(s);
+    int capped = 0;
+    for (int i = 0; i < 6; ++i) {
+        sim.step();
+        const StepStats& st = sim.last_stats();
+        EXPECT_LE(st.continuous_crossings, 2) << "step " << i + 1;
+        if (st.continuous_unresolved > 0) {
+            ++capped;
+            EXPECT_EQ(st.continuous_crossings, 2) << "step " << i + 1;
+            EXPECT_EQ(st.substeps, 4) << "step " << i + 1;
+        }
+    }
+    ASSERT_GT(capped, 0);
+    EXPECT_EQ(sim.health().continuous_unresolved_steps, capped);
+    const auto problems = sim.health().problems();
+    EXPECT_TRUE(std::any_of(problems.begin(), problems.end(), [](const std::string& p) {
+        return p.find("continuous check") != std::string::npos;
+    })) << problems.size();
+}
+
 TEST(SimContinuous, BitIdenticalAtOneAndTwoThreads)
 {
     Scene s1 = plates(15.0, true), s2 = s1;

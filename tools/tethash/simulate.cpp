@@ -201,6 +201,7 @@ void write_run_json(const std::string& dir, const sim::Simulation& sim, const st
         .member("substeps", h.substeps)
         .member("refined_steps", h.refined_steps)
         .member("crossing_steps", h.crossing_steps)
+        .member("continuous_unresolved_steps", h.continuous_unresolved_steps)
         .member("unconverged_substeps", h.unconverged_substeps)
         .member("energy_start", h.energy_start)
         .member("energy_end", h.energy_end)
@@ -423,6 +424,8 @@ class Progress {
             note += fmt::format("  energy +{:.3g}%", 100 * hl.energy_growth);
         if (hl.unconverged_substeps > 0) note += fmt::format("  unconverged {}", hl.unconverged_substeps);
         if (hl.refined_steps > 0) note += fmt::format("  refined {}", hl.refined_steps);
+        if (hl.continuous_unresolved_steps > 0)
+            note += fmt::format("  swept unresolved {}", hl.continuous_unresolved_steps);
         if (m_tty) {
             if (std::chrono::duration<double>(now - m_last_print).count() > 0.1 || s + 1 == steps) {
                 const int width = 30, filled = static_cast<int>(width * (s + 1) / std::max(1, steps));

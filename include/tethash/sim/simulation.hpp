@@ -49,8 +49,11 @@ struct RunHealth {
     double weight_strain = 0;  ///< the largest density · g · height / young of an object: what its weight squeezes
     std::int64_t steps = 0;    ///< steps taken
     std::int64_t substeps = 0; ///< substeps taken (refined steps count theirs)
-    std::int64_t refined_steps = 0;        ///< steps taken again in more substeps (tets inverted or a blow-up)
-    std::int64_t crossing_steps = 0;       ///< of those, steps taken again for a vertex that entered a far part unseen
+    std::int64_t refined_steps = 0;  ///< steps taken again in more substeps (tets inverted or a blow-up)
+    std::int64_t crossing_steps = 0; ///< of those, steps taken again for a vertex that entered a far part unseen
+    /// Steps kept with a far pair met unwatched within a substep, the continuous check's retakes at their cap
+    /// (StepStats::continuous_unresolved)
+    std::int64_t continuous_unresolved_steps = 0;
     std::int64_t unconverged_substeps = 0; ///< substeps whose iterations reached their cap (vbd: max_iterations)
     std::int64_t inverted_end = 0;         ///< dynamic tets inverted after the last step
     std::int64_t tets = 0;                 ///< dynamic tets

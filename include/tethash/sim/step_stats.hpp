@@ -28,8 +28,11 @@ struct StepStats {
     int crossings = 0; ///< times the step was taken again in more substeps for a vertex that entered a far part unseen
                        ///< (Scene::crossing_check)
     int continuous_crossings = 0; ///< of those, the ones the substep's sweep found (Scene::continuous_check)
-    double ms_continuous = 0;     ///< the substeps' sweeps (Scene::continuous_check; part of ms_checks())
-    int tightened = 0;            ///< times the step was taken again with tighter tolerances for energy it gained
+    /// 1 when the step kept a far pair that met unwatched within a substep: the continuous check's retakes had
+    /// reached their cap (two retakes, or max_substeps), so the step stands as taken
+    int continuous_unresolved = 0;
+    double ms_continuous = 0; ///< the substeps' sweeps (Scene::continuous_check; part of ms_checks())
+    int tightened = 0;        ///< times the step was taken again with tighter tolerances for energy it gained
 
     /// The step less its stages: its checks (energy, inverted tets, blow-up) and the copies of steps taken again.
     double ms_checks() const
