@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <malloc.h>
@@ -98,7 +99,16 @@ double resident_bytes()
     return resident * 4096.0;
 }
 
-Row run(const std::string& name, const sim::Scene& scene, int steps)
+/// The calling thread's CPU time, ms (what a step cost it, whatever else the machine runs).
+double thread_cpu_ms()
+{
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+/// `cpu_time`: a step's ms are the thread's CPU time (--cpu-time), else the wall clock's.
+Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_time)
 {
     Row r;
     r.scene = name;
@@ -117,8 +127,11 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     try {
         for (int i = 0; i < steps; ++i) {
             const auto t0 = std::chrono::steady_clock::now();
+            const double c0 = cpu_time ? thread_cpu_ms() : 0.0;
             s.step();
-            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            ms.push_back(
+                cpu_time ? thread_cpu_ms() - c0
+                         : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
             if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
@@ -238,6 +251,7 @@ struct SimBenchOptions {
     bool no_speculative = false, inversion_guard = false;
     std::string crossing_check, continuous_check;
     bool no_peer = false;
+    bool cpu_time = false;
 };
 
 void add_options(CLI::App& app, SimBenchOptions& o)
@@ -266,6 +280,9 @@ void add_options(CLI::App& app, SimBenchOptions& o)
                      "as the run goes, as `tethash simulate` does)")
         ->capture_default_str();
     runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
+    runs->add_flag("--cpu-time", o.cpu_time,
+                   "a step's ms (ms/step, mean) are the thread's CPU time, not the wall clock's (on a machine shared "
+                   "with other work; one thread only, the stages stay wall-clock)");
     runs->add_option("--bodies", o.bodies,
                      "instead of the shared meshes: generated spheres of about these many tets (comma-separated, "
                      "e.g. 1e4,1e5,1e6; 1 m, dropped 0.2 m), each at one thread and at --threads, with a table of "
@@ -312,9 +329,10 @@ void print_header(SimBenchOptions& o)
     std::printf("tethash_sim_bench: %s, flags '%s', %u hardware threads, %d thread(s), load %.2f %.2f %.2f\n",
                 TETHASH_BENCH_COMPILER, TETHASH_BENCH_FLAGS, std::thread::hardware_concurrency(), o.threads, load[0],
                 load[1], load[2]);
-    std::printf("%s simulated per run; ms are medians over the steps\n",
+    std::printf("%s simulated per run; ms are medians over the steps%s\n",
                 o.seconds > 0 ? fmt::format("{} s", o.seconds).c_str()
-                              : "0.5 s (2.5 times the fall where it takes more than 0.25 s)");
+                              : "0.5 s (2.5 times the fall where it takes more than 0.25 s)",
+                o.cpu_time ? " (ms/step and mean: the thread's CPU time, --cpu-time)" : "");
 #ifdef TETHASH_HAVE_BULLET
     std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
                 bench::bullet_version() / 100, bench::bullet_version() % 100, o.peer_iterations,
@@ -509,6 +527,9 @@ int main(int argc, char** argv)
         if (!(o.seconds >= 0) || !std::isfinite(o.seconds))
             throw Error("--seconds must be positive (or 0: automatic), found " + fmt::format("{}", o.seconds));
         if (o.threads < 0 || o.threads > 256) throw Error("--threads must be in 0..256 (0: chosen step by step)");
+        if (o.cpu_time && o.threads != 1)
+            throw Error("--cpu-time measures the calling thread: it needs --threads 1 (found " +
+                        std::to_string(o.threads) + ")");
         if (o.bodies.empty() && !std::filesystem::is_directory(o.meshes_dir)) {
             std::printf("shared meshes not found at %s: nothing to run\n", o.meshes_dir.c_str());
             return 0;
@@ -533,7 +554,7 @@ int main(int argc, char** argv)
                         apply_overrides(scene, o, i, dt);
                         scene.detect.threads = threads;
                         const int steps = std::max(1, static_cast<int>(std::lround(run_seconds(o, scene) / dt)));
-                        const Row r = run(name, scene, steps);
+                        const Row r = run(name, scene, steps, o.cpu_time);
                         print(r);
                         rows.push_back(r);
                     }
