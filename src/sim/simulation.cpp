@@ -208,9 +208,10 @@ void SimulationImpl::set_auto_max_substeps()
 constexpr double energy_step_slack = 1e-3;
 
 /// The continuous check takes a step again in more substeps at most this many times (each doubling them, within
-/// max_substeps): a crumpling body, whose far parts meet in most substeps however short, was otherwise retaken up to
-/// max_substeps (the raptor at 5 cm at 1/60: 1.8× its step). Past the cap the substeps are still swept, and an impact
-/// left is reported (StepStats::continuous_unresolved, RunHealth::continuous_unresolved_steps).
+/// max_substeps): a crumpling body, whose far parts meet in most substeps however short, could otherwise be retaken
+/// up to max_substeps at every step (256 × the substeps for a stiff material at a long step). Past the cap the
+/// substeps are still swept, and an impact left is reported (StepStats::continuous_unresolved,
+/// RunHealth::continuous_unresolved_steps).
 constexpr int max_sweep_retakes = 2;
 
 int SimulationImpl::approach_substeps(int most) const
