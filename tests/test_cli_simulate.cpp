@@ -86,6 +86,8 @@ TEST(CliSimulate, OverridesFromTheCommandLine)
     EXPECT_NE(r.out.find("steps: 3 "), std::string::npos) << r.out;
     EXPECT_NE(read_text(dir / "out" / "run.json").find("\"crossing_steps\": 0"), std::string::npos)
         << read_text(dir / "out" / "run.json");
+    EXPECT_NE(read_text(dir / "out" / "run.json").find("\"continuous_unresolved_steps\": 0"), std::string::npos)
+        << read_text(dir / "out" / "run.json");
 }
 
 TEST(CliSimulate, DefaultSceneRuns)
