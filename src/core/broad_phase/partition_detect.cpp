@@ -61,7 +61,6 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
     // the broad phases split their queries evenly).
     const auto t_inside = Clock::now();
     const double* P = scene.positions;
-    const bool with_stats = stats != nullptr;
 #pragma omp parallel num_threads(T) if (T > 1)
     {
         const int r = team_rank();
@@ -104,20 +103,24 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
             if (++n == static_cast<std::int32_t>(batch_size)) flush();
         }
         flush();
-        if (with_stats) { // degenerate tets, as the hash path counts them: every tet once
+    }
+    const double ms_inside = ms_since(t_inside);
+    if (stats) { // degenerate tets, as the hash path counts them: every tet once (not timed with the exact stage)
+#pragma omp parallel num_threads(T) if (T > 1)
+        {
+            const int r = team_rank();
             std::int64_t begin = 0, end = 0;
             team_split(scene.num_tets, r, team_size(), begin, end);
             for (std::int64_t t = begin; t < end; ++t) {
                 const Index* tv = scene.tets + 4 * static_cast<std::size_t>(t);
-                counts.degenerate += predicates::orient3d(P + 3 * static_cast<std::size_t>(tv[0]),
-                                                          P + 3 * static_cast<std::size_t>(tv[1]),
-                                                          P + 3 * static_cast<std::size_t>(tv[2]),
-                                                          P + 3 * static_cast<std::size_t>(tv[3]))
-                                         .sign == 0;
+                m_counts[static_cast<std::size_t>(r)].degenerate +=
+                    predicates::orient3d(
+                        P + 3 * static_cast<std::size_t>(tv[0]), P + 3 * static_cast<std::size_t>(tv[1]),
+                        P + 3 * static_cast<std::size_t>(tv[2]), P + 3 * static_cast<std::size_t>(tv[3]))
+                        .sign == 0;
             }
         }
     }
-    const double ms_inside = ms_since(t_inside);
 
     const auto t_sort = Clock::now();
     m_all.clear();
