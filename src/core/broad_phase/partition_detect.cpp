@@ -25,8 +25,8 @@ namespace {
 constexpr std::size_t batch_size = 1024;
 /// Pairs of one tet from which its face planes are built (scan.hpp) and tested against all of them; a run of fewer
 /// goes to the oracle's inside test directly (inside_batch.hpp), and so does every pair of a thread whose runs are
-/// shorter than min_mean_run pairs on average: there the planes cost more than they save (scenario 5: 1.3 pairs per
-/// tet, the stage 8 % slower with the planes; thin: 39, 2.2 times faster).
+/// shorter than min_mean_run pairs on average: there the planes cost more than they save (scenario 5: 2.2 pairs per
+/// run, the stage about 10 % slower with the planes; thin: 43, 2.2 times faster; docs/results.md).
 constexpr std::int32_t min_run = 3;
 constexpr std::size_t min_mean_run = 4;
 
