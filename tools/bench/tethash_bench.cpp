@@ -193,15 +193,17 @@ void report(const char* name, const TetMesh& m, const DetectParams& base, int th
                     bench::same_pairs(pairs, one.contacts) ? "" : "  ERROR: contacts differ from the hash");
     }
     // The other broad phases at 1 thread, same scene and parameters (DetectStats::candidates: the pairs handed to
-    // the exact test; nodes: cells, nodes or levels of the structure).
+    // the exact test; nodes: cells, nodes or levels of the structure; the stage split: build + query of the broad
+    // phase, the exact stage, the sort, medians of the runs with statistics).
     for (Method method : methods) {
         DetectParams pm = p1;
         pm.method = method;
         try {
             const Measured r = measure(m, pm, std::max(3, repeat / 3));
-            std::printf("  %-14s %8.3f ms (cpu %.3f)  %7.1f ns/tet  candidates %lld  nodes %lld  memory %.1f B/tet  "
-                        "contacts %lld%s",
+            std::printf("  %-14s %8.3f ms (cpu %.3f)  %7.1f ns/tet  [broad %.3f  exact %.3f  sort %.3f]  candidates "
+                        "%lld  nodes %lld  memory %.1f B/tet  contacts %lld%s",
                         to_string(method), r.ms, r.cpu_ms, 1e6 * r.cpu_ms / std::max(1, m.num_tets()),
+                        r.stats.ms_vertices + r.stats.ms_tets, r.stats.ms_inside, r.stats.ms_sort,
                         static_cast<long long>(r.stats.candidates), static_cast<long long>(r.stats.nodes),
                         double(r.stats.memory_bytes) / std::max(1, m.num_tets()),
                         static_cast<long long>(r.stats.contacts),

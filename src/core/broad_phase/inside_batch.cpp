@@ -86,7 +86,9 @@ __attribute__((target("avx2"))) inline __m256d decided(__m256d det, __m256d boun
 
 // Four pairs per step. A lane is decided when all five filters decide their signs (then every sign is ±1, as
 // orient3d returns it); its result is inside_tet's: inside iff no face has the sign opposite to the tet's, bary the
-// values over their sum taken in order. A lane with an undecided filter goes to inside_tet.
+// values over their sum taken in order. A lane whose tet orientation is decided and one of whose faces is decided
+// with the opposite sign is outside, as inside_tet finds it, without the exact evaluations inside_tet would make of
+// the undecided faces before it; any other lane with an undecided filter goes to inside_tet.
 __attribute__((target("avx2"))) std::int64_t inside_avx2(const double* P, const Index* tets, const Index* vertex,
                                                          const Index* tet, std::int32_t count, std::uint8_t* inside,
                                                          double* bary)
@@ -114,11 +116,25 @@ __attribute__((target("avx2"))) std::int64_t inside_avx2(const double* P, const 
         orient4(a, b, pp, d, f[2], fb[2]);
         orient4(a, b, c, pp, f[3], fb[3]);
         // Decided: det > bound or −det > bound, for all five.
-        __m256d all = decided(o, ob);
-        for (int i = 0; i < 4; ++i)
-            all = _mm256_and_pd(all, decided(f[i], fb[i]));
-        // Inside (decided lanes): every face value has the sign of the tet's.
+        const __m256d odecided = decided(o, ob);
+        __m256d fd[4], all = odecided;
+        for (int i = 0; i < 4; ++i) {
+            fd[i] = decided(f[i], fb[i]);
+            all = _mm256_and_pd(all, fd[i]);
+        }
         const __m256d opos = _mm256_cmp_pd(o, _mm256_setzero_pd(), _CMP_GT_OQ);
+        int decided_mask = _mm256_movemask_pd(all);
+        if (decided_mask != 15) {
+            // Rejected: the tet's sign decided and a face's decided opposite to it (f > 0 where o < 0, f < 0 where
+            // o > 0: the decided f is not 0).
+            __m256d rejected = _mm256_setzero_pd();
+            for (int i = 0; i < 4; ++i)
+                rejected = _mm256_or_pd(
+                    rejected,
+                    _mm256_and_pd(fd[i], _mm256_xor_pd(_mm256_cmp_pd(f[i], _mm256_setzero_pd(), _CMP_GT_OQ), opos)));
+            decided_mask |= _mm256_movemask_pd(_mm256_and_pd(rejected, odecided));
+        }
+        // Inside (decided lanes): every face value has the sign of the tet's.
         __m256d same = all;
         for (int i = 0; i < 4; ++i)
             same = _mm256_and_pd(same, _mm256_xor_pd(_mm256_cmp_pd(f[i], _mm256_setzero_pd(), _CMP_LE_OQ), opos));
@@ -127,7 +143,7 @@ __attribute__((target("avx2"))) std::int64_t inside_avx2(const double* P, const 
         alignas(32) double w[4][4];
         for (int i = 0; i < 4; ++i)
             _mm256_store_pd(w[i], _mm256_div_pd(f[i], sum));
-        const int decided_mask = _mm256_movemask_pd(all), in_mask = _mm256_movemask_pd(same);
+        const int in_mask = _mm256_movemask_pd(same);
         for (int l = 0; l < 4; ++l) {
             if (!(decided_mask >> l & 1)) {
                 exact += inside_scalar(P, tets, vertex, tet, j + l, j + l + 1, inside, bary);

@@ -28,17 +28,24 @@ class PartitionDetector {
     struct alignas(64) Counts {
         std::int64_t inside_tests = 0, exact = 0, degenerate = 0;
     };
-    /// A thread's pairs that passed the object rules, tested a block at a time (inside_batch.hpp).
-    struct Batch {
+    /// A thread's working buffers (grown only). A run of a tet's pairs that passed the object rules (`run`) goes
+    /// through the hash's face-plane filter (`values`, `codes`, `kept`: scan.hpp); the pairs it leaves (inside or
+    /// undecided) go to the oracle's inside test a block at a time (`vertex` ... `bary`: inside_batch.hpp).
+    struct Work {
+        std::vector<Index> run;
+        std::vector<double> values;
+        std::vector<std::int8_t> codes;
+        std::vector<std::int32_t> kept;
         std::vector<Index> vertex, tet;
         std::vector<std::uint8_t> inside;
         std::vector<double> bary;
+        std::int64_t bytes() const;
     };
     Method m_method = Method::hash;
     std::unique_ptr<BroadPhase> m_broad;
     std::vector<CandidateSink> m_sinks;
     std::vector<std::vector<Found>> m_found;
-    std::vector<Batch> m_batches;
+    std::vector<Work> m_work;
     std::vector<Counts> m_counts;
     std::vector<Found> m_all;
 };
