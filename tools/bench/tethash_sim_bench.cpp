@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <malloc.h>
@@ -47,7 +48,12 @@ struct Row {
     double threads = 1;       ///< mean threads per step (--threads 0: chosen step by step)
     double bytes_per_tet = 0; ///< resident memory the run added (set-up, state, detector), per tet
     double ms_mean = 0;       ///< mean ms per step: the cost that counts where some steps were refined
-    double substeps = 1;      ///< mean substeps per step (more than the scene's where steps were refined)
+    /// Processor time of the process per step (ms; median, mean): at one thread the step's own work, which the time
+    /// slices other processes take on a loaded machine leave out (the wall-clock `ms` counts them).
+    double cpu_ms = 0, cpu_ms_mean = 0;
+    double sweeps_mean = 0; ///< mean solver iterations per step (the landing's steps need more than the fall's)
+    double setup_ms = 0;    ///< constructing the simulation (processor time, ms), apart from the steps
+    double substeps = 1;    ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
     std::int64_t unconverged = 0;  ///< substeps whose sweeps reached their cap
     std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
@@ -88,6 +94,14 @@ sim::ObjectSpec placed(const TetMesh& mesh, double lift, double size)
     return o;
 }
 
+/// Processor time the process has used (ms): every thread's, so at one thread the work of the step alone.
+double process_cpu_ms()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
 /// Resident memory of the process (bytes), after giving freed memory back.
 double resident_bytes()
 {
@@ -105,20 +119,24 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.integrator = sim::to_string(scene.integrator);
     r.dt = scene.dt;
     const double rss0 = resident_bytes();
+    const double setup0 = process_cpu_ms();
     sim::Simulation s(scene);
+    r.setup_ms = process_cpu_ms() - setup0;
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
     sim::FarSelfPenetrations far(s.mesh(), start);
     const double energy0 = s.energy().total(), volume0 = sim::total_volume(s.model(), start);
-    std::vector<double> ms, det, dep, prox, resp, integ, other, threads, sw, con, sub;
+    std::vector<double> ms, cpu, det, dep, prox, resp, integ, other, threads, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
     try {
         for (int i = 0; i < steps; ++i) {
+            const double cpu0 = process_cpu_ms();
             const auto t0 = std::chrono::steady_clock::now();
             s.step();
             ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            cpu.push_back(process_cpu_ms() - cpu0);
             if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
@@ -147,6 +165,9 @@ Row run(const std::string& name, const sim::Scene& scene, int steps)
     r.threads = mean(threads);
     r.sweeps = median(sw);
     r.ms_mean = mean(ms);
+    r.cpu_ms = median(cpu);
+    r.cpu_ms_mean = mean(cpu);
+    r.sweeps_mean = mean(sw);
     r.substeps = sub.empty() ? 1 : mean(sub);
     r.contacts = mean(con);
     r.inverted = sim::count_inverted(s.mesh(), start);
@@ -455,33 +476,54 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         if (!out) throw Error("--csv: cannot write '" + tmp + "'");
         out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
                "ms_response,ms_integrate,ms_other,threads,iterations,substeps,contacts,inverted,far_self,"
-               "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,failure\n";
+               "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,cpu_ms_step,"
+               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure\n";
         for (const Row& r : rows)
-            out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
-                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},\"{}\"\n",
-                               r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
-                               r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
-                               r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
-                               r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.failure);
+            out << fmt::format(
+                "{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
+                "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},{:.4g},{:.4g},{:.3g},{:.4g},\"{}\"\n",
+                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth, r.proximity,
+                r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps, r.contacts, r.inverted, r.far_self,
+                r.far_self_max, r.mean_z, r.energy_ratio, r.volume_ratio, r.unconverged, r.stable ? 1 : 0,
+                r.bytes_per_tet, r.cpu_ms, r.cpu_ms_mean, r.sweeps_mean, r.setup_ms, r.failure);
     }
     std::filesystem::rename(tmp, csv);
 }
 
 /// --bodies: per body and time step, the cost per step and per tet, the memory per tet and the threads' speed-up
-/// (rows in pairs: one thread, then --threads, as run).
+/// (rows in pairs: one thread, then --threads, as run). The cost per tet is the processor time at one thread, which
+/// other processes on a loaded machine do not inflate (a long step loses more of its wall-clock time to their
+/// time slices than a short one); the median is mostly the fall's steps, the mean carries the landing's. The
+/// speed-up is wall-clock (median over median, mean over mean), the set-up's processor time is apart.
 void print_bodies(const std::vector<Row>& rows, int threads)
 {
-    std::printf("\nbodies (ns/tet: median ms per step / tets at one thread; B/tet: resident memory the run added):\n");
-    std::printf("%-24s %9s %9s %10s %10s %8s %8s\n", "body", "dt", "tets", "ms 1 thr", "ms more", "speedup", "ns/tet");
     const size_t stride = threads != 1 ? 2 : 1;
+    std::printf(
+        "\nbodies (one thread: wall-clock ms, processor ms and ns/tet per step as median and mean, mean sweeps "
+        "per step;\n%s set-up processor s; B/tet: resident memory the run added):\n",
+        stride == 2 ? fmt::format("{} threads: wall-clock ms and the speed-up over one thread;", threads).c_str() : "");
+    std::printf("%-18s %8s %8s | %8s %8s %8s %7s %7s %6s | %8s %8s %6s %6s | %6s %6s\n", "body", "dt", "tets", "ms",
+                "cpu ms", "cpu mean", "ns/tet", "ns mean", "sweeps", "ms more", "mean", "speed", "mean", "set-up",
+                "B/tet");
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {0, 0};
     for (size_t i = 0; i + stride <= rows.size(); i += stride) {
         const Row& one = rows[i];
         const Row& more = rows[i + stride - 1];
-        std::printf("%-24s %9.5f %9lld %10.2f %10.2f %8.2f %8.1f  %.0f B/tet\n", one.scene.c_str(), one.dt,
-                    static_cast<long long>(one.tets), one.ms, stride == 2 ? more.ms : 0.0,
-                    stride == 2 && more.ms > 0 ? one.ms / more.ms : 1.0, 1e6 * one.ms / static_cast<double>(one.tets),
+        const double tets = static_cast<double>(std::max<Index>(1, one.tets));
+        const double per_tet[2] = {1e6 * one.cpu_ms / tets, 1e6 * one.cpu_ms_mean / tets};
+        for (int k = 0; k < 2; ++k) {
+            lo[k] = std::min(lo[k], per_tet[k]);
+            hi[k] = std::max(hi[k], per_tet[k]);
+        }
+        std::printf("%-18s %8.5f %8lld | %8.2f %8.2f %8.2f %7.1f %7.1f %6.2f | %8.2f %8.2f %6.2f %6.2f | %6.2f %6.0f\n",
+                    one.scene.c_str(), one.dt, static_cast<long long>(one.tets), one.ms, one.cpu_ms, one.cpu_ms_mean,
+                    per_tet[0], per_tet[1], one.sweeps_mean, stride == 2 ? more.ms : 0.0,
+                    stride == 2 ? more.ms_mean : 0.0, stride == 2 && more.ms > 0 ? one.ms / more.ms : 1.0,
+                    stride == 2 && more.ms_mean > 0 ? one.ms_mean / more.ms_mean : 1.0, 1e-3 * one.setup_ms,
                     one.bytes_per_tet);
     }
+    if (rows.size() > stride)
+        std::printf("ns/tet, largest over smallest body: %.2f (median), %.2f (mean)\n", hi[0] / lo[0], hi[1] / lo[1]);
 }
 
 } // namespace
