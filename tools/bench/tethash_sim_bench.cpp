@@ -49,7 +49,13 @@ struct Row {
     double threads = 1;       ///< mean threads per step (--threads 0: chosen step by step)
     double bytes_per_tet = 0; ///< resident memory the run added (set-up, state, detector), per tet
     double ms_mean = 0;       ///< mean ms per step: the cost that counts where some steps were refined
-    double substeps = 1;      ///< mean substeps per step (more than the scene's where steps were refined)
+    /// Processor time of the process per step (ms; median, mean): at one thread the step's own work, which the time
+    /// slices other processes take on a loaded machine leave out (the wall-clock `ms` counts them).
+    double cpu_ms = 0, cpu_ms_mean = 0;
+    double sweeps_mean = 0; ///< mean solver iterations per step (the landing's steps need more than the fall's)
+    double setup_ms = 0;    ///< constructing the simulation (processor time, ms), apart from the steps
+    int threads_asked = 1;  ///< the run's --threads (the --bodies table pairs one thread with more)
+    double substeps = 1;    ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
     std::int64_t unconverged = 0;  ///< substeps whose sweeps reached their cap
     std::int64_t retaken = 0;      ///< steps taken again with tighter tolerances for energy they gained
@@ -92,6 +98,23 @@ sim::ObjectSpec placed(const TetMesh& mesh, double lift, double size)
     return o;
 }
 
+/// Processor time (ms) of a clock: CLOCK_PROCESS_CPUTIME_ID, every thread's (at one thread the work of the step
+/// alone); CLOCK_THREAD_CPUTIME_ID, the calling thread's (what a step cost it, whatever else the machine runs).
+double cpu_ms(clockid_t clock)
+{
+    timespec t{};
+    clock_gettime(clock, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+double process_cpu_ms()
+{
+    return cpu_ms(CLOCK_PROCESS_CPUTIME_ID);
+}
+double thread_cpu_ms()
+{
+    return cpu_ms(CLOCK_THREAD_CPUTIME_ID);
+}
+
 /// Resident memory of the process (bytes), after giving freed memory back.
 double resident_bytes()
 {
@@ -102,14 +125,6 @@ double resident_bytes()
     return resident * 4096.0;
 }
 
-/// The calling thread's CPU time, ms (what a step cost it, whatever else the machine runs).
-double thread_cpu_ms()
-{
-    timespec t{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
-
 /// `cpu_time`: a step's ms are the thread's CPU time (--cpu-time), else the wall clock's.
 Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_time)
 {
@@ -117,24 +132,29 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
     r.scene = name;
     r.integrator = sim::to_string(scene.integrator);
     r.dt = scene.dt;
+    r.threads_asked = scene.detect.threads;
     const double rss0 = resident_bytes();
+    const double setup0 = process_cpu_ms();
     sim::Simulation s(scene);
+    r.setup_ms = process_cpu_ms() - setup0;
     r.vertices = s.mesh().num_vertices();
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
     sim::FarSelfPenetrations far(s.mesh(), start);
     const double energy0 = s.energy().total(), volume0 = sim::total_volume(s.model(), start);
-    std::vector<double> ms, det, dep, prox, resp, integ, other, threads, sw, con, sub;
+    std::vector<double> ms, cpu, det, dep, prox, resp, integ, other, threads, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
     const int frame_every = std::max(1, static_cast<int>(std::lround(1.0 / (60.0 * scene.dt))));
     try {
         for (int i = 0; i < steps; ++i) {
+            const double cpu0 = process_cpu_ms();
             const auto t0 = std::chrono::steady_clock::now();
             const double c0 = cpu_time ? thread_cpu_ms() : 0.0;
             s.step();
             ms.push_back(
                 cpu_time ? thread_cpu_ms() - c0
                          : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            cpu.push_back(process_cpu_ms() - cpu0);
             if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
@@ -165,6 +185,9 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
     r.threads = mean(threads);
     r.sweeps = median(sw);
     r.ms_mean = mean(ms);
+    r.cpu_ms = median(cpu);
+    r.cpu_ms_mean = mean(cpu);
+    r.sweeps_mean = mean(sw);
     r.substeps = sub.empty() ? 1 : mean(sub);
     r.contacts = mean(con);
     r.inverted = sim::count_inverted(s.mesh(), start);
@@ -250,7 +273,7 @@ struct SimBenchOptions {
     std::vector<std::string> integrators{"vbd"}, dts{"1/240"};
     std::vector<double> sizes{1.0}, youngs, bodies;
     double seconds = 0; ///< 0: automatic (run_seconds)
-    int threads = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
+    int threads = 1, rounds = 1, peer_iterations = 10, iterations = 0, max_substeps = 0, max_iterations = 0;
     double convergence = -1;
     bool no_coarse = false;
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
@@ -284,6 +307,12 @@ void add_options(CLI::App& app, SimBenchOptions& o)
     runs->add_option("--threads", o.threads,
                      "detector and solver threads; 0: every core, fewer in the steps where they do not pay (chosen "
                      "as the run goes, as `tethash simulate` does)")
+        ->capture_default_str();
+    runs->add_option("--rounds", o.rounds,
+                     "run each scene this many times; with --bodies one thread and --threads alternate, and the "
+                     "table gives the medians over the rounds and the median of the rounds' speed-ups (interleaved "
+                     "rounds for a loaded machine)")
+        ->check(CLI::Range(1, 100))
         ->capture_default_str();
     runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
     runs->add_flag("--cpu-time", o.cpu_time,
@@ -479,35 +508,82 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         if (!out) throw Error("--csv: cannot write '" + tmp + "'");
         out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
                "ms_response,ms_integrate,ms_other,threads,iterations,substeps,contacts,inverted,far_self,"
-               "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,failure,retaken,"
-               "crossed\n";
+               "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,cpu_ms_step,"
+               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure,retaken,crossed\n";
         for (const Row& r : rows)
             out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
-                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},\"{}\",{},{}\n",
+                               "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},{:.4g},{:.4g},{:.3g},{:"
+                               ".4g},\"{}\",{},{}\n",
                                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
                                r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
                                r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
-                               r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.failure, r.retaken,
-                               r.crossed);
+                               r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.cpu_ms,
+                               r.cpu_ms_mean, r.sweeps_mean, r.setup_ms, r.failure, r.retaken, r.crossed);
     }
     std::filesystem::rename(tmp, csv);
 }
 
-/// --bodies: per body and time step, the cost per step and per tet, the memory per tet and the threads' speed-up
-/// (rows in pairs: one thread, then --threads, as run).
-void print_bodies(const std::vector<Row>& rows, int threads)
+/// --bodies: per body and time step, the cost per step and per tet, the memory per tet and the threads' speed-up,
+/// each the median over the --rounds (rows as run: one thread, then --threads, round after round). The cost per tet
+/// is the processor time at one thread, which other processes on a loaded machine do not inflate (a long step loses
+/// more of its wall-clock time to their time slices than a short one); the median is mostly the fall's steps, the
+/// mean carries the landing's. The speed-up is wall-clock (one round's median over median, mean over mean; the
+/// median over the rounds), the set-up's processor time is apart.
+void print_bodies(const std::vector<Row>& rows, int threads, int rounds)
 {
-    std::printf("\nbodies (ns/tet: median ms per step / tets at one thread; B/tet: resident memory the run added):\n");
-    std::printf("%-24s %9s %9s %10s %10s %8s %8s\n", "body", "dt", "tets", "ms 1 thr", "ms more", "speedup", "ns/tet");
-    const size_t stride = threads != 1 ? 2 : 1;
-    for (size_t i = 0; i + stride <= rows.size(); i += stride) {
+    const bool more = threads != 1;
+    std::printf("\nbodies (one thread: wall-clock ms, processor ms and ns/tet per step as median and mean, mean sweeps "
+                "per step;\n%sset-up processor s; B/tet: resident memory the run added%s):\n",
+                more ? fmt::format("{} threads: wall-clock ms and the speed-up over one thread; ", threads).c_str()
+                     : "",
+                rounds > 1 ? fmt::format("; medians over {} rounds", rounds).c_str() : "");
+    std::printf("%-18s %8s %8s | %8s %8s %8s %7s %7s %6s | %8s %8s %6s %6s | %6s %6s\n", "body", "dt", "tets", "ms",
+                "cpu ms", "cpu mean", "ns/tet", "ns mean", "sweeps", "ms more", "mean", "speed", "mean", "set-up",
+                "B/tet");
+    auto over = [](const std::vector<const Row*>& rs, auto field) {
+        std::vector<double> v;
+        for (const Row* r : rs)
+            v.push_back(field(*r));
+        return median(v);
+    };
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {0, 0};
+    int bodies = 0;
+    for (size_t i = 0; i < rows.size();) {
+        // One body at one integrator and dt: its rounds' rows.
+        size_t end = i;
+        while (end < rows.size() && rows[end].scene == rows[i].scene && rows[end].integrator == rows[i].integrator &&
+               rows[end].dt == rows[i].dt)
+            ++end;
+        std::vector<const Row*> ones, mores;
+        for (size_t k = i; k < end; ++k)
+            (more && rows[k].threads_asked != 1 ? mores : ones).push_back(&rows[k]);
+        std::vector<double> speed, speed_mean;
+        for (size_t k = 0; k < std::min(ones.size(), mores.size()); ++k) {
+            speed.push_back(mores[k]->ms > 0 ? ones[k]->ms / mores[k]->ms : 0.0);
+            speed_mean.push_back(mores[k]->ms_mean > 0 ? ones[k]->ms_mean / mores[k]->ms_mean : 0.0);
+        }
         const Row& one = rows[i];
-        const Row& more = rows[i + stride - 1];
-        std::printf("%-24s %9.5f %9lld %10.2f %10.2f %8.2f %8.1f  %.0f B/tet\n", one.scene.c_str(), one.dt,
-                    static_cast<long long>(one.tets), one.ms, stride == 2 ? more.ms : 0.0,
-                    stride == 2 && more.ms > 0 ? one.ms / more.ms : 1.0, 1e6 * one.ms / static_cast<double>(one.tets),
-                    one.bytes_per_tet);
+        const double tets = static_cast<double>(std::max<Index>(1, one.tets));
+        const double per_tet[2] = {1e6 * over(ones, [](const Row& r) { return r.cpu_ms; }) / tets,
+                                   1e6 * over(ones, [](const Row& r) { return r.cpu_ms_mean; }) / tets};
+        for (int k = 0; k < 2; ++k) {
+            lo[k] = std::min(lo[k], per_tet[k]);
+            hi[k] = std::max(hi[k], per_tet[k]);
+        }
+        std::printf("%-18s %8.5f %8lld | %8.2f %8.2f %8.2f %7.1f %7.1f %6.2f | %8.2f %8.2f %6.2f %6.2f | %6.2f %6.0f\n",
+                    one.scene.c_str(), one.dt, static_cast<long long>(one.tets),
+                    over(ones, [](const Row& r) { return r.ms; }), over(ones, [](const Row& r) { return r.cpu_ms; }),
+                    over(ones, [](const Row& r) { return r.cpu_ms_mean; }), per_tet[0], per_tet[1],
+                    over(ones, [](const Row& r) { return r.sweeps_mean; }),
+                    over(mores, [](const Row& r) { return r.ms; }), over(mores, [](const Row& r) { return r.ms_mean; }),
+                    speed.empty() ? 1.0 : median(speed), speed_mean.empty() ? 1.0 : median(speed_mean),
+                    1e-3 * over(ones, [](const Row& r) { return r.setup_ms; }),
+                    over(ones, [](const Row& r) { return r.bytes_per_tet; }));
+        ++bodies;
+        i = end;
     }
+    if (bodies > 1)
+        std::printf("ns/tet, largest over smallest body: %.2f (median), %.2f (mean)\n", hi[0] / lo[0], hi[1] / lo[1]);
 }
 
 } // namespace
@@ -558,14 +634,15 @@ int main(int argc, char** argv)
             if (!o.bodies.empty() && o.threads != 1) thread_counts.insert(thread_counts.begin(), 1);
             for (sim::Integrator i : integ)
                 for (double dt : steps_dt)
-                    for (int threads : thread_counts) {
-                        apply_overrides(scene, o, i, dt);
-                        scene.detect.threads = threads;
-                        const int steps = std::max(1, static_cast<int>(std::lround(run_seconds(o, scene) / dt)));
-                        const Row r = run(name, scene, steps, o.cpu_time);
-                        print(r);
-                        rows.push_back(r);
-                    }
+                    for (int round = 0; round < o.rounds; ++round)
+                        for (int threads : thread_counts) {
+                            apply_overrides(scene, o, i, dt);
+                            scene.detect.threads = threads;
+                            const int steps = std::max(1, static_cast<int>(std::lround(run_seconds(o, scene) / dt)));
+                            const Row r = run(name, scene, steps, o.cpu_time);
+                            print(r);
+                            rows.push_back(r);
+                        }
 #ifdef TETHASH_HAVE_BULLET
             if (!o.no_peer && o.bodies.empty())
                 for (double dt : steps_dt) {
@@ -579,7 +656,7 @@ int main(int argc, char** argv)
 #endif
         }
         print_stable_dt(rows);
-        if (!o.bodies.empty()) print_bodies(rows, o.threads);
+        if (!o.bodies.empty()) print_bodies(rows, o.threads, o.rounds);
         if (!o.csv.empty()) write_csv(o.csv, rows);
     } catch (const Error& e) {
         std::fprintf(stderr, "tethash_sim_bench: %s\n", e.what());
