@@ -168,6 +168,8 @@ TEST(CliSimulate, BadSceneKeysAndOptionsExit2)
     write_text(dir / "bad4.toml", "continuous_check = \"on\"\n[[object]]\ngenerate = { shape = \"box\" }\n");
     r = run_tethash("simulate " + quote(dir / "bad4.toml") + " --steps 1 --out " + quote(dir / "o"));
     expect_refused(r, {"bad4.toml:1", "continuous_check"});
+    r = run_tethash("simulate --contact-edges yes --steps 1 --out " + quote(dir / "o"));
+    expect_refused(r, {"--contact-edges", "on or off", "'yes'"});
 }
 
 TEST(CliSimulate, BlowUpStopsWithStatus1AndNoNaNFrame)

@@ -17,6 +17,36 @@ using Mat3 = Eigen::Matrix3d;
 using tethash::detail::Clock;
 using tethash::detail::ms_since;
 
+/// Closest points of segments p0 p1 and q0 q1: p0 + s (p1 − p0) and q0 + u (q1 − q0), s, u in [0, 1].
+void closest_points(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& u)
+{
+    const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+    const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+    s = 0;
+    u = 0;
+    if (!(a > 0) && !(e > 0)) return;
+    if (!(a > 0)) {
+        u = std::clamp(f / e, 0.0, 1.0);
+        return;
+    }
+    const double c = d1.dot(r);
+    if (!(e > 0)) {
+        s = std::clamp(-c / a, 0.0, 1.0);
+        return;
+    }
+    const double b = d1.dot(d2), denom = a * e - b * b;
+    // Parallel segments (denom 0): any s; 0, then u and s clamped in turn.
+    s = denom > 0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+    u = (b * s + f) / e;
+    if (u < 0) {
+        u = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+    } else if (u > 1) {
+        u = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+    }
+}
+
 } // namespace
 
 void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model& model,
@@ -54,6 +84,9 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
             m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
                               local_contact_edges);
         m_proximity.set_threads(scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core());
+        if (scene.contact.edges)
+            m_edges.set_topology(mesh.tets, mesh.num_vertices(), mesh.vertex_object, mesh.tet_object, options);
+        m_edge_threads = scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core();
     }
 }
 
@@ -62,6 +95,7 @@ void ContactResponse::set_threads(int threads)
     if (!m_enabled) return;
     m_detector.set_threads(threads);
     m_proximity.set_threads(threads > 0 ? threads : detail::ThreadChoice::every_core());
+    m_edge_threads = threads > 0 ? threads : detail::ThreadChoice::every_core();
 }
 
 double ContactResponse::pair_stiffness(Index a, Index b, double m_eff) const
@@ -86,6 +120,7 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     m_k.clear();
     m_c.clear();
     m_mred.clear();
+    m_edge_pairs.clear();
     m_ignored_local = 0;
     if (!m_enabled) return;
     auto t0 = Clock::now();
@@ -135,8 +170,19 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
         if (c.tet >= 0 && c.depth > 0) m_active.back().depth += m_proximity.margin(c.vertex); // 0 without margin
     }
     m_active.insert(m_active.end(), m_near.begin(), m_near.end());
+    stats.ms_response += ms_since(t0);
+    if (m_params.edges) {
+        t0 = Clock::now();
+        const EdgeFaceResult& crossings = m_edges.find(x, m_edge_threads);
+        add_edge_contacts(crossings, x);
+        stats.ms_detect += ms_since(t0);
+        stats.edge_contacts = static_cast<std::int64_t>(m_edge_pairs.size());
+    }
+
+    t0 = Clock::now();
     const std::vector<Contact>& active = m_active;
     const size_t nc = active.size();
+    const size_t edge_begin = nc - m_edge_pairs.size();
     m_k.resize(nc);
     m_c.resize(nc);
     m_mred.resize(nc);
@@ -144,11 +190,23 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     for (size_t q = 0; q < nc; ++q) {
         const Contact& c = active[q];
         // Effective mass of the contact: 1 / (1/m_v + Σ b_j² / m_j), the mass the penalty's direction sees when
-        // the tet's point is x = Σ b_j x_j (fixed vertices and obstacles: infinite mass).
-        double inv = model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
-        for (int k = 0; k < 4 && c.tet >= 0; ++k) {
-            const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
-            if (!model.fixed[j]) inv += c.bary[k] * c.bary[k] / model.mass[j];
+        // the tet's point is x = Σ b_j x_j (fixed vertices and obstacles: infinite mass); an edge contact's, 1 / Σ
+        // coef_j² / m_j over its four ends.
+        double inv = 0;
+        if (q >= edge_begin) {
+            Index node[5];
+            double coef[5];
+            stencil(q, node, coef);
+            for (int k = 0; k < 4; ++k) {
+                const size_t j = static_cast<size_t>(node[k]);
+                if (!model.fixed[j]) inv += coef[k] * coef[k] / model.mass[j];
+            }
+        } else {
+            inv = model.fixed[static_cast<size_t>(c.vertex)] ? 0.0 : 1.0 / model.mass[static_cast<size_t>(c.vertex)];
+            for (int k = 0; k < 4 && c.tet >= 0; ++k) {
+                const size_t j = static_cast<size_t>(mesh.tets(c.tet, k));
+                if (!model.fixed[j]) inv += c.bary[k] * c.bary[k] / model.mass[j];
+            }
         }
         m_mred[q] = inv > 0 ? 1.0 / inv : 0.0;
         m_k[q] = pair_stiffness(c.vertex_object, c.tet_object, m_mred[q]);
@@ -170,9 +228,96 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     stats.ms_response += ms_since(t0);
 }
 
+void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Positions& x)
+{
+    const Model& model = *m_model;
+    const std::vector<EdgeFaceContact>& crossings = found.contacts; // sorted by (edge, face)
+    const Edges& edges = found.edges;                               // (i < j), sorted
+    const auto edge_index = [&](Index i, Index j) -> Index {
+        if (i > j) std::swap(i, j);
+        Index lo = 0, hi = static_cast<Index>(edges.rows());
+        while (lo < hi) {
+            const Index mid = lo + (hi - lo) / 2;
+            if (edges(mid, 0) < i || (edges(mid, 0) == i && edges(mid, 1) < j))
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        return lo < edges.rows() && edges(lo, 0) == i && edges(lo, 1) == j ? lo : -1;
+    };
+    // Whether boundary edge g passes through a boundary face of `object`.
+    const auto crosses_object = [&](Index g, Index object) {
+        auto it = std::lower_bound(crossings.begin(), crossings.end(), g,
+                                   [](const EdgeFaceContact& c, Index e) { return c.edge < e; });
+        for (; it != crossings.end() && it->edge == g; ++it)
+            if (it->face_object == object) return true;
+        return false;
+    };
+    const Positions& rest = m_rest;
+    // The pairs (edge, an edge of a face it passes through that passes through the first edge's object), each
+    // once, the lower edge index first: the crossings of the intersection of two surfaces, taken two by two.
+    m_edge_keys.clear();
+    for (const EdgeFaceContact& c : crossings) {
+        if (c.edge_object == c.face_object) { // a self pair the rest state calls local is the material's
+            const double reach = local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.face_object)];
+            bool local = false;
+            for (const Index p : c.edge_vertices)
+                for (const Index f : c.face_vertices)
+                    local = local || (rest.row(p) - rest.row(f)).squaredNorm() < reach * reach;
+            if (local) continue;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const Index g = edge_index(c.face_vertices[k], c.face_vertices[(k + 1) % 3]);
+            if (g < 0 || !crosses_object(g, c.edge_object)) continue;
+            m_edge_keys.emplace_back(std::min(c.edge, g), std::max(c.edge, g));
+        }
+    }
+    std::sort(m_edge_keys.begin(), m_edge_keys.end());
+    m_edge_keys.erase(std::unique(m_edge_keys.begin(), m_edge_keys.end()), m_edge_keys.end());
+    for (const auto& [ea, eb] : m_edge_keys) {
+        EdgePair e{};
+        for (int k = 0; k < 2; ++k) {
+            e.a[k] = edges(ea, k);
+            e.b[k] = edges(eb, k);
+        }
+        const Vec3 a0 = x.row(e.a[0]).transpose(), a1 = x.row(e.a[1]).transpose();
+        const Vec3 b0 = x.row(e.b[0]).transpose(), b1 = x.row(e.b[1]).transpose();
+        closest_points(a0, a1, b0, b1, e.s, e.u);
+        const Vec3 gap = (b0 + e.u * (b1 - b0)) - (a0 + e.s * (a1 - a0));
+        const double depth = gap.norm();
+        const Index oa = model.vertex_object[static_cast<size_t>(e.a[0])];
+        if (!(depth > 1e-12 * model.object_mean_edge[static_cast<size_t>(oa)])) continue; // met: no direction
+        Contact ct;
+        ct.vertex = e.s > 0.5 ? e.a[1] : e.a[0];
+        ct.vertex_object = oa;
+        ct.tet = -1;
+        ct.tet_object = model.vertex_object[static_cast<size_t>(e.b[0])];
+        ct.depth = depth;
+        for (int r = 0; r < 3; ++r)
+            ct.direction[r] = gap(r) / depth; // a towards b
+        m_edge_pairs.push_back(e);
+        m_active.push_back(ct);
+    }
+}
+
 void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
 {
     const Contact& c = m_active[q];
+    const size_t edge_begin = m_active.size() - m_edge_pairs.size();
+    if (q >= edge_begin) {
+        const EdgePair& e = m_edge_pairs[q - edge_begin];
+        node[0] = e.a[0];
+        node[1] = e.a[1];
+        node[2] = e.b[0];
+        node[3] = e.b[1];
+        node[4] = e.a[0];
+        coef[0] = 1.0 - e.s;
+        coef[1] = e.s;
+        coef[2] = -(1.0 - e.u);
+        coef[3] = -e.u;
+        coef[4] = 0.0;
+        return;
+    }
     node[0] = c.vertex;
     coef[0] = 1.0;
     if (c.tet < 0) { // an obstacle: fixed, only the vertex moves

@@ -7,6 +7,7 @@
 #include "proximity.hpp"
 
 #include "tethash/detect.hpp"
+#include "tethash/edge_contacts.hpp"
 #include "tethash/penetration.hpp"
 #include "tethash/sim/model.hpp"
 #include "tethash/sim/scene.hpp"
@@ -14,6 +15,7 @@
 
 #include <Eigen/Sparse>
 
+#include <utility>
 #include <vector>
 
 namespace tethash::sim {
@@ -58,8 +60,11 @@ class ContactResponse {
     const std::vector<Contact>& active() const { return m_active; }
     /// The margin contacts (proximity.hpp): depth = the vertex's margin − its distance to the face (< 0: speculative).
     const std::vector<Contact>& margin_contacts() const { return m_near; }
-    /// Whether active contact q is a margin contact (they follow the penetrating ones).
+    /// Whether active contact q is a margin contact (they follow the penetrating ones; the edge contacts follow
+    /// them, and count as margin contacts here: they are pushed while their depth is positive).
     bool is_margin(size_t q) const { return q >= m_contacts.size(); }
+    /// The edge contacts (ContactParams::edges) at the last update: how many follow the margin contacts in active().
+    size_t edge_contacts() const { return m_edge_pairs.size(); }
     std::int64_t ignored_local() const { return m_ignored_local; }
     /// Per contact: weight (1 / contacts of the vertex with that object), stiffness, damping, effective mass.
     const std::vector<double>& weight() const { return m_weight; }
@@ -68,7 +73,8 @@ class ContactResponse {
     double friction() const { return m_mu; }
     /// The five nodes of contact q (its vertex, then the tet's four) and their coefficients (1, −b0 … −b3):
     /// the gap along the direction changes by −n · Σ coef_a Δx_a. An obstacle contact (tet −1): the vertex, then
-    /// the vertex again four times with coefficient 0 (the obstacle does not move).
+    /// the vertex again four times with coefficient 0 (the obstacle does not move). An edge contact: the first
+    /// edge's two ends (1 − s, s) and the second's (−(1 − u), −u), then the first end again with coefficient 0.
     void stencil(size_t q, Index node[5], double coef[5]) const;
 
     /// f += penalty + friction forces at velocities `vel` for a step h (friction capped so that it cannot reverse
@@ -90,6 +96,17 @@ class ContactResponse {
     /// scale_k · k + scale_c · c (the matrix terms of the three functions above).
     template <class Visit> void for_each_term(double scale_k, double scale_c, Visit&& visit) const;
 
+    /// An edge contact (ContactParams::edges): edge a of one object passes through a far boundary face that has
+    /// edge b, and b passes through a boundary face of a's object; a is pushed towards b (and b towards a) along the
+    /// segment between their closest points a(s), b(u), by its length.
+    struct EdgePair {
+        Index a[2], b[2];
+        double s, u;
+    };
+    /// The edge contacts of the edge-face contacts found at x, into m_edge_pairs and (as Contacts, vertex a's
+    /// nearer end, tet −1) appended to m_active.
+    void add_edge_contacts(const EdgeFaceResult& found, const Positions& x);
+
     const TetMesh* m_mesh = nullptr;
     const Model* m_model = nullptr;
     Positions m_rest; // rest (start) positions, for telling local self-contacts from folds
@@ -99,6 +116,10 @@ class ContactResponse {
     Detector m_detector;
     Penetration m_penetration;
     Proximity m_proximity;
+    EdgeFaceDetector m_edges; ///< ContactParams::edges
+    int m_edge_threads = 1;
+    std::vector<EdgePair> m_edge_pairs; ///< the edge contacts, the last m_edge_pairs.size() of m_active
+    std::vector<std::pair<Index, Index>> m_edge_keys;
     std::vector<Contact> m_contacts, m_near, m_active;
     std::vector<double> m_weight, m_k, m_c, m_mred;
     std::vector<double> m_object_rate; // automatic penalty per unit effective mass per object (0: static)

@@ -425,7 +425,8 @@ const std::vector<Key<ContactParams>>& contact_keys()
     static const std::vector<Key<ContactParams>> keys =
         joined(penalty_keys<ContactParams>(), {key("in_matrix", &ContactParams::in_matrix, &Reader::boolean),
                                                key("margin", &ContactParams::margin, &Reader::non_negative),
-                                               key("speculative", &ContactParams::speculative, &Reader::boolean)});
+                                               key("speculative", &ContactParams::speculative, &Reader::boolean),
+                                               key("edges", &ContactParams::edges, &Reader::boolean)});
     return keys;
 }
 

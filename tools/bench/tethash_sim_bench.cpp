@@ -278,7 +278,7 @@ struct SimBenchOptions {
     bool no_coarse = false;
     double skin = -1, sweep_tolerance = -1, rho = -1, margin = -1;
     bool no_speculative = false, inversion_guard = false;
-    std::string crossing_check, continuous_check;
+    std::string crossing_check, continuous_check, contact_edges;
     bool no_peer = false;
     bool cpu_time = false;
 };
@@ -347,6 +347,10 @@ void add_options(CLI::App& app, SimBenchOptions& o)
         ->add_option("--continuous-check", o.continuous_check,
                      "on or off: also sweep each substep by continuous detection and retake a step where a far pair "
                      "met unseen (continuous_check)")
+        ->check(CLI::IsMember({"on", "off"}));
+    overrides
+        ->add_option("--contact-edges", o.contact_edges,
+                     "on or off: push boundary edges out of the far boundary faces they pass through (contact.edges)")
         ->check(CLI::IsMember({"on", "off"}));
     CLI::Option_group* peer = app.add_option_group("Peer", "Bullet's soft bodies, when built with libbullet-dev");
     peer->add_flag("--no-peer", o.no_peer, "do not run the peer even when built with it");
@@ -478,6 +482,7 @@ void apply_overrides(sim::Scene& scene, const SimBenchOptions& o, sim::Integrato
     if (o.inversion_guard) scene.inversion_guard = true;
     if (!o.crossing_check.empty()) scene.crossing_check = o.crossing_check == "on";
     if (!o.continuous_check.empty()) scene.continuous_check = o.continuous_check == "on";
+    if (!o.contact_edges.empty()) scene.contact.edges = o.contact_edges == "on";
     if (o.skin >= 0) {
         scene.detect.skin_mode = DetectParams::SkinMode::factor_of_cell_size;
         scene.detect.skin = o.skin;

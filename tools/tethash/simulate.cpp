@@ -68,6 +68,7 @@ struct SimulateOptions {
     std::string integrator;
     std::string crossing_check;   ///< "" = the scene's; "on" or "off"
     std::string continuous_check; ///< "" = the scene's; "on" or "off"
+    std::string contact_edges;    ///< "" = the scene's; "on" or "off"
     std::string threads;          ///< "" = the scene's
     std::string out = "out";
     bool strict = false; ///< a run that cannot be trusted (RunHealth::problems) exits 1
@@ -162,6 +163,7 @@ height = 0.0
 
 [contact]
 # margin = 0.25         # contact before penetration, in mean edges
+# edges = false         # push edges out of far faces they pass through with no vertex inside
 # friction = 0.0
 
 [output]
@@ -277,6 +279,11 @@ sim::Scene simulate_scene(SimulateOptions& o, std::string& mesh_scene)
         if (o.continuous_check != "on" && o.continuous_check != "off")
             throw Error("--continuous-check must be on or off, found '" + o.continuous_check + "'");
         scene.continuous_check = o.continuous_check == "on";
+    }
+    if (!o.contact_edges.empty()) {
+        if (o.contact_edges != "on" && o.contact_edges != "off")
+            throw Error("--contact-edges must be on or off, found '" + o.contact_edges + "'");
+        scene.contact.edges = o.contact_edges == "on";
     }
     if (!o.threads.empty())
         scene.detect.threads = parse_threads(o.threads);
@@ -639,6 +646,9 @@ Registrar reg{
                         "detection and take the step again in more substeps where a vertex-face or edge-edge pair of "
                         "different objects or far parts met unseen by the contacts (a vertex through a thin layer, an "
                         "edge through a face)");
+         sub.add_option("--contact-edges", o->contact_edges,
+                        "on or off (overrides the scene's contact.edges): push a boundary edge that passes through a "
+                        "far boundary face, with no vertex inside, out of it");
          sub.add_option("--threads", o->threads,
                         "Threads of the detector and the solver: 0 = every hardware thread, fewer in the steps "
                         "where they do not pay (measured as the run goes), or a fixed 1..256 (default: the scene's "

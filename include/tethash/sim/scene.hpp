@@ -85,6 +85,11 @@ struct ContactParams {
     /// pushes only if the gap closes within the substep's iterations (vbd; the other integrators push positive
     /// depths only). Off: false.
     bool speculative = true;
+    /// A boundary edge through a far boundary face (edge_contacts.hpp, found at the start of each substep; the
+    /// crossings no vertex-in-tet contact sees) pushes the edge and each edge of that face which itself passes
+    /// through the edge's object towards each other, by the distance between them (docs/simulator.md, Contacts,
+    /// step 9). Off: false.
+    bool edges = false;
 };
 
 struct Output {

@@ -9,7 +9,7 @@ namespace tethash::sim {
 
 /// Timing and contact figures of one step (all its substeps). Times in milliseconds.
 struct StepStats {
-    double ms_detect = 0;           ///< Detector::detect
+    double ms_detect = 0;           ///< Detector::detect, the obstacles' and the edge-face contacts (contact.edges)
     double ms_depth = 0;            ///< penetration depth and direction (Penetration::compute)
     double ms_proximity = 0;        ///< margin and speculative contacts (near pairs of far surfaces)
     double ms_response = 0;         ///< contact set-up: filtering, stiffness, damping, per-vertex lists
@@ -18,6 +18,7 @@ struct StepStats {
     int threads = 1;                ///< threads the step ran on (threads = 0: chosen step by step)
     std::int64_t contacts = 0;      ///< vertices inside tets at the last substep (contacts())
     std::int64_t near_contacts = 0; ///< margin contacts at the last substep: vertices near a far surface
+    std::int64_t edge_contacts = 0; ///< edge contacts at the last substep (contact.edges): edges through far faces
     std::int64_t ignored_local = 0; ///< self-contacts at the last substep left to the elastic terms: the tet lies
                                     ///< within 2 mean edges of the vertex in the rest state (local inversion)
     double max_depth = 0;           ///< largest penetration depth at the last substep (0 without contacts)
