@@ -129,7 +129,13 @@ class BlockDescent final : public StepIntegrator {
         ++m_tighter;
         return true;
     }
-    void relax() override { m_tighter = 0; }
+    void relax() override
+    {
+        m_tighter = 0;
+        m_resumable = false;
+    }
+    bool resumable() const override { return m_resumable; }
+    int resume(Positions& x, Positions& v, double h) override;
     void set_threads(int threads) override
     {
 #ifdef TETHASH_HAVE_OPENMP
@@ -184,6 +190,11 @@ class BlockDescent final : public StepIntegrator {
     void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
     /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
     void accelerate(int n, double rho, double& omega, double* x);
+    /// The substep's sweeps on m_x4, from where m_run left them, until converged (the tolerances m_tighter's) or the
+    /// substep has swept `max_iterations` times in all; returns the sweeps taken now.
+    int iterate(double h);
+    /// The sweeps' end into x and v (v from the substep's start m_xt, the acceleration against its start velocity).
+    void end_substep(Positions& x, Positions& v, double h);
 
     StepContext m_ctx;
     // Fixed set-up, built once: the free vertices of each colour in groups of four lanes (vertex_stencils.hpp),
@@ -215,7 +226,17 @@ class BlockDescent final : public StepIntegrator {
     std::vector<double> m_prev1, m_prev2; ///< the iterates of the two previous sweeps (Chebyshev acceleration)
     std::vector<double> m_group_moved;    ///< per group: Σ dᵀ H d of the current sweep
     std::vector<double> m_moved_history;  ///< Σ dᵀ H d of each sweep of the substep
-    bool m_converged = true;              ///< the last substep's sweeps met the tolerance
+    Positions m_vt;                       ///< velocities at the start of the substep
+    /// Where the substep's sweeps stand, kept so that a retake for energy continues them (resume): the sweeps taken,
+    /// the largest sweep's moves (the convergence test's reference), the Chebyshev weight, the coarse space's use.
+    struct SweepRun {
+        int sweeps = 0;
+        double omega = 1, moved_max = 0;
+        bool use_coarse = false, first_coarse = true;
+    };
+    SweepRun m_run;
+    bool m_resumable = false; ///< the last substep's state is intact: resume may continue it
+    bool m_converged = true;  ///< the last substep's sweeps met the tolerance
     int m_tighter = 0; ///< times the step is being taken again for energy it gained (tighten): tolerances / 10 each
     mutable std::vector<char> m_entered; ///< vertex id → it stepped into a contact in this substep (leaving_fraction)
     double m_energy_ref = 0;             ///< the energy the scene has to spend (energy_scale at the first substep)
@@ -875,7 +896,6 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     start_substep(xp);
     m_y.resize(3 * un);
     const bool automatic = m_ctx.scene.iterations <= 0;
-    const double inv_h = 1.0 / h;
     if (!(m_energy_ref > 0)) m_energy_ref = energy_scale(x, v);
     // Chebyshev acceleration: the scene's ρ, or automatic: none with the coarse space (its corrections carry the
     // long waves the acceleration was for), 0.9 without.
@@ -914,6 +934,46 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     gather_contacts();
     m_entered.assign(un, 0);
 
+    m_vt = v;
+    m_run = SweepRun{};
+    m_run.use_coarse = !m_coarse.empty();
+    m_moved_history.clear();
+    if (rho > 0) {
+        m_prev2.assign(xp, xp + 4 * un);
+        m_prev1 = m_prev2;
+    }
+    const int sweeps = iterate(h);
+    if (m_ctx.scene.inversion_guard) m_inversions.restore_in_substep(xp);
+    end_substep(x, v, h);
+    // Continued only where nothing changes the iterate between its end and the sweeps (the inversion guard's
+    // restoration does, and an interrupted substep is rolled back) and sweeps are left below the cap (a capped
+    // substep is started over, with the cap's sweeps again).
+    m_resumable =
+        automatic && !m_ctx.scene.inversion_guard && !m_ctx.interrupted() && m_run.sweeps < m_ctx.scene.max_iterations;
+    return sweeps;
+}
+
+int BlockDescent::resume(Positions& x, Positions& v, double h)
+{
+    assert(m_resumable && x.rows() == m_xt.rows());
+    // The same substep continued from where its sweeps stopped: the same start m_xt, inertial target m_y, contacts
+    // (gathered at its start), vertices that entered a contact (m_entered), convergence reference (the largest
+    // sweep's moves and the moves' history), Chebyshev iterates and coarse factorisation; only the tolerances are
+    // tighter (m_tighter). The acceleration m_accel is taken against the start velocity m_vt, as a retake from the
+    // start leaves it. A retake from the start swept again from its predictor: the small raptor at 1/60 took 57.6
+    // sweeps a step that way, 45.2 continued (docs/simulator.md, "Where a 15 cm step's extra work goes").
+    const int sweeps = iterate(h);
+    end_substep(x, v, h);
+    m_resumable = !m_ctx.interrupted() && m_run.sweeps < m_ctx.scene.max_iterations;
+    return sweeps;
+}
+
+int BlockDescent::iterate(double h)
+{
+    double* xp = m_x4.data()->c;
+    const bool automatic = m_ctx.scene.iterations <= 0;
+    const double rho = m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
+
     // Automatic: sweep until a sweep's moves (Σ dᵀ H d) are below `convergence` of the largest sweep's of the substep
     // and below energy_tolerance of the scene's energy, or they hardly move at all; at least min_sweeps, at most
     // max_iterations (then the substep is reported unconverged). A fixed `iterations` sweeps that many times.
@@ -929,23 +989,19 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     // step ended its drop with several times its start energy, every substep converged; docs/simulator.md, "Figures
     // behind the code's constants").
     const double refined_share = tighter * std::min(1.0, h * m_ctx.scene.substeps / m_ctx.scene.dt);
-    int sweeps = 0;
-    double omega = 1, moved_max = 0;
-    m_moved_history.clear();
+    // A continued substep (resume) counts its sweeps on from the first attempt's (the coarse corrections keep their
+    // rhythm, the stall test its history, the cap is the substep's): what a retake from the start would have swept.
+    int& sweeps = m_run.sweeps;
+    const int first_sweep = sweeps;
+    double& moved_max = m_run.moved_max;
     m_converged = !automatic;
-    if (rho > 0) {
-        m_prev2.assign(xp, xp + 4 * un);
-        m_prev1 = m_prev2;
-    }
-    bool use_coarse = !m_coarse.empty();
     bool met_base = false;
-    bool first_coarse = true;
     while (sweeps < max_sweeps) {
         if (m_ctx.interrupted()) break; // Ctrl-C: the simulation rolls the step back
         refresh_contacts(xp);
         const Sweep sw = sweep(xp, h);
         ++sweeps;
-        if (rho > 0) accelerate(sweeps, rho, omega, xp);
+        if (rho > 0) accelerate(sweeps, rho, m_run.omega, xp);
         if (sw.largest <= stop) break;
         moved_max = std::max(moved_max, sw.moved);
         const double energy_limit = energy_tolerance * refined_share * m_energy_ref;
@@ -966,29 +1022,37 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
         // converged.
         met_base = m_tighter > 0 && (sw.moved <= tol2 / tighter * moved_max || stalled) &&
                    0.5 * sw.moved <= energy_limit / tighter;
-        if (use_coarse && sweeps % sweeps_per_correction == 0 && sweeps < max_sweeps) {
-            use_coarse = coarse_correction(xp, h, first_coarse) >= 0;
-            first_coarse = false;
+        if (m_run.use_coarse && sweeps % sweeps_per_correction == 0 && sweeps < max_sweeps) {
+            m_run.use_coarse = coarse_correction(xp, h, m_run.first_coarse) >= 0;
+            m_run.first_coarse = false;
         }
     }
     if (!m_converged && met_base) m_converged = true;
-    if (m_ctx.scene.inversion_guard) m_inversions.restore_in_substep(xp);
+    return sweeps - first_sweep;
+}
+
+void BlockDescent::end_substep(Positions& x, Positions& v, double h)
+{
+    const Model& model = m_ctx.model;
+    const size_t un = m_x4.size();
+    const double* xp = m_x4.data()->c;
+    const double inv_h = 1.0 / h;
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
         for (int r = 0; r < 3; ++r) {
-            const double v_old = v(static_cast<Index>(i), r);
+            const double v_old = m_vt(static_cast<Index>(i), r);
             x(static_cast<Index>(i), r) = xp[4 * i + static_cast<size_t>(r)];
             v(static_cast<Index>(i), r) = (x(static_cast<Index>(i), r) - m_xt(static_cast<Index>(i), r)) * inv_h;
             m_accel[3 * i + static_cast<size_t>(r)] = (v(static_cast<Index>(i), r) - v_old) * inv_h;
         }
     }
-    return sweeps;
 }
 
 void BlockDescent::finish_step(Positions& x, const std::vector<std::int32_t>& inverted)
 {
     // With the guard each substep ended with restore_in_substep (its slivers may stay inverted: turned back here
     // too, its pressed struts at 1/60 ended with a non-sliver inverted).
+    m_resumable = false;
     if (inverted.empty() || m_ctx.scene.inversion_guard) return;
     // Positions only: the velocities keep what the step gave them, so the moves add no kinetic energy.
     const size_t un = static_cast<size_t>(x.rows());

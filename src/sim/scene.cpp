@@ -454,6 +454,7 @@ std::vector<Key<Scene>> scene_keys(std::optional<Eigen::Vector3d>& up)
         int_key("max_iterations", &Scene::max_iterations, 1),
         key("convergence", &Scene::convergence, &Reader::fraction_below_one),
         key("coarse_space", &Scene::coarse_space, &Reader::boolean),
+        key("resume_retakes", &Scene::resume_retakes, &Reader::boolean),
         key("tolerance", &Scene::tolerance, &Reader::positive),
         key("sweep_tolerance", &Scene::sweep_tolerance, &Reader::non_negative),
         key("acceleration", &Scene::acceleration, &Reader::fraction_below_one),

@@ -499,29 +499,35 @@ void Simulation::step()
         return true;
     };
     double energy_now = 0, volume_now = 0;
+    // The step's one substep is continued rather than taken again from the step's start (a retake for energy).
+    bool resuming = false;
     for (;;) {
         const double h = s.scene.dt / substeps;
         std::string bad;
         bool crossed = false, swept = false;
         for (sub = 0; sub < substeps; ++sub) {
-            try {
-                s.update_contacts(x, h, st);
-            } catch (const Error& e) {
-                // The input was checked at construction: a detector error now comes from the state (a vertex
-                // flung far away, a tet stretched over millions of cells), i.e. from a diverging run.
-                bad = std::string("collision detection failed (") + e.what() + ")";
-                break;
+            // A continued substep keeps its contacts, watched pairs and start (x_substep).
+            if (!resuming) {
+                try {
+                    s.update_contacts(x, h, st);
+                } catch (const Error& e) {
+                    // The input was checked at construction: a detector error now comes from the state (a vertex
+                    // flung far away, a tet stretched over millions of cells), i.e. from a diverging run.
+                    bad = std::string("collision detection failed (") + e.what() + ")";
+                    break;
+                }
+                // A far part entered within the last substep, unseen by its contacts: the step again in more
+                // substeps. (entered_unseen also refreshes the watched pairs, which the sweep reads.)
+                const bool unseen = (s.scene.crossing_check || sweeping) && s.entered_unseen();
+                if (unseen && s.scene.crossing_check && sub > 0 && substeps * 2 <= max_substeps) {
+                    crossed = true;
+                    break;
+                }
+                if (sweeping) s.x_substep = x;
             }
-            // A far part entered within the last substep, unseen by its contacts: the step again in more substeps.
-            // (entered_unseen also refreshes the watched pairs, which the sweep reads.)
-            const bool unseen = (s.scene.crossing_check || sweeping) && s.entered_unseen();
-            if (unseen && s.scene.crossing_check && sub > 0 && substeps * 2 <= max_substeps) {
-                crossed = true;
-                break;
-            }
-            if (sweeping) s.x_substep = x;
             const auto t0 = Clock::now();
-            st.solver_iterations += s.integrator->substep(x, s.v, h);
+            st.solver_iterations += resuming ? s.integrator->resume(x, s.v, h) : s.integrator->substep(x, s.v, h);
+            resuming = false;
             if (!s.integrator->converged()) ++st.unconverged;
             st.ms_integrate += ms_since(t0);
             if (s.interrupt && *s.interrupt) {
@@ -564,10 +570,15 @@ void Simulation::step()
         // A passive scene's step cannot gain energy: one that did stopped its iterations short (slow convergence
         // where contacts switch: a stiff body's bounce) and is taken again with tighter tolerances, then, if it still
         // gains, in more substeps (a small sheet falling over at 1/60 folds onto itself faster than its contacts see).
+        // A step of one substep continues its iterations from where they stopped (Scene::resume_retakes); one of
+        // several starts over.
         if (energy_now > s.health.energy_end + energy_step_slack * s.health.energy_scale) {
             if (s.integrator->tighten()) {
-                x = s.x_save;
-                s.v = s.v_save;
+                resuming = substeps == 1 && s.scene.resume_retakes && s.integrator->resumable();
+                if (!resuming) {
+                    x = s.x_save;
+                    s.v = s.v_save;
+                }
                 st.unconverged = 0;
                 ++st.tightened;
                 continue;

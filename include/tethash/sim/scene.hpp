@@ -129,6 +129,11 @@ struct Scene {
     /// vbd: between sweeps, the coarse space's correction (a lattice over each object, coarse_space.hpp) carries the
     /// long waves that sweeps carry one ring of vertices at a time; false: sweeps alone (the former method).
     bool coarse_space = true;
+    /// vbd, automatic sweeps: a step of one substep that gained energy, taken again with tighter tolerances, continues
+    /// its sweeps from where they stopped (the same inertial target, contacts and convergence reference); false: it
+    /// starts over from the step's start, repeating the sweeps already done (the former way; docs/simulator.md,
+    /// "Where a 15 cm step's extra work goes").
+    bool resume_retakes = true;
     /// vbd: Chebyshev acceleration of the sweeps (Wang 2015, as in the VBD paper): the estimated spectral radius
     /// ρ of one sweep, in [0, 1); 0 = off; negative (the default) = automatic: off with the coarse space, 0.9
     /// without (a few accelerated sweeps come closer to the converged answer than more plain ones; docs/simulator.md).
