@@ -1,9 +1,14 @@
 #pragma once
-// Helpers shared by the simulator tests: scene objects built from the generator.
+// Helpers shared by the simulator tests: scene objects built from the generator, and a bar of one cube.
+#include "support.hpp"
+
 #include "tethash/meshing/generate.hpp"
 #include "tethash/sim/scene.hpp"
 
 #include <Eigen/Core>
+
+#include <array>
+#include <vector>
 
 namespace tethash::test {
 
@@ -29,6 +34,27 @@ inline sim::ObjectSpec box_object(const Eigen::Vector3d& size, const Eigen::Vect
 inline sim::ObjectSpec box_object(double size, const Eigen::Vector3d& at, int res = 2)
 {
     return box_object(Eigen::Vector3d::Constant(size), at, res);
+}
+
+/// A bar: one cube of six tets (vertices at its corners only), `size`, centred at `at`; the test box's material and
+/// options above, with this mesh in place of the generated one.
+inline sim::ObjectSpec bar_object(const Eigen::Vector3d& size, const Eigen::Vector3d& at)
+{
+    std::vector<Eigen::Vector3d> x;
+    for (int k = 0; k <= 1; ++k)
+        for (int j = 0; j <= 1; ++j)
+            for (int i = 0; i <= 1; ++i)
+                x.emplace_back(i - 0.5, j - 0.5, k - 0.5);
+    const auto id = [](int i, int j, int k) { return static_cast<Index>(i + 2 * (j + 2 * k)); };
+    const auto tets = kuhn_tets(0, 0, 0, id);
+    sim::ObjectSpec o = box_object(1.0, at);
+    o.generate.reset();
+    TetMesh m;
+    m.positions = matrix_of<Positions>(x);
+    m.tets = matrix_of<Tets>(std::vector<std::array<Index, 4>>(tets.begin(), tets.end()));
+    o.data = m;
+    o.scale = size;
+    return o;
 }
 
 } // namespace tethash::test

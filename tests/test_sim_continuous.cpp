@@ -53,37 +53,16 @@ double lowest(const Scene& s, int steps)
     return low;
 }
 
-/// A bar: one cube of six tets (vertices at its corners only), `size`, centred at `at`.
-ObjectSpec bar(const Eigen::Vector3d& size, const Eigen::Vector3d& at)
-{
-    std::vector<Eigen::Vector3d> x;
-    for (int k = 0; k <= 1; ++k)
-        for (int j = 0; j <= 1; ++j)
-            for (int i = 0; i <= 1; ++i)
-                x.emplace_back(i - 0.5, j - 0.5, k - 0.5);
-    const auto id = [](int i, int j, int k) { return static_cast<Index>(i + 2 * (j + 2 * k)); };
-    const auto tets = kuhn_tets(0, 0, 0, id);
-    // The shared test box's material and options, with this mesh in place of the generated one.
-    ObjectSpec o = test::box_object(1.0, at);
-    o.generate.reset();
-    TetMesh m;
-    m.positions = matrix_of<Positions>(x);
-    m.tets = matrix_of<Tets>(std::vector<std::array<Index, 4>>(tets.begin(), tets.end()));
-    o.data = m;
-    o.scale = size;
-    return o;
-}
-
 /// A bar along y (0.05 thick) thrown down at 10 m/s across a static bar along x as thin, 0.12 above it: after one
 /// step of 1/100 it straddles the other, its lower long edges through the other's side faces, and no vertex of
 /// either is inside the other (their vertices are at their far ends). No gravity, the crossing check on.
 Scene crossed_bars(bool continuous)
 {
     Scene s;
-    ObjectSpec lower = bar({1.0, 0.05, 0.05}, {0, 0, 0});
+    ObjectSpec lower = bar_object({1.0, 0.05, 0.05}, {0, 0, 0});
     lower.is_static = true;
     s.objects.push_back(lower);
-    s.objects.push_back(bar({0.05, 1.0, 0.05}, {0, 0, 0.12}));
+    s.objects.push_back(bar_object({0.05, 1.0, 0.05}, {0, 0, 0.12}));
     s.objects[1].velocity = Eigen::Vector3d(0, 0, -10);
     s.gravity.setZero();
     s.dt = 1.0 / 100;

@@ -19,36 +19,16 @@ using namespace tethash::test;
 
 namespace {
 
-/// A bar: one cube of six tets (vertices at its corners only), `size`, centred at `at`.
-ObjectSpec bar(const Eigen::Vector3d& size, const Eigen::Vector3d& at)
-{
-    std::vector<Eigen::Vector3d> x;
-    for (int k = 0; k <= 1; ++k)
-        for (int j = 0; j <= 1; ++j)
-            for (int i = 0; i <= 1; ++i)
-                x.emplace_back(i - 0.5, j - 0.5, k - 0.5);
-    const auto id = [](int i, int j, int k) { return static_cast<Index>(i + 2 * (j + 2 * k)); };
-    const auto tets = kuhn_tets(0, 0, 0, id);
-    ObjectSpec o = test::box_object(1.0, at);
-    o.generate.reset();
-    TetMesh m;
-    m.positions = matrix_of<Positions>(x);
-    m.tets = matrix_of<Tets>(std::vector<std::array<Index, 4>>(tets.begin(), tets.end()));
-    o.data = m;
-    o.scale = size;
-    return o;
-}
-
 /// A bar along y (0.05 thick) at rest across a static bar along x as thin, sunk 0.02 into it: its lower long edges
 /// pass through the other's side faces, the other's upper long edges through its side faces, and no vertex of either
 /// is inside the other (their vertices are at their far ends). No gravity, dt 1/100.
 Scene crossed_bars(bool edges)
 {
     Scene s;
-    ObjectSpec lower = bar({1.0, 0.05, 0.05}, {0, 0, 0});
+    ObjectSpec lower = bar_object({1.0, 0.05, 0.05}, {0, 0, 0});
     lower.is_static = true;
     s.objects.push_back(lower);
-    s.objects.push_back(bar({0.05, 1.0, 0.05}, {0, 0, 0.03}));
+    s.objects.push_back(bar_object({0.05, 1.0, 0.05}, {0, 0, 0.03}));
     s.gravity.setZero();
     s.dt = 1.0 / 100;
     s.output.every = 0;
