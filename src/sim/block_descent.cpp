@@ -190,10 +190,17 @@ class BlockDescent final : public StepIntegrator {
     void add_lane_terms(const LaneGroup& grp, int lane, LaneTerms& terms, const double* x4, double h) const;
     /// Chebyshev step after sweep n: x ← ω (x − x_{n−2}) + x_{n−2} on the free vertices (stride 4).
     void accelerate(int n, double rho, double& omega, double* x);
+    /// Chebyshev acceleration's ρ: the scene's, or automatic: none with the coarse space (its corrections carry the
+    /// long waves the acceleration was for), 0.9 without.
+    double acceleration_rho() const
+    {
+        return m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
+    }
     /// The substep's sweeps on m_x4, from where m_run left them, until converged (the tolerances m_tighter's) or the
     /// substep has swept `max_iterations` times in all; returns the sweeps taken now.
     int iterate(double h);
-    /// The sweeps' end into x and v (v from the substep's start m_xt, the acceleration against its start velocity).
+    /// The sweeps' end into x and v (v, the substep's start velocities on entry: from the start m_xt, and the
+    /// acceleration against the start velocities).
     void end_substep(Positions& x, Positions& v, double h);
 
     StepContext m_ctx;
@@ -226,7 +233,6 @@ class BlockDescent final : public StepIntegrator {
     std::vector<double> m_prev1, m_prev2; ///< the iterates of the two previous sweeps (Chebyshev acceleration)
     std::vector<double> m_group_moved;    ///< per group: Σ dᵀ H d of the current sweep
     std::vector<double> m_moved_history;  ///< Σ dᵀ H d of each sweep of the substep
-    Positions m_vt;                       ///< velocities at the start of the substep
     /// Where the substep's sweeps stand, kept so that a retake for energy continues them (resume): the sweeps taken,
     /// the largest sweep's moves (the convergence test's reference), the Chebyshev weight, the coarse space's use.
     struct SweepRun {
@@ -897,9 +903,7 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     m_y.resize(3 * un);
     const bool automatic = m_ctx.scene.iterations <= 0;
     if (!(m_energy_ref > 0)) m_energy_ref = energy_scale(x, v);
-    // Chebyshev acceleration: the scene's ρ, or automatic: none with the coarse space (its corrections carry the
-    // long waves the acceleration was for), 0.9 without.
-    const double rho = m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
+    const double rho = acceleration_rho();
     // Inertial target y = x + h v + h² g. The iterations start from x + h v + h² ã, ã the part of the vertex's
     // acceleration over the previous substep along gravity, clamped to [0, |g|] (the VBD paper's adaptive start, per
     // vertex; g at the first substep): y in free fall, x + h v for a body at rest. Starting from y, a resting body
@@ -934,7 +938,6 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
     gather_contacts();
     m_entered.assign(un, 0);
 
-    m_vt = v;
     m_run = SweepRun{};
     m_run.use_coarse = !m_coarse.empty();
     m_moved_history.clear();
@@ -956,10 +959,11 @@ int BlockDescent::substep(Positions& x, Positions& v, double h)
 int BlockDescent::resume(Positions& x, Positions& v, double h)
 {
     assert(m_resumable && x.rows() == m_xt.rows());
-    // The same substep continued from where its sweeps stopped: the same start m_xt, inertial target m_y, contacts
+    // The same substep, from the same start (x = m_xt and v, as the caller gives them back), continued from where
+    // its sweeps stopped: the same inertial target m_y, contacts
     // (gathered at its start), vertices that entered a contact (m_entered), convergence reference (the largest
     // sweep's moves and the moves' history), Chebyshev iterates and coarse factorisation; only the tolerances are
-    // tighter (m_tighter). The acceleration m_accel is taken against the start velocity m_vt, as a retake from the
+    // tighter (m_tighter). The acceleration m_accel is taken against the start velocity v, as a retake from the
     // start leaves it. A retake from the start swept again from its predictor: the small raptor at 1/60 took 57.6
     // sweeps a step that way, 45.2 continued (docs/simulator.md, "Where a 15 cm step's extra work goes").
     const int sweeps = iterate(h);
@@ -972,7 +976,7 @@ int BlockDescent::iterate(double h)
 {
     double* xp = m_x4.data()->c;
     const bool automatic = m_ctx.scene.iterations <= 0;
-    const double rho = m_ctx.scene.acceleration >= 0 ? m_ctx.scene.acceleration : (m_coarse.empty() ? 0.9 : 0.0);
+    const double rho = acceleration_rho();
 
     // Automatic: sweep until a sweep's moves (Σ dᵀ H d) are below `convergence` of the largest sweep's of the substep
     // and below energy_tolerance of the scene's energy, or they hardly move at all; at least min_sweeps, at most
@@ -1040,7 +1044,7 @@ void BlockDescent::end_substep(Positions& x, Positions& v, double h)
     for (size_t i = 0; i < un; ++i) {
         if (model.fixed[i]) continue;
         for (int r = 0; r < 3; ++r) {
-            const double v_old = m_vt(static_cast<Index>(i), r);
+            const double v_old = v(static_cast<Index>(i), r);
             x(static_cast<Index>(i), r) = xp[4 * i + static_cast<size_t>(r)];
             v(static_cast<Index>(i), r) = (x(static_cast<Index>(i), r) - m_xt(static_cast<Index>(i), r)) * inv_h;
             m_accel[3 * i + static_cast<size_t>(r)] = (v(static_cast<Index>(i), r) - v_old) * inv_h;

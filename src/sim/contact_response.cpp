@@ -47,6 +47,23 @@ void closest_points(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
     }
 }
 
+/// The threads of the stages that take every core where the scene says 0 (chosen step by step: the detector follows
+/// the step's count, these run on every core).
+int stage_threads(int threads)
+{
+    return threads > 0 ? threads : detail::ThreadChoice::every_core();
+}
+
+/// Whether some vertex of a[0..na) and some vertex of b[0..nb) lie nearer than `reach` in the rest state: the
+/// contacts' locality rule (a self pair within it is the material's to resolve, not a contact).
+bool near_at_rest(const Positions& rest, const Index* a, int na, const Index* b, int nb, double reach)
+{
+    for (int i = 0; i < na; ++i)
+        for (int k = 0; k < nb; ++k)
+            if ((rest.row(a[i]) - rest.row(b[k])).squaredNorm() < reach * reach) return true;
+    return false;
+}
+
 } // namespace
 
 void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model& model,
@@ -83,10 +100,10 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         if (scene.contact.margin > 0 || scene.contact.speculative)
             m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
                               local_contact_edges);
-        m_proximity.set_threads(scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core());
         if (scene.contact.edges)
             m_edges.set_topology(mesh.tets, mesh.num_vertices(), mesh.vertex_object, mesh.tet_object, options);
-        m_edge_threads = scene.detect.threads > 0 ? scene.detect.threads : detail::ThreadChoice::every_core();
+        m_proximity.set_threads(stage_threads(scene.detect.threads));
+        m_edge_threads = stage_threads(scene.detect.threads);
     }
 }
 
@@ -94,8 +111,8 @@ void ContactResponse::set_threads(int threads)
 {
     if (!m_enabled) return;
     m_detector.set_threads(threads);
-    m_proximity.set_threads(threads > 0 ? threads : detail::ThreadChoice::every_core());
-    m_edge_threads = threads > 0 ? threads : detail::ThreadChoice::every_core();
+    m_proximity.set_threads(stage_threads(threads));
+    m_edge_threads = stage_threads(threads);
 }
 
 double ContactResponse::pair_stiffness(Index a, Index b, double m_eff) const
@@ -135,10 +152,9 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     for (const Contact& c : found) {
         if (c.vertex_object == c.tet_object) {
             const double reach = local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.tet_object)];
-            double nearest = std::numeric_limits<double>::infinity();
-            for (int k = 0; k < 4; ++k)
-                nearest = std::min(nearest, (rest.row(c.vertex) - rest.row(mesh.tets(c.tet, k))).squaredNorm());
-            if (nearest < reach * reach) {
+            const Index corners[4] = {mesh.tets(c.tet, 0), mesh.tets(c.tet, 1), mesh.tets(c.tet, 2),
+                                      mesh.tets(c.tet, 3)};
+            if (near_at_rest(rest, &c.vertex, 1, corners, 4, reach)) {
                 ++m_ignored_local;
                 continue;
             }
@@ -260,11 +276,7 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
     for (const EdgeFaceContact& c : crossings) {
         if (c.edge_object == c.face_object) { // a self pair the rest state calls local is the material's
             const double reach = local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.face_object)];
-            bool local = false;
-            for (const Index p : c.edge_vertices)
-                for (const Index f : c.face_vertices)
-                    local = local || (rest.row(p) - rest.row(f)).squaredNorm() < reach * reach;
-            if (local) continue;
+            if (near_at_rest(rest, c.edge_vertices, 2, c.face_vertices, 3, reach)) continue;
         }
         for (int k = 0; k < 3; ++k) {
             const Index g = edge_index(c.face_vertices[k], c.face_vertices[(k + 1) % 3]);

@@ -43,9 +43,10 @@ class StepIntegrator {
     virtual void relax() {}
     /// Whether the last substep can be continued (resume) rather than taken again from its start: false by default.
     virtual bool resumable() const { return false; }
-    /// After `tighten`, instead of a new substep from the step's start: the last substep's iterations continue from
-    /// where they stopped (x, v as it left them), with its inertial target, contacts and convergence reference, to
-    /// the tighter tolerance. Returns the iterations it took. Only when `resumable`.
+    /// After `tighten`, instead of substep(x, v, h) again from the same start (x, v: the last substep's start, given
+    /// back as for substep): the last substep's iterations continue from where they stopped, with its inertial
+    /// target, contacts and convergence reference, to the tighter tolerance. Returns the iterations it took. Only
+    /// when `resumable`.
     virtual int resume(Positions& /*x*/, Positions& /*v*/, double /*h*/) { return 0; }
     /// The thread count of the next substeps (≥ 1); the result does not depend on it. Ignored by default.
     virtual void set_threads(int /*threads*/) {}

@@ -574,11 +574,9 @@ void Simulation::step()
         // several starts over.
         if (energy_now > s.health.energy_end + energy_step_slack * s.health.energy_scale) {
             if (s.integrator->tighten()) {
+                x = s.x_save;
+                s.v = s.v_save;
                 resuming = substeps == 1 && s.scene.resume_retakes && s.integrator->resumable();
-                if (!resuming) {
-                    x = s.x_save;
-                    s.v = s.v_save;
-                }
                 st.unconverged = 0;
                 ++st.tightened;
                 continue;

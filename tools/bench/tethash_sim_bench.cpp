@@ -98,21 +98,13 @@ sim::ObjectSpec placed(const TetMesh& mesh, double lift, double size)
     return o;
 }
 
-/// Processor time (ms) of a clock: CLOCK_PROCESS_CPUTIME_ID, every thread's (at one thread the work of the step
-/// alone); CLOCK_THREAD_CPUTIME_ID, the calling thread's (what a step cost it, whatever else the machine runs).
-double cpu_ms(clockid_t clock)
-{
-    timespec t{};
-    clock_gettime(clock, &t);
-    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
+/// Processor time the process has used (ms): every thread's, so at one thread the work of the step alone, whatever
+/// else the machine runs.
 double process_cpu_ms()
 {
-    return cpu_ms(CLOCK_PROCESS_CPUTIME_ID);
-}
-double thread_cpu_ms()
-{
-    return cpu_ms(CLOCK_THREAD_CPUTIME_ID);
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
 }
 
 /// Resident memory of the process (bytes), after giving freed memory back.
@@ -125,7 +117,7 @@ double resident_bytes()
     return resident * 4096.0;
 }
 
-/// `cpu_time`: a step's ms are the thread's CPU time (--cpu-time), else the wall clock's.
+/// `cpu_time`: a step's ms are its processor time (--cpu-time, one thread), else the wall clock's.
 Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_time)
 {
     Row r;
@@ -149,12 +141,11 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
         for (int i = 0; i < steps; ++i) {
             const double cpu0 = process_cpu_ms();
             const auto t0 = std::chrono::steady_clock::now();
-            const double c0 = cpu_time ? thread_cpu_ms() : 0.0;
             s.step();
-            ms.push_back(
-                cpu_time ? thread_cpu_ms() - c0
-                         : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
             cpu.push_back(process_cpu_ms() - cpu0);
+            ms.push_back(
+                cpu_time ? cpu.back()
+                         : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
             if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
@@ -316,7 +307,7 @@ void add_options(CLI::App& app, SimBenchOptions& o)
         ->capture_default_str();
     runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
     runs->add_flag("--cpu-time", o.cpu_time,
-                   "a step's ms (ms/step, mean) are the thread's CPU time, not the wall clock's (on a machine shared "
+                   "a step's ms (ms/step, mean) are its processor time, not the wall clock's (on a machine shared "
                    "with other work; one thread only, the stages stay wall-clock)");
     runs->add_option("--bodies", o.bodies,
                      "instead of the shared meshes: generated spheres of about these many tets (comma-separated, "
@@ -371,7 +362,7 @@ void print_header(SimBenchOptions& o)
     std::printf("%s simulated per run; ms are medians over the steps%s\n",
                 o.seconds > 0 ? fmt::format("{} s", o.seconds).c_str()
                               : "0.5 s (2.5 times the fall where it takes more than 0.25 s)",
-                o.cpu_time ? " (ms/step and mean: the thread's CPU time, --cpu-time)" : "");
+                o.cpu_time ? " (ms/step and mean: processor time, --cpu-time)" : "");
 #ifdef TETHASH_HAVE_BULLET
     std::printf("peer: Bullet %d.%02d soft bodies, %d position iterations, links on the tet edges%s\n",
                 bench::bullet_version() / 100, bench::bullet_version() % 100, o.peer_iterations,
@@ -617,7 +608,7 @@ int main(int argc, char** argv)
             throw Error("--seconds must be positive (or 0: automatic), found " + fmt::format("{}", o.seconds));
         if (o.threads < 0 || o.threads > 256) throw Error("--threads must be in 0..256 (0: chosen step by step)");
         if (o.cpu_time && o.threads != 1)
-            throw Error("--cpu-time measures the calling thread: it needs --threads 1 (found " +
+            throw Error("--cpu-time measures one thread's work: it needs --threads 1 (found " +
                         std::to_string(o.threads) + ")");
         if (o.bodies.empty() && !std::filesystem::is_directory(o.meshes_dir)) {
             std::printf("shared meshes not found at %s: nothing to run\n", o.meshes_dir.c_str());

@@ -126,6 +126,17 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
         const unsigned char* self_flag = flags.self_collision.data();
         const unsigned char* static_flag = flags.is_static.data();
         std::int64_t tested = 0;
+        // The object rules: a pair within an object without self-collision, or between two static objects, is not
+        // tested.
+        const auto ruled_out = [&](Index vo, Index to) {
+            return (vo == to && !self_flag[to]) || (static_flag[to] && static_flag[vo]);
+        };
+        // A pair for the oracle's inside test, whose block is tested when full.
+        const auto queue = [&](Index v, Index t) {
+            w.vertex[static_cast<std::size_t>(n)] = v;
+            w.tet[static_cast<std::size_t>(n)] = t;
+            if (++n == static_cast<std::int32_t>(batch_size)) flush();
+        };
         // Where the sink's runs of a tet are long on average (min_mean_run pairs; only the broad phases that query tet
         // by tet write runs longer than one pair), a run of min_run pairs or more against the tet's face planes at
         // once; any other pair straight to the oracle's test. Sorting the pairs of the broad phases that query vertex
@@ -149,12 +160,9 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
             if (!starts_run(i, t)) {
                 const Index v = pairs[i++].vertex;
                 assert(!own_vertex(scene.tets, {v, t}));
-                const Index vo = vertex_object[v], to = tet_object[t];
-                if ((vo == to && !self_flag[to]) || (static_flag[to] && static_flag[vo])) continue;
+                if (ruled_out(vertex_object[v], tet_object[t])) continue;
                 ++tested;
-                w.vertex[static_cast<std::size_t>(n)] = v;
-                w.tet[static_cast<std::size_t>(n)] = t;
-                if (++n == static_cast<std::int32_t>(batch_size)) flush();
+                queue(v, t);
                 continue;
             }
             // The run of tet t: the pairs up to the next other tet; those that pass the object rules in w.run.
@@ -170,12 +178,11 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
                 w.kept.resize(w.run.size());
             }
             const Index to = tet_object[t];
-            const bool self = self_flag[to] != 0, tet_static = static_flag[to] != 0;
             std::int32_t count = 0;
             for (; i < end; ++i) {
-                const Index v = pairs[i].vertex, vo = vertex_object[v];
+                const Index v = pairs[i].vertex;
                 w.run[static_cast<std::size_t>(count)] = v;
-                count += !((vo == to && !self) || (tet_static && static_flag[vo]));
+                count += !ruled_out(vertex_object[v], to);
             }
             if (count == 0) continue;
             tested += count;
@@ -191,12 +198,8 @@ void PartitionDetector::detect(Method method, const PartitionScene& scene, const
             if (sign == 0) continue;
             const std::int32_t num_kept =
                 filter_candidates(f, P, w.run.data(), count, w.values.data(), w.codes.data(), w.kept.data());
-            for (std::int32_t k = 0; k < num_kept; ++k) {
-                w.vertex[static_cast<std::size_t>(n)] =
-                    w.run[static_cast<std::size_t>(w.kept[static_cast<std::size_t>(k)])];
-                w.tet[static_cast<std::size_t>(n)] = t;
-                if (++n == static_cast<std::int32_t>(batch_size)) flush();
-            }
+            for (std::int32_t k = 0; k < num_kept; ++k)
+                queue(w.run[static_cast<std::size_t>(w.kept[static_cast<std::size_t>(k)])], t);
         }
         counts.inside_tests += tested;
         flush();
