@@ -6,6 +6,7 @@
 #include "sim_support.hpp"
 #include "support.hpp"
 
+#include "tethash/sim/quality.hpp"
 #include "tethash/sim/scene.hpp"
 #include "tethash/sim/simulation.hpp"
 
@@ -156,4 +157,28 @@ TEST(SimContinuous, SceneKey)
     EXPECT_TRUE(load_scene((dir / "s.toml").string()).continuous_check);
     write_text(dir / "bad.toml", "continuous_check = \"yes\"\n[[object]]\ngenerate = { shape = \"box\" }\n");
     expect_error([&] { load_scene((dir / "bad.toml").string()); }, {"continuous_check", "bad.toml:1"});
+}
+
+TEST(SimContinuous, InsideOtherObjectsCountsVerticesInAnotherBodyOnly)
+{
+    // Two unit cubes (six tets each, vertices at the corners), the second's centre at (0.8, 0.8, 0.8): its corner
+    // (0.3, 0.3, 0.3) is inside the first and the first's corner (0.5, 0.5, 0.5) inside it. The cubes' own vertices
+    // lie in their own tets (on them): those are not counted.
+    Scene s;
+    s.objects.push_back(bar_object({1, 1, 1}, {0, 0, 0}));
+    s.objects.push_back(bar_object({1, 1, 1}, {0.8, 0.8, 0.8}));
+    s.objects[1].self_collision = true;
+    s.output.every = 0;
+    Simulation sim(s);
+    InsideOtherObjects inside(sim.mesh());
+    EXPECT_EQ(inside.count(sim.positions()), 2);
+    Positions x = sim.positions();
+    const auto [b0, bn] = sim.object_vertices(1);
+    x.middleRows(b0, bn).col(2).array() += 1.0; // the second cube above the first, no corner inside
+    EXPECT_EQ(inside.count(x), 0);
+    x.middleRows(b0, bn).col(2).array() -= 1.6; // centre (0.8, 0.8, 0.2): its corner (0.3, 0.3, -0.3) inside the
+    // first, the first's corner (0.5, 0.5, 0.5) inside it
+    EXPECT_EQ(inside.count(x), 2);
+    x.middleRows(b0, bn).col(0).array() += 0.3; // centre (1.1, 0.8, 0.2): its corners at x = 0.6, none inside
+    EXPECT_EQ(inside.count(x), 0);
 }

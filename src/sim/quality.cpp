@@ -56,4 +56,29 @@ std::int64_t FarSelfPenetrations::count(const PositionsRef& positions)
     return count;
 }
 
+InsideOtherObjects::InsideOtherObjects(const TetMesh& mesh)
+    : m_detector(DetectParams{.threads = 1}), m_counted(static_cast<size_t>(mesh.num_vertices()), 0)
+{
+    // Self-contacts are not looked for: an object's own tets cost nothing beyond the hash's stage 1.
+    Index objects = 1;
+    for (const std::vector<Index>* ids : {&mesh.vertex_object, &mesh.tet_object})
+        if (!ids->empty()) objects = std::max(objects, *std::max_element(ids->begin(), ids->end()) + 1);
+    std::vector<ObjectOptions> options(static_cast<size_t>(objects));
+    for (ObjectOptions& o : options)
+        o.self_collision = false;
+    m_detector.set_topology(mesh, options);
+}
+
+std::int64_t InsideOtherObjects::count(const PositionsRef& positions)
+{
+    std::fill(m_counted.begin(), m_counted.end(), 0);
+    std::int64_t count = 0;
+    for (const Contact& c : m_detector.detect(positions)) {
+        if (c.vertex_object == c.tet_object || m_counted[static_cast<size_t>(c.vertex)]) continue;
+        m_counted[static_cast<size_t>(c.vertex)] = 1;
+        ++count;
+    }
+    return count;
+}
+
 } // namespace tethash::sim

@@ -1,14 +1,13 @@
 // tethash_sim_bench: the simulator on the meshes people load. Drops every mesh of ../shared/meshes (scaled to
-// 1 m, 0.2 m above the ground, density 1000, young 1e5) and throws two armadillo_4k into each other at 2 m/s, for
-// each integrator and time step asked; prints per scene the median ms per step split into detection / depth /
-// response / integration, solver iterations, contacts, inverted tets and far self-penetrations (at the end and the
-// most at any frame of 1/60 s), the steps taken again (with tighter tolerances for energy they gained, in more
-// substeps for a far part entered unseen), and
-// the measure of Teschner et al. 2004: largest stable dt (of those run) divided by the cost per step. When built
-// with Bullet (libbullet-dev found), each scene and dt also runs with Bullet's soft bodies in the same process
-// (rows "bullet"), so the ratio to the peer comes from one run. With --bodies, generated spheres of about that
-// many tets instead, each at one thread and at --threads: ms per step, ns per tet, bytes per tet and the speed-up
-// of the threads (how the step scales from 10 k to 1 M tets).
+// 1 m, 0.2 m above the ground, density 1000, young 1e5) and throws two armadillo_4k into each other at 2 m/s (--throw),
+// for each integrator and time step asked; prints per scene the median ms per step split into detection / depth /
+// response / integration, solver iterations, contacts, inverted tets, far self-penetrations and vertices inside
+// another object (each at the end and the most at any frame of 1/60 s), the steps taken again (with tighter tolerances
+// for energy they gained, in more substeps for a far part entered unseen), and the measure of Teschner et al. 2004:
+// largest stable dt (of those run) divided by the cost per step. When built with Bullet (libbullet-dev found), each
+// scene and dt also runs with Bullet's soft bodies in the same process (rows "bullet"), so the ratio to the peer comes
+// from one run. With --bodies, generated spheres of about that many tets instead, each at one thread and at --threads:
+// ms per step, ns per tet, bytes per tet and the speed-up of the threads (how the step scales from 10 k to 1 M tets).
 #include "tethash/detect.hpp"
 #include "tethash/error.hpp"
 #include "tethash/io/mesh_io.hpp"
@@ -61,6 +60,9 @@ struct Row {
     std::int64_t retaken = 0;      ///< steps taken again with tighter tolerances for energy they gained
     std::int64_t crossed = 0;      ///< steps taken again in more substeps for a far part entered unseen
     std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
+    std::int64_t inside = 0;       ///< vertices inside a tet of another object at the end
+    std::int64_t inside_max = 0;   ///< the most at any frame (every 1/60 s)
+    std::int64_t unresolved = 0;   ///< steps whose continuous check left an impact past its retakes
     double mean_z = 0;             ///< mean height of the vertices at the end (how far the body sagged or sank)
     double energy_ratio = 0;       ///< total energy at the end / at the start (a passive drop must stay ≤ 1)
     double volume_ratio = 0;       ///< volume of the dynamic tets at the end / at the start
@@ -133,6 +135,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
     r.tets = s.mesh().num_tets();
     const Positions start = s.positions();
     sim::FarSelfPenetrations far(s.mesh(), start);
+    sim::InsideOtherObjects inside(s.mesh());
     const double energy0 = s.energy().total(), volume0 = sim::total_volume(s.model(), start);
     std::vector<double> ms, cpu, det, dep, prox, resp, integ, other, threads, sw, con, sub;
     // Frames as a viewer would see them: every 1/60 s (every step at larger steps), counted outside the timing.
@@ -146,7 +149,10 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
             ms.push_back(
                 cpu_time ? cpu.back()
                          : std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-            if ((i + 1) % frame_every == 0) r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
+            if ((i + 1) % frame_every == 0) {
+                r.far_self_max = std::max(r.far_self_max, far.count(s.positions()));
+                r.inside_max = std::max(r.inside_max, inside.count(s.positions()));
+            }
             const sim::StepStats& st = s.last_stats();
             det.push_back(st.ms_detect);
             dep.push_back(st.ms_depth);
@@ -161,6 +167,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
             r.unconverged += st.unconverged;
             if (st.tightened > 0) ++r.retaken;
             if (st.crossings > 0) ++r.crossed;
+            if (st.continuous_unresolved > 0) ++r.unresolved;
         }
     } catch (const RunFailure& e) {
         r.failure = e.what();
@@ -184,6 +191,8 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
     r.inverted = sim::count_inverted(s.mesh(), start);
     r.far_self = far.count(s.positions());
     r.far_self_max = std::max(r.far_self_max, r.far_self);
+    r.inside = inside.count(s.positions());
+    r.inside_max = std::max(r.inside_max, r.inside);
     r.mean_z = s.mesh().positions.col(2).mean();
     r.energy_ratio = s.energy().total() / energy0;
     r.volume_ratio = sim::total_volume(s.model(), s.positions()) / volume0;
@@ -237,12 +246,13 @@ void print(const Row& r)
 {
     std::printf(
         "%-36s %-16s %8.5f %7d %7d %8.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f %4.2g %6.1f %5.2f %8.1f %7lld %5lld "
-        "%5lld %8.4g %7.3g %6.3f %6lld %7lld %7lld %10.3g  %s\n",
+        "%5lld %5lld %5lld %8.4g %7.3g %6.3f %6lld %7lld %7lld %5lld %10.3g  %s\n",
         r.scene.c_str(), r.integrator.c_str(), r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
         r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps, r.contacts,
         static_cast<long long>(r.inverted), static_cast<long long>(r.far_self), static_cast<long long>(r.far_self_max),
-        r.mean_z, r.energy_ratio, r.volume_ratio, static_cast<long long>(r.unconverged),
-        static_cast<long long>(r.retaken), static_cast<long long>(r.crossed), r.stable ? r.dt / r.ms_mean : 0.0,
+        static_cast<long long>(r.inside), static_cast<long long>(r.inside_max), r.mean_z, r.energy_ratio,
+        r.volume_ratio, static_cast<long long>(r.unconverged), static_cast<long long>(r.retaken),
+        static_cast<long long>(r.crossed), static_cast<long long>(r.unresolved), r.stable ? r.dt / r.ms_mean : 0.0,
         r.failure.c_str());
     std::fflush(stdout);
 }
@@ -272,6 +282,7 @@ struct SimBenchOptions {
     std::string crossing_check, continuous_check, contact_edges;
     bool no_peer = false;
     bool cpu_time = false;
+    double throw_speed = 2; ///< m/s at which the two armadillos close on each other
 };
 
 void add_options(CLI::App& app, SimBenchOptions& o)
@@ -304,6 +315,9 @@ void add_options(CLI::App& app, SimBenchOptions& o)
                      "table gives the medians over the rounds and the median of the rounds' speed-ups (interleaved "
                      "rounds for a loaded machine)")
         ->check(CLI::Range(1, 100))
+        ->capture_default_str();
+    runs->add_option("--throw", o.throw_speed,
+                     "speed (m/s) at which the two armadillos close on each other (each moves at half of it)")
         ->capture_default_str();
     runs->add_option("--csv", o.csv, "write the rows as CSV to this file");
     runs->add_flag("--cpu-time", o.cpu_time,
@@ -443,12 +457,14 @@ std::vector<std::pair<std::string, sim::Scene>> make_scenes(const SimBenchOption
                     for (int k = 0; k < 2; ++k) {
                         sim::ObjectSpec obj = with_young(placed(mesh, 0.3, size), young);
                         obj.translate.x() += (k == 0 ? -0.7 : 0.7) * size;
-                        obj.velocity = Eigen::Vector3d(k == 0 ? 1.0 : -1.0, 0, 0);
+                        obj.velocity = Eigen::Vector3d((k == 0 ? 0.5 : -0.5) * o.throw_speed, 0, 0);
                         two.objects.push_back(obj);
                     }
                     two.ground.enabled = true;
                     two.output.every = 0;
-                    scenes.emplace_back("two armadillos at 2 m/s" + size_name(size) + young_name(young), two);
+                    scenes.emplace_back(fmt::format("two armadillos at {:g} m/s", o.throw_speed) + size_name(size) +
+                                            young_name(young),
+                                        two);
                 }
             }
     }
@@ -505,16 +521,17 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
                "ms_response,ms_integrate,ms_other,threads,iterations,substeps,contacts,inverted,far_self,"
                "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,cpu_ms_step,"
-               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure,retaken,crossed\n";
+               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure,retaken,crossed,inside,inside_max,unresolved\n";
         for (const Row& r : rows)
             out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
                                "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},{:.4g},{:.4g},{:.3g},{:"
-                               ".4g},\"{}\",{},{}\n",
+                               ".4g},\"{}\",{},{},{},{},{}\n",
                                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
                                r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
                                r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
                                r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.cpu_ms,
-                               r.cpu_ms_mean, r.sweeps_mean, r.setup_ms, r.failure, r.retaken, r.crossed);
+                               r.cpu_ms_mean, r.sweeps_mean, r.setup_ms, r.failure, r.retaken, r.crossed, r.inside,
+                               r.inside_max, r.unresolved);
     }
     std::filesystem::rename(tmp, csv);
 }
@@ -606,6 +623,8 @@ int main(int argc, char** argv)
             integ.push_back(sim::parse_integrator(i));
         if (!(o.seconds >= 0) || !std::isfinite(o.seconds))
             throw Error("--seconds must be positive (or 0: automatic), found " + fmt::format("{}", o.seconds));
+        if (!(o.throw_speed >= 0) || !std::isfinite(o.throw_speed))
+            throw Error("--throw must be a speed (m/s, 0 or more), found " + fmt::format("{}", o.throw_speed));
         if (o.threads < 0 || o.threads > 256) throw Error("--threads must be in 0..256 (0: chosen step by step)");
         if (o.cpu_time && o.threads != 1)
             throw Error("--cpu-time measures one thread's work: it needs --threads 1 (found " +
@@ -616,12 +635,12 @@ int main(int argc, char** argv)
         }
         print_header(o);
         std::vector<std::pair<std::string, sim::Scene>> scenes = make_scenes(o);
-        std::printf("%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %7s %4s %6s %5s %8s %7s %5s %5s %8s %7s %6s "
-                    "%6s %7s %7s "
-                    "%10s  %s\n",
-                    "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
-                    "integr", "other", "thr", "iters", "subst", "contacts", "invert", "far", "fmax", "mean_z", "E1/E0",
-                    "V1/V0", "unconv", "retaken", "crossed", "dt/ms", "failure");
+        std::printf(
+            "%-36s %-16s %8s %7s %7s %8s %7s %7s %7s %7s %7s %7s %7s %4s %6s %5s %8s %7s %5s %5s %5s %5s %8s %7s "
+            "%6s %6s %7s %7s %5s %10s  %s\n",
+            "scene", "integrator", "dt", "verts", "tets", "ms/step", "mean", "detect", "depth", "near", "resp",
+            "integr", "other", "thr", "iters", "subst", "contacts", "invert", "far", "fmax", "in", "inmax", "mean_z",
+            "E1/E0", "V1/V0", "unconv", "retaken", "crossed", "unres", "dt/ms", "failure");
         std::vector<Row> rows;
         for (auto& [name, scene] : scenes) {
             if (!o.filter.empty() && name.find(o.filter) == std::string::npos) continue;

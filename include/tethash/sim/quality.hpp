@@ -40,4 +40,19 @@ class FarSelfPenetrations {
     std::vector<char> m_counted;
 };
 
+/// Distinct vertices lying inside a tet of another object (exact detector, contacts between objects only), for many
+/// states of one run (every frame): a body entered by another, which contact should have kept out. Static objects
+/// count like the others (a vertex inside an obstacle's tet is inside it).
+class InsideOtherObjects {
+  public:
+    /// `mesh` gives the topology and object ids.
+    explicit InsideOtherObjects(const TetMesh& mesh);
+    /// The count at `positions` (n × 3, the same vertices as the mesh).
+    std::int64_t count(const PositionsRef& positions);
+
+  private:
+    Detector m_detector;
+    std::vector<char> m_counted;
+};
+
 } // namespace tethash::sim
