@@ -544,21 +544,9 @@ py::tuple ccd_query(bool edge_edge, const py::object& start, const py::object& e
     return py::make_tuple(r.hit, r.toi);
 }
 
-/// Continuous detection over a step (continuous.hpp) as a dict of arrays.
-py::dict detect_continuous(const py::object& tets, const py::object& x0, const py::object& x1, int threads,
-                           double tolerance, std::int64_t max_iterations)
+/// A continuous detection's result as a dict of arrays: kind, a, b, toi, faces, edges and the broad phase's pairs.
+py::dict continuous_dict(const tethash::ccd::ContinuousResult& r)
 {
-    const auto t = tets_of(tets);
-    const auto p0 = positions_of(x0, "x0"), p1 = positions_of(x1, "x1");
-    tethash::ccd::ContinuousParams params;
-    params.threads = threads;
-    params.query.tolerance = tolerance;
-    params.query.max_iterations = max_iterations;
-    tethash::ccd::ContinuousResult r;
-    {
-        py::gil_scoped_release release;
-        r = tethash::ccd::detect_continuous(t.map(), p0.map(), p1.map(), params);
-    }
     const auto n = static_cast<py::ssize_t>(r.contacts.size());
     py::array_t<std::int8_t> kind(n);
     py::array_t<Index> a(n), b(n);
@@ -581,8 +569,96 @@ py::dict detect_continuous(const py::object& tets, const py::object& x0, const p
     d["toi"] = toi;
     d["faces"] = faces;
     d["edges"] = edges;
+    d["broad_phase_pairs"] = r.broad_phase_pairs;
     return d;
 }
+
+tethash::ccd::ContinuousParams continuous_params(int threads, double tolerance, std::int64_t max_iterations)
+{
+    tethash::ccd::ContinuousParams params;
+    params.threads = threads;
+    params.query.tolerance = tolerance;
+    params.query.max_iterations = max_iterations;
+    return params;
+}
+
+/// Continuous detection over a step (continuous.hpp) as a dict of arrays.
+py::dict detect_continuous(const py::object& tets, const py::object& x0, const py::object& x1, int threads,
+                           double tolerance, std::int64_t max_iterations)
+{
+    const auto t = tets_of(tets);
+    const auto p0 = positions_of(x0, "x0"), p1 = positions_of(x1, "x1");
+    const tethash::ccd::ContinuousParams params = continuous_params(threads, tolerance, max_iterations);
+    tethash::ccd::ContinuousResult r;
+    {
+        py::gil_scoped_release release;
+        r = tethash::ccd::detect_continuous(t.map(), p0.map(), p1.map(), params);
+    }
+    return continuous_dict(r);
+}
+
+/// tethash.ContinuousDetector: continuous detection (continuous.hpp) kept between calls on a fixed topology, with
+/// its locality rule.
+class PyContinuousDetector {
+  public:
+    void set_topology(const py::object& tets, Index num_vertices)
+    {
+        if (num_vertices < 0)
+            throw tethash::Error("ContinuousDetector.set_topology: num_vertices must be >= 0, found " +
+                                 std::to_string(num_vertices));
+        const auto t = tets_of(tets);
+        m_has_topology = false;
+        m_detector.set_topology(t.map(), num_vertices);
+        m_num_vertices = num_vertices;
+        m_has_topology = true;
+    }
+
+    void set_locality(const py::object& rest, const py::object& vertex_group, const py::object& reach_sq)
+    {
+        ready("set_locality");
+        const auto r = positions_of(rest, "rest");
+        if (r.rows != m_num_vertices)
+            throw tethash::Error("ContinuousDetector.set_locality: rest has " + std::to_string(r.rows) +
+                                 " rows, expected " + std::to_string(m_num_vertices) +
+                                 " (the vertex count given to set_topology)");
+        if (vertex_group.is_none()) throw py::type_error("vertex_group: expected a numpy array of int32, found None");
+        const std::vector<Index> groups = ids_of(vertex_group, "vertex_group", m_num_vertices);
+        const auto q = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(reach_sq);
+        if (!q || q.ndim() != 1)
+            throw py::type_error("reach_sq: expected a one-dimensional array of squared reaches (one per group)");
+        const std::vector<double> reaches(q.data(), q.data() + q.shape(0));
+        m_detector.set_locality(r.map(), groups, reaches);
+    }
+
+    py::dict detect(const py::object& x0, const py::object& x1, int threads, double tolerance,
+                    std::int64_t max_iterations)
+    {
+        ready("detect");
+        const auto p0 = positions_of(x0, "x0"), p1 = positions_of(x1, "x1");
+        if (p0.rows != m_num_vertices || p1.rows != m_num_vertices)
+            throw tethash::Error("ContinuousDetector.detect: x0 and x1 have " + std::to_string(p0.rows) + " and " +
+                                 std::to_string(p1.rows) + " rows, expected " + std::to_string(m_num_vertices) +
+                                 " (the vertex count given to set_topology)");
+        const tethash::ccd::ContinuousParams params = continuous_params(threads, tolerance, max_iterations);
+        const tethash::ccd::ContinuousResult* r = nullptr;
+        {
+            py::gil_scoped_release release;
+            r = &m_detector.detect(p0.map(), p1.map(), params);
+        }
+        return continuous_dict(*r);
+    }
+
+  private:
+    void ready(const char* what) const
+    {
+        if (!m_has_topology)
+            throw tethash::Error(std::string("ContinuousDetector.") + what +
+                                 ": call set_topology(tets, num_vertices) first");
+    }
+    tethash::ccd::ContinuousDetector m_detector;
+    Index m_num_vertices = 0;
+    bool m_has_topology = false;
+};
 
 /// One edge-face contact as numpy sees it (dtype tethash.EDGE_CONTACT_DTYPE): the C++ EdgeFaceContact, field for
 /// field (inner_end as int32).
@@ -756,6 +832,13 @@ PYBIND11_MODULE(_tethash, m)
             return ccd_query(true, start, end, tolerance, max_iterations);
         },
         py::arg("start"), py::arg("end"), py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
+    py::class_<PyContinuousDetector>(m, "ContinuousDetector")
+        .def(py::init<>())
+        .def("set_topology", &PyContinuousDetector::set_topology, py::arg("tets"), py::arg("num_vertices"))
+        .def("set_locality", &PyContinuousDetector::set_locality, py::arg("rest"), py::arg("vertex_group"),
+             py::arg("reach_sq"))
+        .def("detect", &PyContinuousDetector::detect, py::arg("x0"), py::arg("x1"), py::arg("threads") = 1,
+             py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
     m.def("detect_continuous", &detect_continuous, py::arg("tets"), py::arg("x0"), py::arg("x1"),
           py::arg("threads") = 1, py::arg("tolerance") = 1e-6, py::arg("max_iterations") = 1000000);
 }

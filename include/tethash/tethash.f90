@@ -171,6 +171,26 @@ module tethash
       real(c_double), intent(out), optional :: toi(*)
       integer(c_int) :: status
     end function
+    ! rest(3, num_vertices), vertex_group(num_vertices) (0-based groups), reach_sq(num_groups): squared reaches.
+    function tethash_detector_set_continuous_locality(detector, rest, num_vertices, vertex_group, reach_sq, &
+                                                      num_groups) &
+        bind(C, name="tethash_detector_set_continuous_locality") result(status)
+      import :: c_ptr, c_int, c_int32_t, c_int64_t, c_double
+      type(c_ptr), value :: detector
+      real(c_double), intent(in) :: rest(*)
+      integer(c_int64_t), value :: num_vertices
+      integer(c_int32_t), intent(in) :: vertex_group(*)
+      real(c_double), intent(in) :: reach_sq(*)
+      integer(c_int64_t), value :: num_groups
+      integer(c_int) :: status
+    end function
+    function tethash_detector_continuous_broad_phase_pairs(detector, pairs) &
+        bind(C, name="tethash_detector_continuous_broad_phase_pairs") result(status)
+      import :: c_ptr, c_int, c_int64_t
+      type(c_ptr), value :: detector
+      integer(c_int64_t), intent(out) :: pairs
+      integer(c_int) :: status
+    end function
     function tethash_detector_compute_penetration(detector, positions, num_vertices) &
         bind(C, name="tethash_detector_compute_penetration") result(status)
       import :: c_ptr, c_int, c_int64_t, c_double

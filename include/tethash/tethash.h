@@ -170,6 +170,21 @@ tethash_status tethash_detector_detect_continuous(tethash_detector* detector, co
  *  count. */
 tethash_status tethash_detector_get_continuous_contacts(const tethash_detector* detector, int64_t capacity,
                                                         int32_t* kind, int32_t* vertices, double* toi);
+/** A locality rule for tethash_detector_detect_continuous (ContinuousDetector::set_locality in continuous.hpp),
+ *  applied in its broad phase: a pair is left out when the first vertices of its two primitives are of one group g
+ *  and some vertex of one and some vertex of the other lie nearer than the group's reach in `rest`: squared distance
+ *  below reach_sq[g] (parts that a simulator's elastic terms keep apart: neighbours on the surface). `rest`:
+ *  num_vertices x 3 (num_vertices as in set_topology); `vertex_group`: num_vertices entries in [0, num_groups);
+ *  `reach_sq`: num_groups entries >= 0 (0: no pair of that group is local); all copied. num_groups = 0 removes the
+ *  rule (vertex_group and reach_sq may then be NULL). Kept until the next set_topology (object options keep it); a
+ *  refused rule leaves the one before. Drops the last continuous contacts. */
+tethash_status tethash_detector_set_continuous_locality(tethash_detector* detector, const double* rest,
+                                                        int64_t num_vertices, const int32_t* vertex_group,
+                                                        const double* reach_sq, int64_t num_groups);
+/** The broad phase's work in the last tethash_detector_detect_continuous (ContinuousResult::broad_phase_pairs): the
+ *  pairs its grid met whose boxes passed its single-precision test, before the exact box test, the shared-vertex and
+ *  locality rules, each pair once (0 before any call). */
+tethash_status tethash_detector_continuous_broad_phase_pairs(const tethash_detector* detector, int64_t* out_pairs);
 
 #ifdef __cplusplus
 } /* extern "C" */

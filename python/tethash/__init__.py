@@ -39,15 +39,15 @@ def _load_failure(error):
 
 
 try:
-    from ._tethash import (CONTACT_DTYPE, EDGE_CONTACT_DTYPE, Detector, EdgeFaceDetector, Error, RunFailure,
-                           ccd_edge_edge, ccd_vertex_face, detect_continuous)
+    from ._tethash import (CONTACT_DTYPE, EDGE_CONTACT_DTYPE, ContinuousDetector, Detector, EdgeFaceDetector, Error,
+                           RunFailure, ccd_edge_edge, ccd_vertex_face, detect_continuous)
     from . import _tethash
 except ImportError as _error:
     raise _load_failure(_error) from _error
 
 __all__ = ["CONTACT_DTYPE", "Detector", "Error", "RunFailure", "detect", "read_mesh", "write_mesh", "simulate",
            "study", "scene_toml", "default_scene_text", "ccd_vertex_face", "ccd_edge_edge", "detect_continuous",
-           "EDGE_CONTACT_DTYPE", "EdgeFaceDetector", "detect_edges"]
+           "ContinuousDetector", "EDGE_CONTACT_DTYPE", "EdgeFaceDetector", "detect_edges"]
 
 
 def detect(positions, tets, vertex_object=None, tet_object=None, objects=None, **params):

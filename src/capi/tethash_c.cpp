@@ -37,7 +37,13 @@ struct tethash_detector {
     tethash::EdgeFaceDetector edges;
     bool edges_ready = false;                             ///< edges has the current topology and object options
     const tethash::EdgeFaceResult* edge_result = nullptr; ///< the last edge-face contacts of the current topology
-    tethash::ccd::ContinuousResult continuous;            ///< the last continuous detection of the current topology
+    tethash::ccd::ContinuousDetector continuous_detector; ///< continuous detection, set up at its first call
+    bool continuous_ready = false; ///< continuous_detector has the current topology and the locality rule below
+    const tethash::ccd::ContinuousResult* continuous = nullptr; ///< the last continuous detection of the topology
+    // The locality rule of continuous detection as given (empty: none): kept when object options re-apply the
+    // topology, cleared by set_topology.
+    std::vector<double> locality_rest, locality_reach_sq;
+    std::vector<tethash::Index> locality_group;
 };
 
 namespace {
@@ -82,6 +88,22 @@ tethash_status invalid(const char* where, const std::string& what)
 
 constexpr std::int64_t max_index = std::numeric_limits<tethash::Index>::max();
 
+/// The continuous detector with the current topology and locality rule (set up when either changed).
+tethash::ccd::ContinuousDetector& continuous_detector(tethash_detector& d)
+{
+    if (!d.continuous_ready) {
+        const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+        d.continuous_detector.set_topology(tets, d.num_vertices);
+        if (!d.locality_reach_sq.empty()) {
+            const Eigen::Map<const tethash::Positions> rest(d.locality_rest.data(),
+                                                            static_cast<Eigen::Index>(d.num_vertices), 3);
+            d.continuous_detector.set_locality(rest, d.locality_group, d.locality_reach_sq);
+        }
+        d.continuous_ready = true;
+    }
+    return d.continuous_detector;
+}
+
 /// Re-applies the stored topology with the current object options.
 void apply_topology(tethash_detector& d)
 {
@@ -91,7 +113,8 @@ void apply_topology(tethash_detector& d)
     d.has_topology = false;
     d.edges_ready = false;
     d.edge_result = nullptr;
-    d.continuous = {};
+    d.continuous = nullptr;
+    d.continuous_ready = false;
     d.detector.set_topology(tets, d.num_vertices, d.vertex_object, d.tet_object, d.objects);
     d.has_topology = true;
 }
@@ -310,6 +333,9 @@ tethash_status tethash_detector_set_topology(tethash_detector* detector, const i
             d.has_topology = false;
             throw;
         }
+        d.locality_rest.clear();
+        d.locality_reach_sq.clear();
+        d.locality_group.clear();
         return TETHASH_OK;
     });
 }
@@ -488,18 +514,75 @@ tethash_status tethash_detector_detect_continuous(tethash_detector* detector, co
     if (!end && num_vertices > 0) return null_argument(where, "end");
     return guard(where, [&] {
         tethash_detector& d = *detector;
-        d.continuous = {};
-        const Eigen::Map<const tethash::Tets> tets(d.tets.data(), static_cast<Eigen::Index>(d.tets.size() / 4), 4);
+        d.continuous = nullptr;
         const Eigen::Map<const tethash::Positions> x0(start, static_cast<Eigen::Index>(num_vertices), 3);
         const Eigen::Map<const tethash::Positions> x1(end, static_cast<Eigen::Index>(num_vertices), 3);
         tethash::ccd::ContinuousParams params;
         params.query.tolerance = tolerance;
         params.query.max_iterations = max_iterations;
         params.threads = d.detector.params().threads;
-        d.continuous = tethash::ccd::detect_continuous(tets, x0, x1, params);
-        if (out_count) *out_count = static_cast<int64_t>(d.continuous.contacts.size());
+        d.continuous = &continuous_detector(d).detect(x0, x1, params);
+        if (out_count) *out_count = static_cast<int64_t>(d.continuous->contacts.size());
         return TETHASH_OK;
     });
+}
+
+tethash_status tethash_detector_set_continuous_locality(tethash_detector* detector, const double* rest,
+                                                        int64_t num_vertices, const int32_t* vertex_group,
+                                                        const double* reach_sq, int64_t num_groups)
+{
+    const char* where = "tethash_detector_set_continuous_locality";
+    if (!detector) return null_argument(where, "detector");
+    if (!detector->has_topology) return fail(TETHASH_ERROR_STATE, std::string(where) + ": no topology set");
+    if (num_vertices != detector->num_vertices)
+        return invalid(where, "num_vertices is " + std::to_string(num_vertices) + ", the topology has " +
+                                  std::to_string(detector->num_vertices));
+    if (num_groups < 0 || num_groups > max_index)
+        return invalid(where, "num_groups must be in [0, " + std::to_string(max_index) + "], got " +
+                                  std::to_string(num_groups));
+    if (num_groups > 0 && !rest && num_vertices > 0) return null_argument(where, "rest");
+    if (num_groups > 0 && !vertex_group && num_vertices > 0) return null_argument(where, "vertex_group");
+    if (num_groups > 0 && !reach_sq) return null_argument(where, "reach_sq");
+    return guard(where, [&] {
+        tethash_detector& d = *detector;
+        const auto n = static_cast<std::size_t>(num_vertices), g = static_cast<std::size_t>(num_groups);
+        std::vector<double> r, q;
+        std::vector<tethash::Index> v;
+        if (g > 0) {
+            if (n > 0) {
+                r.assign(rest, rest + 3 * n);
+                v.assign(vertex_group, vertex_group + n);
+            }
+            q.assign(reach_sq, reach_sq + g);
+        }
+        // The continuous detector validates (naming the entry); on failure the rule before is kept.
+        d.continuous = nullptr;
+        continuous_detector(d);
+        if (g > 0) {
+            const Eigen::Map<const tethash::Positions> x(r.data(), static_cast<Eigen::Index>(n), 3);
+            try {
+                d.continuous_detector.set_locality(x, v, q);
+            } catch (...) {
+                d.continuous_ready = false;
+                throw;
+            }
+        } else {
+            d.continuous_ready = false;
+        }
+        d.locality_rest.swap(r);
+        d.locality_group.swap(v);
+        d.locality_reach_sq.swap(q);
+        return TETHASH_OK;
+    });
+}
+
+tethash_status tethash_detector_continuous_broad_phase_pairs(const tethash_detector* detector, int64_t* out_pairs)
+{
+    const char* where = "tethash_detector_continuous_broad_phase_pairs";
+    if (!detector) return null_argument(where, "detector");
+    if (!out_pairs) return null_argument(where, "out_pairs");
+    *out_pairs = detector->continuous ? detector->continuous->broad_phase_pairs : 0;
+    return TETHASH_OK;
 }
 
 tethash_status tethash_detector_get_continuous_contacts(const tethash_detector* detector, int64_t capacity,
@@ -507,7 +590,8 @@ tethash_status tethash_detector_get_continuous_contacts(const tethash_detector* 
 {
     const char* where = "tethash_detector_get_continuous_contacts";
     if (!detector) return null_argument(where, "detector");
-    const tethash::ccd::ContinuousResult& r = detector->continuous;
+    static const tethash::ccd::ContinuousResult none;
+    const tethash::ccd::ContinuousResult& r = detector->continuous ? *detector->continuous : none;
     const std::size_t count = r.contacts.size();
     if (capacity < 0 || static_cast<std::size_t>(capacity) < count)
         return invalid(where, "capacity " + std::to_string(capacity) + " is less than the " + std::to_string(count) +

@@ -132,6 +132,52 @@ int main(void)
               "no continuous contact without motion");
     }
 
+    /* The locality rule: vertex 7 lies 0.3 from vertex 0, a corner of the face 0 1 2 it passes through, at rest (the
+     * first positions). In one group with a reach of 0.5 the pair is local and left out, though the grid met it;
+     * with a reach of 0.05, or in two groups (by object), it is far and found again. */
+    {
+        const double rest[8 * 3] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 1, 0, -1, 0, 1, -1, 0.2, 0.2, 0.1};
+        const int32_t one_group[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+        double back[8 * 3];
+        memcpy(back, xyz, sizeof back);
+        back[7 * 3 + 2] = 0.1;
+        const double wide = 0.25, narrow = 0.0025;
+        int64_t pairs = -1;
+        check(tethash_detector_set_continuous_locality(d, rest, 8, one_group, &wide, 1) == TETHASH_OK,
+              "set_continuous_locality");
+        check(tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK && count == 0,
+              "a local pair is left out");
+        check(tethash_detector_continuous_broad_phase_pairs(d, &pairs) == TETHASH_OK && pairs >= 1,
+              "the grid met the local pair");
+        check(tethash_detector_set_continuous_locality(d, rest, 8, one_group, &narrow, 1) == TETHASH_OK &&
+                  tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK &&
+                  count == 1,
+              "a far pair is found");
+        const double reaches[2] = {wide, wide};
+        check(tethash_detector_set_continuous_locality(d, rest, 8, vertex_object, reaches, 2) == TETHASH_OK &&
+                  tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK &&
+                  count == 1,
+              "a pair of two groups is never local");
+        /* Bad input names what is wrong; the rule before stays. */
+        check(tethash_detector_set_continuous_locality(d, rest, 8, vertex_object, &wide, 1) ==
+                  TETHASH_ERROR_INVALID_ARGUMENT,
+              "a group outside [0, num_groups) refused");
+        check(strstr(tethash_last_error(), "vertex 4 is in group 1") != NULL, "message names the vertex and group");
+        check(tethash_detector_set_continuous_locality(d, rest, 7, one_group, &wide, 1) ==
+                  TETHASH_ERROR_INVALID_ARGUMENT,
+              "a vertex count other than the topology's refused");
+        check(strstr(tethash_last_error(), "num_vertices is 7") != NULL, "message names num_vertices");
+        check(tethash_detector_set_continuous_locality(d, rest, 8, one_group, NULL, 1) == TETHASH_ERROR_NULL_ARGUMENT,
+              "NULL reach_sq refused");
+        check(strstr(tethash_last_error(), "reach_sq") != NULL, "message names reach_sq");
+        check(tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK && count == 1,
+              "the rule before stays");
+        check(tethash_detector_set_continuous_locality(d, rest, 8, NULL, NULL, 0) == TETHASH_OK &&
+                  tethash_detector_detect_continuous(d, xyz, back, 8, 1e-6, 1000000, &count) == TETHASH_OK &&
+                  count == 1,
+              "no rule");
+    }
+
     tethash_detector_destroy(d);
 
     /* Continuous queries: the vertex from (0.2, 0.2, 1) to (0.2, 0.2, -1) through the still triangle (0,0,0),

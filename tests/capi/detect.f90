@@ -2,7 +2,7 @@
 ! result worked out by hand there: vertex 8 (0-based 7) at (0.2, 0.2, 0.1) inside tet 1 (0-based 0), barycentric
 ! (0.5, 0.2, 0.2, 0.1), penetration depth 0.1 along -z, and the three edge-face contacts of the edges into it; no
 ! contact after the caller moves it to z = -0.1; moved back up over a step, continuous detection finds it passing
-! through tet 1's base at t = 0.5.
+! through tet 1's base at t = 0.5, unless a locality rule makes the pair local.
 ! Stops with status 1 on any failure.
 program detect_fortran
   use, intrinsic :: iso_c_binding
@@ -24,6 +24,8 @@ program detect_fortran
   real(c_double) :: t(3), normal(3, 3)
   real(c_double) :: x_end(3, 8), cont_toi(1)
   integer(c_int32_t) :: kind(1), ids(4, 1)
+  integer(c_int32_t) :: group(8)
+  integer(c_int64_t) :: pairs
 
   failures = 0
   x = reshape([0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, 0d0, 0d0, 0d0, 1d0, &
@@ -93,6 +95,21 @@ program detect_fortran
     call expect(sum(ids(2:4, 1)) == 3 .and. product(ids(2:4, 1)) == 0, "the face 0 1 2")
     call expect(cont_toi(1) <= 0.5d0 .and. cont_toi(1) > 0.4999d0, "at t = 0.5")
   end if
+  ! The locality rule: vertex 8 lies 0.3 from vertex 1 (the face's corner) in x_end (the rest state here). One group
+  ! with a squared reach of 0.25 makes the pair local and leaves it out, though the grid met it; 0.0025 makes it far.
+  group = 0
+  call ok(tethash_detector_set_continuous_locality(d, x_end, 8_c_int64_t, group, [0.25d0], 1_c_int64_t), &
+          "set_continuous_locality")
+  call ok(tethash_detector_detect_continuous(d, x, x_end, 8_c_int64_t, 1d-6, 1000000_c_int64_t, count), &
+          "detect_continuous with the rule")
+  call expect(count == 0, "a local pair left out")
+  call ok(tethash_detector_continuous_broad_phase_pairs(d, pairs), "continuous_broad_phase_pairs")
+  call expect(pairs >= 1, "the grid met the local pair")
+  call ok(tethash_detector_set_continuous_locality(d, x_end, 8_c_int64_t, group, [0.0025d0], 1_c_int64_t), &
+          "set_continuous_locality, narrow")
+  call ok(tethash_detector_detect_continuous(d, x, x_end, 8_c_int64_t, 1d-6, 1000000_c_int64_t, count), &
+          "detect_continuous with the narrow rule")
+  call expect(count == 1, "a far pair found")
 
   call tethash_detector_destroy(d)
 

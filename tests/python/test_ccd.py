@@ -55,3 +55,50 @@ def test_detect_continuous_sees_a_tet_passing_through_another():
     assert r["faces"].shape == (8, 3) and r["edges"].shape == (12, 2)
     same = tethash.detect_continuous(tets, x0, x1, threads=2)
     assert all(np.array_equal(r[k], same[k]) for k in r)
+
+
+def _vertex_through_a_face():
+    """Tet 0 the unit corner tet; tet 1's apex, vertex 7, rises from z = -0.1 to 0.1 through tet 0's base, 0.3 from
+    its corner 0 at the end (the rest state)."""
+    tets = np.array([[0, 1, 2, 3], [4, 5, 6, 7]], dtype=np.int32)
+    rest = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, -1], [1, 0, -1], [0, 1, -1], [0.2, 0.2, 0.1]],
+                    dtype=np.float64)
+    x0 = rest.copy()
+    x0[7, 2] = -0.1
+    return tets, rest, x0, rest.copy()
+
+
+def test_continuous_detector_locality_refuses_a_local_pair_and_accepts_a_far_one():
+    tets, rest, x0, x1 = _vertex_through_a_face()
+    det = tethash.ContinuousDetector()
+    det.set_topology(tets, 8)
+    free = det.detect(x0, x1)
+    assert list(free["kind"]) == [0] and list(free["a"]) == [7] and free["broad_phase_pairs"] >= 1
+    one_group = np.zeros(8, dtype=np.int32)
+    det.set_locality(rest, one_group, [0.25])  # reach 0.5: vertex 7 and corner 0 are 0.3 apart, local
+    local = det.detect(x0, x1)
+    assert len(local["toi"]) == 0 and local["broad_phase_pairs"] >= 1  # met by the grid, refused by the rule
+    det.set_locality(rest, one_group, [0.05 ** 2])  # reach 0.05: far
+    assert list(det.detect(x0, x1)["a"]) == [7]
+    by_object = np.array([0, 0, 0, 0, 1, 1, 1, 1], dtype=np.int32)
+    det.set_locality(rest, by_object, [0.25, 0.25])  # two groups: never local
+    assert list(det.detect(x0, x1)["a"]) == [7]
+
+
+def test_continuous_detector_bad_input_is_named():
+    tets, rest, x0, x1 = _vertex_through_a_face()
+    det = tethash.ContinuousDetector()
+    with pytest.raises(tethash.Error, match="set_topology"):
+        det.detect(x0, x1)
+    det.set_topology(tets, 8)
+    one_group = np.zeros(8, dtype=np.int32)
+    with pytest.raises(tethash.Error, match="vertex 4 is in group 1"):
+        det.set_locality(rest, np.array([0, 0, 0, 0, 1, 1, 1, 1], dtype=np.int32), [0.25])
+    with pytest.raises(tethash.Error, match="squared reach of group 0"):
+        det.set_locality(rest, one_group, [-1.0])
+    with pytest.raises(tethash.Error, match="rest has 7 rows"):
+        det.set_locality(rest[:7], one_group, [0.25])
+    with pytest.raises(ValueError, match="vertex_group: expected 8 ids"):
+        det.set_locality(rest, one_group[:7], [0.25])
+    with pytest.raises(tethash.Error, match="x0 and x1 have 8 and 7 rows"):
+        det.detect(x0, x1[:7])
