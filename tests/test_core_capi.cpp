@@ -182,6 +182,98 @@ TEST(CoreCapi, ContinuousContactsAsTheBruteForceOverAStep)
     }
 }
 
+TEST(CoreCapi, ContinuousLocalityAsCpp)
+{
+    // The step of the test above with a locality rule by object (reaches of 0.3, 0, 0.3, 0.3 for the objects): the C
+    // detector's contacts and broad-phase pairs are the C++ ContinuousDetector's with the same rule, fewer contacts
+    // than without it, and the rule outlives object options (set_object_options re-applies the topology) but not
+    // set_topology; num_groups 0 removes it.
+    const test::Scene s = test::random_scene(13, 4, 3, 0.3);
+    Positions x1 = s.positions;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.15, 0.15);
+    for (Eigen::Index v = 0; v < x1.rows(); ++v)
+        x1.row(v) += Eigen::RowVector3d(0.3 * (s.vertex_object[static_cast<size_t>(v)] % 2 ? 1 : -1), 0, 0) +
+                     Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    const std::vector<double> reach_sq{0.09, 0.0, 0.09, 0.09};
+    ccd::ContinuousDetector cpp;
+    cpp.set_topology(s.tets, static_cast<Index>(s.positions.rows()));
+    const std::int64_t all = static_cast<std::int64_t>(cpp.detect(s.positions, x1).contacts.size());
+    cpp.set_locality(s.positions, s.vertex_object, reach_sq);
+    const ccd::ContinuousResult& want = cpp.detect(s.positions, x1);
+    ASSERT_GT(want.contacts.size(), 0u);
+    ASSERT_LT(static_cast<std::int64_t>(want.contacts.size()), all) << "the rule leaves some pairs out";
+    ASSERT_GT(want.broad_phase_pairs, 0);
+
+    Handle h;
+    set_topology(h.d, s);
+    ASSERT_EQ(tethash_detector_set_threads(h.d, 1), TETHASH_OK);
+    const auto groups = static_cast<int64_t>(reach_sq.size());
+    ASSERT_EQ(tethash_detector_set_continuous_locality(h.d, s.positions.data(), s.positions.rows(),
+                                                       s.vertex_object.data(), reach_sq.data(), groups),
+              TETHASH_OK)
+        << tethash_last_error();
+    ASSERT_EQ(tethash_detector_set_object_options(h.d, 1, 0, 0), TETHASH_OK); // keeps the rule
+    const auto count_of = [&] {
+        int64_t count = -1;
+        EXPECT_EQ(
+            tethash_detector_detect_continuous(h.d, s.positions.data(), x1.data(), x1.rows(), 1e-6, 1000000, &count),
+            TETHASH_OK)
+            << tethash_last_error();
+        return count;
+    };
+    ASSERT_EQ(count_of(), static_cast<int64_t>(want.contacts.size()));
+    int64_t pairs = -1;
+    ASSERT_EQ(tethash_detector_continuous_broad_phase_pairs(h.d, &pairs), TETHASH_OK);
+    EXPECT_EQ(pairs, want.broad_phase_pairs);
+    const auto n = static_cast<size_t>(want.contacts.size());
+    std::vector<int32_t> kind(n), vertices(4 * n);
+    ASSERT_EQ(
+        tethash_detector_get_continuous_contacts(h.d, static_cast<int64_t>(n), kind.data(), vertices.data(), nullptr),
+        TETHASH_OK);
+    for (size_t i = 0; i < n; ++i) {
+        const ccd::ContinuousContact& c = want.contacts[i];
+        const bool vf = c.kind == ccd::ContinuousKind::vertex_face;
+        EXPECT_EQ(kind[i], vf ? 0 : 1) << i;
+        EXPECT_EQ(vertices[4 * i], vf ? c.a : want.edges(c.a, 0)) << i;
+    }
+    // A refused rule names what is wrong and leaves the one before.
+    std::vector<int32_t> bad = s.vertex_object;
+    bad[3] = 7;
+    expect_error(tethash_detector_set_continuous_locality(h.d, s.positions.data(), s.positions.rows(), bad.data(),
+                                                          reach_sq.data(), groups),
+                 TETHASH_ERROR_INVALID_ARGUMENT, "tethash_detector_set_continuous_locality");
+    EXPECT_NE(std::string(tethash_last_error()).find("vertex 3 is in group 7"), std::string::npos)
+        << tethash_last_error();
+    const std::vector<double> negative{0.09, -1.0, 0.09, 0.09};
+    expect_error(tethash_detector_set_continuous_locality(h.d, s.positions.data(), s.positions.rows(),
+                                                          s.vertex_object.data(), negative.data(), groups),
+                 TETHASH_ERROR_INVALID_ARGUMENT, "squared reach of group 1");
+    expect_error(tethash_detector_set_continuous_locality(h.d, nullptr, s.positions.rows(), s.vertex_object.data(),
+                                                          reach_sq.data(), groups),
+                 TETHASH_ERROR_NULL_ARGUMENT, "rest is NULL");
+    expect_error(tethash_detector_set_continuous_locality(h.d, s.positions.data(), s.positions.rows(),
+                                                          s.vertex_object.data(), reach_sq.data(), -1),
+                 TETHASH_ERROR_INVALID_ARGUMENT, "num_groups");
+    expect_error(tethash_detector_continuous_broad_phase_pairs(h.d, nullptr), TETHASH_ERROR_NULL_ARGUMENT, "out_pairs");
+    EXPECT_EQ(count_of(), static_cast<int64_t>(want.contacts.size())) << "the rule before stays";
+    // Without the rule, all the contacts again; set_topology forgets the rule too.
+    ASSERT_EQ(tethash_detector_set_continuous_locality(h.d, nullptr, s.positions.rows(), nullptr, nullptr, 0),
+              TETHASH_OK);
+    EXPECT_EQ(count_of(), all);
+    ASSERT_EQ(tethash_detector_set_continuous_locality(h.d, s.positions.data(), s.positions.rows(),
+                                                       s.vertex_object.data(), reach_sq.data(), groups),
+              TETHASH_OK);
+    set_topology(h.d, s);
+    EXPECT_EQ(count_of(), all);
+    {
+        Handle none;
+        expect_error(tethash_detector_set_continuous_locality(none.d, s.positions.data(), s.positions.rows(),
+                                                              s.vertex_object.data(), reach_sq.data(), groups),
+                     TETHASH_ERROR_STATE, "no topology set");
+    }
+}
+
 TEST(CoreCapi, EdgeContactsAsCppWithObjectOptions)
 {
     const test::Scene s = test::random_scene(7, 3, 3, 0.3);
