@@ -82,6 +82,7 @@ class SimulationImpl {
     Positions x_save, v_save;                // last good step (rollback on failure)
     std::int64_t inverted = 0;               // inverted dynamic tets after the last step
     std::vector<std::int32_t> inverted_tets; // which (scratch of each step)
+    Model::TetScan tet_scan;                 // the step's pass over the tets (with its energy)
     int refined = 1;                         // substeps of the last refined step, kept until refined_until
     int auto_max_substeps = 8;               // vbd's automatic max_substeps (set_auto_max_substeps)
     double refined_until = 0;
@@ -558,8 +559,9 @@ void Simulation::step()
             if (swept) ++st.continuous_crossings;
             continue;
         }
+        // The energy, and in the same pass over the tets the inverted ones and the volume (read below).
         if (bad.empty()) {
-            const Energy e = s.model.energy(x, s.v, s.threads_now);
+            const Energy e = s.model.energy(x, s.v, s.threads_now, &s.tet_scan);
             bad = s.failure.check_energy(e.internal() + s.contacts.energy());
             energy_now = e.total() + s.contacts.energy();
         }
@@ -588,7 +590,9 @@ void Simulation::step()
                 continue;
             }
         }
-        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now, s.threads_now);
+        s.inverted_tets.swap(s.tet_scan.inverted);
+        s.inverted = static_cast<std::int64_t>(s.inverted_tets.size());
+        volume_now = s.tet_scan.volume;
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
         // stiff body, which can gain the scene a tenth of its energy in one such substep; docs/simulator.md): taken
