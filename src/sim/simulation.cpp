@@ -95,10 +95,11 @@ class SimulationImpl {
     bool choose_threads = false;
     int threads_now = 1;
     // Scene::crossing_check: the (vertex, object) pairs the contacts of the last update watched (penetrations and
-    // margin contacts, sorted), and the state of the step's end update, which the next step's first substep reuses.
+    // margin contacts, sorted), and whether the contacts are those of the state the last step ended in (for a substep
+    // of h_end), which the next step's first substep then reuses. Only step() changes the state: it clears the flag
+    // wherever it takes the state back (a refinement, a failure) after that update.
     std::vector<std::pair<Index, Index>> watched;
     bool contacts_at_end = false;
-    Positions x_end, v_end;
     double h_end = 0;
     // Scene::continuous_check: the sweep of each substep, and the substep's start positions.
     SweepCheck sweep;
@@ -294,7 +295,7 @@ int SimulationImpl::approach_substeps(int most) const
 
 void SimulationImpl::update_contacts(const Positions& x, double h, StepStats& st)
 {
-    if (contacts_at_end && h == h_end && (x.array() == x_end.array()).all() && (v.array() == v_end.array()).all()) {
+    if (contacts_at_end && h == h_end) {
         contacts_at_end = false;
         return;
     }
@@ -457,6 +458,7 @@ void Simulation::step()
     int substeps = s.scene.substeps;
     int sub = 0;
     auto fail = [&](const std::string& what, bool with_cause = true) {
+        s.contacts_at_end = false;
         x = s.x_save;
         s.v = s.v_save;
         const double h = s.scene.dt / substeps;
@@ -492,6 +494,7 @@ void Simulation::step()
     const bool sweeping = s.scene.continuous_check && s.contacts.enabled();
     auto refine = [&] {
         if (substeps * 2 > max_substeps) return false;
+        s.contacts_at_end = false;
         x = s.x_save;
         s.v = s.v_save;
         substeps *= 2;
@@ -610,8 +613,6 @@ void Simulation::step()
                 fail(std::string("collision detection failed (") + e.what() + ")");
             }
             s.contacts_at_end = true;
-            s.x_end = x;
-            s.v_end = s.v;
             s.h_end = h;
             if (s.entered_unseen() && refine()) {
                 ++st.crossings;
