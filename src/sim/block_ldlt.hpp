@@ -7,7 +7,8 @@
 // lattices of small meshes (125-200 nodes) that was a third of the instructions of a step. Here the ordering (AMD on
 // the nodes' graph), the elimination tree and the factor's pattern are computed once per pattern, and the numeric
 // factorisation reads the blocks in place and updates 3 × 3 blocks: the same up-looking algorithm, a ninth of the
-// index work (docs/simulator.md, "Where the step's time goes").
+// index work; the octopus drop's factorisations went from 357M to 100M instructions (docs/simulator.md, "The small
+// meshes against Bullet").
 //
 // A = Pᵀ L D Lᵀ P with L unit lower triangular in blocks and D block diagonal (each D_k a symmetric 3 × 3, kept
 // inverted). Serial, so the result is the same at any thread count.
