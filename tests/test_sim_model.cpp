@@ -368,3 +368,45 @@ TEST(SimModel, EnergyIsTheSameAtAnyThreadCount)
         kinetic += 0.5 * model.mass[static_cast<size_t>(i)] * v.row(i).squaredNorm();
     EXPECT_NEAR(e1.kinetic, kinetic, 1e-12 * kinetic);
 }
+
+TEST(SimModel, EnergyPassFindsTheInvertedTetsAndTheVolume)
+{
+    // A step's checks read the energy, the inverted tets and the volume from one pass over the tets: each must be the
+    // bits of a pass of its own (signed_volume, its energy and the volumes summed in blocks of 4,096 tets; the tets of
+    // signed volume ≤ 0 in order), at one thread and at two, on a box shaken until some of its tets turn inside out.
+    TetMesh m = box_mesh(14);
+    ASSERT_GT(m.num_tets(), 3 * 4096);
+    Material mat;
+    mat.young = 1e5;
+    const Model model = Model::build(m, {mat}, {0});
+    const Positions x = perturbed(m.positions, 5, 0.05);
+    const Positions v = perturbed(Positions::Zero(m.num_vertices(), 3), 6, 1.0);
+    const Tets& tets = model.volumes.tets;
+    double volume_energy = 0, six_volume = 0;
+    std::vector<std::int32_t> inverted;
+    for (Index b = 0; b < tets.rows(); b += 4096) {
+        double part = 0, six_part = 0;
+        for (Index t = b; t < std::min<Index>(tets.rows(), b + 4096); ++t) {
+            const double vol = signed_volume(x, {tets(t, 0), tets(t, 1), tets(t, 2), tets(t, 3)});
+            const double v0 = model.volumes.rest[static_cast<size_t>(t)];
+            part += 0.5 * model.volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
+            six_part += 6 * vol;
+            if (!(vol > 0)) inverted.push_back(static_cast<std::int32_t>(t));
+        }
+        volume_energy += part;
+        six_volume += six_part;
+    }
+    ASSERT_GT(inverted.size(), 10u);
+    for (const int threads : {1, 2}) {
+        Model::TetScan scan;
+        scan.inverted = {1, 2, 3}; // replaced, not appended to
+        const Energy with = model.energy(x, v, threads, &scan);
+        const Energy without = model.energy(x, v, threads);
+        EXPECT_EQ(scan.inverted, inverted) << threads;
+        EXPECT_NEAR(scan.volume, six_volume / 6, 1e-14 * std::abs(six_volume)) << threads;
+        EXPECT_EQ(with.volume, volume_energy) << threads;
+        EXPECT_EQ(without.volume, volume_energy) << threads;
+        EXPECT_EQ(with.spring, without.spring) << threads;
+        EXPECT_EQ(with.kinetic, without.kinetic) << threads;
+    }
+}

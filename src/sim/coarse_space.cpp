@@ -461,7 +461,7 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
             }
         }
     }
-    bool same = m_analysed && m_factored_h == h && m_factored_age < 8 &&
+    bool same = m_analysed && m_factor.ok() && m_factored_h == h && m_factored_age < 8 &&
                 10 * differ <= std::max(with_extra.size(), m_factored_extra.size());
     for (size_t o = 0; same && o < m_objects.size(); ++o) {
         const Eigen::AngleAxisd turn(m_rotation[o] * m_factored_rotation[o].transpose());
@@ -518,11 +518,10 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
         }
     }
     if (!m_analysed) {
-        m_solver.analyzePattern(m_matrix);
+        m_factor.analyse(m_nodes, m_blocks);
         m_analysed = true;
     }
-    m_solver.factorize(m_matrix);
-    return m_solver.info() == Eigen::Success;
+    return m_factor.factorise(m_matrix.valuePtr(), m_block_value.data());
 }
 
 Eigen::MatrixXd CoarseSpace::start_matrix(double h)
@@ -580,7 +579,7 @@ void CoarseSpace::correct(const std::vector<double>& r, std::vector<double>& dx)
         for (size_t q = 0; q < 3; ++q)
             rc[3 * static_cast<size_t>(node) + q] = s[q];
     }
-    m_dc.noalias() = m_solver.solve(m_rc);
+    m_factor.solve(m_rc.data(), m_dc.data());
     const double* dc = m_dc.data();
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel for num_threads(m_threads) schedule(static) if (parallel)

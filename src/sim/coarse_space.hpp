@@ -24,11 +24,12 @@
 // mean edges; an object gets at most a quarter as many nodes as it has vertices (125 for any) and at most 8 ω h
 // between 200 and 400: the factorisation costs a few sweeps, and is worth more where ω h makes a substep need many.
 
+#include "block_ldlt.hpp"
+
 #include "tethash/sim/model.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cstdint>
@@ -108,7 +109,7 @@ class CoarseSpace {
     int m_threads = 1;
     std::vector<std::int32_t> m_vertex_blocks; ///< 64 per vertex: the block of (node a, node b) of its 8 × 8
     Eigen::SparseMatrix<double> m_matrix;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_solver;
+    BlockLdlt m_factor; ///< of m_matrix, in its 3 × 3 blocks
     bool m_analysed = false;
     std::vector<Cached> m_cache;
     std::vector<Eigen::Matrix3d> m_rotation;          ///< per object, this substep

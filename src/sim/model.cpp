@@ -349,7 +349,7 @@ struct VertexSums {
 
 } // namespace
 
-Energy Model::energy(const Positions& x, const Positions& v, int threads) const
+Energy Model::energy(const Positions& x, const Positions& v, int threads, TetScan* tets) const
 {
     using detail::block_sum;
     Energy en;
@@ -378,17 +378,41 @@ Energy Model::energy(const Positions& x, const Positions& v, int threads) const
         }
         return sum;
     });
-    const PositionsRef xr(x);
-    en.volume = block_sum<double>(static_cast<Index>(volumes.tets.rows()), threads, [&](Index begin, Index end) {
-        double sum = 0;
-        for (Index t = begin; t < end; ++t) {
-            const double vol =
-                signed_volume(xr, {volumes.tets(t, 0), volumes.tets(t, 1), volumes.tets(t, 2), volumes.tets(t, 3)});
-            const double v0 = volumes.rest[static_cast<size_t>(t)];
-            sum += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
+    // The tets: their energy, and with `tets` the inverted ones and the volume, in one pass (each sum in the blocks'
+    // order, so each the same bits as a pass of its own: signed_volume's and find_inverted_tets's products).
+    struct TetSums {
+        double energy = 0, six_volume = 0;
+        std::vector<std::int32_t> inverted;
+        TetSums& operator+=(const TetSums& o)
+        {
+            energy += o.energy;
+            six_volume += o.six_volume;
+            inverted.insert(inverted.end(), o.inverted.begin(), o.inverted.end());
+            return *this;
         }
-        return sum;
+    };
+    const bool scan = tets != nullptr;
+    TetSums ts = block_sum<TetSums>(static_cast<Index>(volumes.tets.rows()), threads, [&](Index begin, Index end) {
+        TetSums part;
+        for (Index t = begin; t < end; ++t) {
+            const Vec3 a = row(x, volumes.tets(t, 0));
+            const double w = (row(x, volumes.tets(t, 1)) - a)
+                                 .dot((row(x, volumes.tets(t, 2)) - a).cross(row(x, volumes.tets(t, 3)) - a));
+            const double vol = w / 6.0;
+            const double v0 = volumes.rest[static_cast<size_t>(t)];
+            part.energy += 0.5 * volumes.k[static_cast<size_t>(t)] * (vol - v0) * (vol - v0) / v0;
+            if (scan) {
+                part.six_volume += w;
+                if (!(w > 0)) part.inverted.push_back(static_cast<std::int32_t>(t));
+            }
+        }
+        return part;
     });
+    en.volume = ts.energy;
+    if (scan) {
+        tets->inverted.swap(ts.inverted);
+        tets->volume = ts.six_volume / 6;
+    }
     return en;
 }
 

@@ -82,6 +82,7 @@ class SimulationImpl {
     Positions x_save, v_save;                // last good step (rollback on failure)
     std::int64_t inverted = 0;               // inverted dynamic tets after the last step
     std::vector<std::int32_t> inverted_tets; // which (scratch of each step)
+    Model::TetScan tet_scan;                 // the step's pass over the tets (with its energy)
     int refined = 1;                         // substeps of the last refined step, kept until refined_until
     int auto_max_substeps = 8;               // vbd's automatic max_substeps (set_auto_max_substeps)
     double refined_until = 0;
@@ -94,10 +95,11 @@ class SimulationImpl {
     bool choose_threads = false;
     int threads_now = 1;
     // Scene::crossing_check: the (vertex, object) pairs the contacts of the last update watched (penetrations and
-    // margin contacts, sorted), and the state of the step's end update, which the next step's first substep reuses.
+    // margin contacts, sorted), and whether the contacts are those of the state the last step ended in (for a substep
+    // of h_end), which the next step's first substep then reuses. Only step() changes the state: it clears the flag
+    // wherever it takes the state back (a refinement, a failure) after that update.
     std::vector<std::pair<Index, Index>> watched;
     bool contacts_at_end = false;
-    Positions x_end, v_end;
     double h_end = 0;
     // Scene::continuous_check: the sweep of each substep, and the substep's start positions.
     SweepCheck sweep;
@@ -293,7 +295,7 @@ int SimulationImpl::approach_substeps(int most) const
 
 void SimulationImpl::update_contacts(const Positions& x, double h, StepStats& st)
 {
-    if (contacts_at_end && h == h_end && (x.array() == x_end.array()).all() && (v.array() == v_end.array()).all()) {
+    if (contacts_at_end && h == h_end) {
         contacts_at_end = false;
         return;
     }
@@ -456,6 +458,7 @@ void Simulation::step()
     int substeps = s.scene.substeps;
     int sub = 0;
     auto fail = [&](const std::string& what, bool with_cause = true) {
+        s.contacts_at_end = false;
         x = s.x_save;
         s.v = s.v_save;
         const double h = s.scene.dt / substeps;
@@ -491,6 +494,7 @@ void Simulation::step()
     const bool sweeping = s.scene.continuous_check && s.contacts.enabled();
     auto refine = [&] {
         if (substeps * 2 > max_substeps) return false;
+        s.contacts_at_end = false;
         x = s.x_save;
         s.v = s.v_save;
         substeps *= 2;
@@ -558,8 +562,9 @@ void Simulation::step()
             if (swept) ++st.continuous_crossings;
             continue;
         }
+        // The energy, and in the same pass over the tets the inverted ones and the volume (read below).
         if (bad.empty()) {
-            const Energy e = s.model.energy(x, s.v, s.threads_now);
+            const Energy e = s.model.energy(x, s.v, s.threads_now, &s.tet_scan);
             bad = s.failure.check_energy(e.internal() + s.contacts.energy());
             energy_now = e.total() + s.contacts.energy();
         }
@@ -588,7 +593,9 @@ void Simulation::step()
                 continue;
             }
         }
-        s.inverted = find_inverted_tets(s.model, x, s.inverted_tets, &volume_now, s.threads_now);
+        s.inverted_tets.swap(s.tet_scan.inverted);
+        s.inverted = static_cast<std::int64_t>(s.inverted_tets.size());
+        volume_now = s.tet_scan.volume;
         if (s.inverted > allowed && refine()) continue;
         // A substep whose iterations reached their cap is a step too long for them to converge in (an impact of a
         // stiff body, which can gain the scene a tenth of its energy in one such substep; docs/simulator.md): taken
@@ -606,8 +613,6 @@ void Simulation::step()
                 fail(std::string("collision detection failed (") + e.what() + ")");
             }
             s.contacts_at_end = true;
-            s.x_end = x;
-            s.v_end = s.v;
             s.h_end = h;
             if (s.entered_unseen() && refine()) {
                 ++st.crossings;

@@ -7,9 +7,22 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <memory>
 
 namespace tethash::bench {
+
+namespace {
+
+/// Processor time of the process (ms).
+double process_cpu_ms()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+} // namespace
 
 int bullet_version()
 {
@@ -77,7 +90,9 @@ PeerResult run_bullet(const std::vector<PeerBody>& bodies, double dt, int steps,
     PeerResult r;
     for (int s = 0; s < steps; ++s) {
         const auto t0 = std::chrono::steady_clock::now();
+        const double cpu0 = process_cpu_ms();
         world.stepSimulation(static_cast<btScalar>(dt), 0, static_cast<btScalar>(dt));
+        r.cpu_ms.push_back(process_cpu_ms() - cpu0);
         r.ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
         bool finite = true;
         for (const auto& sb : soft)

@@ -20,6 +20,7 @@ struct PeerBody {
 
 struct PeerResult {
     std::vector<double> ms;       ///< wall time of each step
+    std::vector<double> cpu_ms;   ///< processor time of each step (the process's: one thread, Bullet's step alone)
     std::vector<Positions> final; ///< each body's positions at the end
     std::string failure;          ///< non-empty when a position went non-finite
 };

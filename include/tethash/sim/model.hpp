@@ -21,6 +21,7 @@
 #include <Eigen/Sparse>
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 namespace tethash::sim {
@@ -120,9 +121,16 @@ struct Model {
     /// them).
     void add_forces(const Positions& x, const Positions& v, Positions& f) const { add_forces(x, v, f, ForceOptions{}); }
     void add_forces(const Positions& x, const Positions& v, Positions& f, const ForceOptions& opt) const;
+    /// What the energy's pass over the tets finds besides their energy (Model::energy with `tets`): the tets whose
+    /// signed volume is ≤ 0, by row, and the sum of the signed volumes (what find_inverted_tets gives, bit for bit).
+    struct TetScan {
+        std::vector<std::int32_t> inverted;
+        double volume = 0;
+    };
     /// Energies (contact left 0: see Simulation). Summed in blocks of a fixed size, the blocks split over `threads`
-    /// and added in order: the same bits at any thread count.
-    Energy energy(const Positions& x, const Positions& v, int threads = 1) const;
+    /// and added in order: the same bits at any thread count. With `tets`, the same pass over the tets also fills
+    /// it (a step's checks read both: one pass instead of two).
+    Energy energy(const Positions& x, const Positions& v, int threads = 1, TetScan* tets = nullptr) const;
     /// Largest eigenvalue bound of M⁻¹K over springs and volume terms (Gershgorin, rest state): ω_max².
     double omega_max_sq(const Positions& x) const;
     /// Explicit (symplectic Euler) stability limit (s) per vertex from the Gershgorin bounds of ω² and of the
