@@ -47,6 +47,10 @@ void closest_points(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
     }
 }
 
+/// The edge-face contacts' skin (candidate reuse between substeps), in mean edges of the smallest moving object: on
+/// the hand at 1/240 a quarter edge cost less than half or one edge (docs/simulator.md, "Edges through faces").
+constexpr double edge_skin_edges = 0.25;
+
 /// The threads of the stages that take every core where the scene says 0 (chosen step by step: the detector follows
 /// the step's count, these run on every core).
 int stage_threads(int threads)
@@ -100,8 +104,24 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         if (scene.contact.margin > 0 || scene.contact.speculative)
             m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
                               local_contact_edges);
-        if (scene.contact.edges)
+        if (scene.contact.edges) {
             m_edges.set_topology(mesh.tets, mesh.num_vertices(), mesh.vertex_object, mesh.tet_object, options);
+            // Candidate reuse between substeps (EdgeFaceDetector::set_skin): a skin of edge_skin_edges × the
+            // smallest moving object's mean edge.
+            double edge = 0;
+            for (size_t o = 0; o < model.object_mean_edge.size(); ++o)
+                if (model.object_mean_edge[o] > 0 && (o >= options.size() || !options[o].is_static))
+                    edge = edge > 0 ? std::min(edge, model.object_mean_edge[o]) : model.object_mean_edge[o];
+            m_edges.set_skin(edge_skin_edges * edge);
+            // The locality rule of the crossings (add_edge_contacts) applied in the find, so that neither the tests
+            // nor the kept pairs hold the object's own neighbourhood; a hair narrower than the rule, so that rounding
+            // never drops a pair the rule keeps. The crossings it leaves out are asked for one by one when a pair
+            // needs them (crosses_locally).
+            std::vector<double> reach(model.object_mean_edge.size());
+            for (size_t o = 0; o < reach.size(); ++o)
+                reach[o] = local_contact_edges * model.object_mean_edge[o] * (1 - 1e-9);
+            m_edges.set_local_reach(m_rest, reach);
+        }
         m_proximity.set_threads(stage_threads(scene.detect.threads));
         m_edge_threads = stage_threads(scene.detect.threads);
     }
@@ -267,7 +287,7 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
                                    [](const EdgeFaceContact& c, Index e) { return c.edge < e; });
         for (; it != crossings.end() && it->edge == g; ++it)
             if (it->face_object == object) return true;
-        return false;
+        return m_edges.crosses_locally(g, object, x); // a crossing the find left out as local
     };
     const Positions& rest = m_rest;
     // The pairs (edge, an edge of a face it passes through that passes through the first edge's object), each
