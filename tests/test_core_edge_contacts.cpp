@@ -219,7 +219,9 @@ TEST(CoreEdgeContacts, SkinReusesKeptPairsAndEqualsOracle)
         EXPECT_EQ(plain.kept_candidates, 0);
         reused += got.reused;
         full += 1 - got.reused;
-        if (got.reused == 0) EXPECT_GT(got.kept_candidates, got.candidates) << "the grown boxes keep more pairs";
+        if (got.reused == 0) {
+            EXPECT_GT(got.kept_candidates, got.candidates) << "the grown boxes keep more pairs";
+        }
         total += got.contacts.size();
     }
     EXPECT_GT(reused, 12) << "most finds reuse the kept pairs";
@@ -243,15 +245,20 @@ TEST(CoreEdgeContacts, SkinPausesWhenEverythingMovesAndResumesWhenSlow)
         const EdgeFaceResult& r = det.find(s.positions);
         EXPECT_TRUE(same(r, oracle(s))) << "step " << step;
         EXPECT_EQ(r.reused, 0);
-        if (step >= 1) EXPECT_EQ(r.kept_candidates, 0) << "paused, step " << step;
+        if (step >= 1) {
+            EXPECT_EQ(r.kept_candidates, 0) << "paused, step " << step;
+        }
     }
     for (int step = 0; step < 3; ++step) {
         s.positions.col(1).array() += 0.001; // slow: 0.001 per find
         s.positions(0, 1) += 0.0001 * step;
         const EdgeFaceResult& r = det.find(s.positions);
         EXPECT_TRUE(same(r, oracle(s))) << "slow step " << step;
-        if (step == 0) EXPECT_GT(r.kept_candidates, 0) << "resumed";
-        if (step > 0) EXPECT_EQ(r.reused, 1) << "slow step " << step;
+        if (step == 0) {
+            EXPECT_GT(r.kept_candidates, 0) << "resumed";
+        } else {
+            EXPECT_EQ(r.reused, 1) << "slow step " << step;
+        }
     }
 }
 

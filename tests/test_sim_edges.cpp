@@ -97,7 +97,9 @@ TEST(SimEdges, SlabPiercedStraightThroughIsUndoneOnlyWithEdgeContacts)
         for (; steps < 100 && crossings(sim) > 0; ++steps) {
             sim.step();
             // Without the edge contacts nothing moves; with them the bar's lower end passes up through the slab.
-            if (!edges) EXPECT_EQ(sim.last_stats().contacts, 0) << "no vertex inside anything, step " << steps + 1;
+            if (!edges) {
+                EXPECT_EQ(sim.last_stats().contacts, 0) << "no vertex inside anything, step " << steps + 1;
+            }
         }
         const auto [b0, bn] = sim.object_vertices(1);
         if (edges) {
