@@ -511,7 +511,7 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         for (const Row& r : rows)
             out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
                                "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},{:.4g},{:.4g},{:.3g},{:"
-                               ".4g},\"{}\",{},{}\n",
+                               ".4g},\"{}\",{},{},{}\n",
                                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
                                r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
                                r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
