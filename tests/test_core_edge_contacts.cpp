@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 using namespace tethash;
 using test::Scene;
@@ -185,6 +186,131 @@ TEST(CoreEdgeContacts, DetectorKeptAcrossStepsEqualsOracle)
     }
     EXPECT_GT(total, 0u);
     EXPECT_THROW(det.find(Positions(3, 3)), Error);
+}
+
+TEST(CoreEdgeContacts, SkinReusesKeptPairsAndEqualsOracle)
+{
+    // A scene deformed a little more at every find, carried along by a large common translation: with a skin the
+    // finds between full ones test only the kept pairs, and every find equals the oracle and a find without a skin
+    // (contacts and candidates), at 1 and 2 threads alternately.
+    Scene s = test::random_scene(13, 4, 3, 0.3);
+    test::set_object_rules(s, 6);
+    const Positions start = s.positions;
+    EdgeFaceDetector with, without;
+    with.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    without.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    with.set_skin(0.1);
+    int reused = 0, full = 0;
+    std::size_t total = 0;
+    for (int step = 0; step < 24; ++step) {
+        // A growing bend (0.01 x² more per step) and 2.5 units of common translation per step.
+        s.positions = start;
+        const double bend = 0.01 * step;
+        for (Eigen::Index v = 0; v < s.positions.rows(); ++v) {
+            s.positions(v, 2) += bend * s.positions(v, 0) * s.positions(v, 0);
+            s.positions(v, 0) += 2.5 * step;
+        }
+        const int threads = step % 2 + 1;
+        const EdgeFaceResult& got = with.find(s.positions, threads);
+        const EdgeFaceResult& plain = without.find(s.positions, 3 - threads);
+        EXPECT_TRUE(same(got, oracle(s))) << "step " << step;
+        EXPECT_EQ(got.candidates, plain.candidates) << "step " << step;
+        EXPECT_EQ(plain.reused, 0);
+        EXPECT_EQ(plain.kept_candidates, 0);
+        reused += got.reused;
+        full += 1 - got.reused;
+        if (got.reused == 0) {
+            EXPECT_GT(got.kept_candidates, got.candidates) << "the grown boxes keep more pairs";
+        }
+        total += got.contacts.size();
+    }
+    EXPECT_GT(reused, 12) << "most finds reuse the kept pairs";
+    EXPECT_GT(full, 1) << "the bend outgrows the skin now and then";
+    EXPECT_GT(total, 0u);
+    EXPECT_THROW(with.set_skin(-1), Error);
+    EXPECT_THROW(with.set_skin(std::numeric_limits<double>::infinity()), Error);
+}
+
+TEST(CoreEdgeContacts, SkinPausesWhenEverythingMovesAndResumesWhenSlow)
+{
+    // Every find jitters the scene by far more than the skin: the kept pairs are never reused, so the finds after
+    // the second run without them (nothing kept); slow steps then bring the skin back. Always the oracle's contacts.
+    Scene s = test::random_scene(17, 3, 3, 0.2);
+    EdgeFaceDetector det;
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+    det.set_skin(0.01);
+    const Positions start = s.positions;
+    for (int step = 0; step < 4; ++step) {
+        deform(s, 300 + step, 0.5);
+        const EdgeFaceResult& r = det.find(s.positions);
+        EXPECT_TRUE(same(r, oracle(s))) << "step " << step;
+        EXPECT_EQ(r.reused, 0);
+        if (step >= 1) {
+            EXPECT_EQ(r.kept_candidates, 0) << "paused, step " << step;
+        }
+    }
+    for (int step = 0; step < 3; ++step) {
+        s.positions.col(1).array() += 0.001; // slow: 0.001 per find
+        s.positions(0, 1) += 0.0001 * step;
+        const EdgeFaceResult& r = det.find(s.positions);
+        EXPECT_TRUE(same(r, oracle(s))) << "slow step " << step;
+        if (step == 0) {
+            EXPECT_GT(r.kept_candidates, 0) << "resumed";
+        } else {
+            EXPECT_EQ(r.reused, 1) << "slow step " << step;
+        }
+    }
+}
+
+TEST(CoreEdgeContacts, LocalReachLeavesOutTheRestLocalSelfPairsOnly)
+{
+    // With a reach per object, a self pair with a vertex of the edge and one of the triangle nearer than the reach
+    // in the rest state is left out; everything else is the oracle's. crosses_locally answers for the pairs left out.
+    std::int64_t dropped = 0, kept_self = 0;
+    for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+        Scene s = test::random_scene(seed, 3, 3, 0.3);
+        const Positions rest = s.positions;
+        deform(s, seed, 1.0);
+        const std::vector<double> reach(4, 0.35);
+        EdgeFaceDetector det;
+        det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object, s.objects);
+        det.set_local_reach(rest, reach);
+        const EdgeFaceResult& got = det.find(s.positions, static_cast<int>(seed % 2) + 1);
+        const EdgeFaceResult want = oracle(s);
+        EdgeFaceResult filtered = want;
+        filtered.contacts.clear();
+        std::vector<std::pair<Index, Index>> local; // (edge, object) with a crossing left out
+        for (const EdgeFaceContact& c : want.contacts) {
+            bool near = false;
+            for (const Index a : c.edge_vertices)
+                for (const Index b : c.face_vertices)
+                    near = near || (rest.row(a) - rest.row(b)).squaredNorm() < 0.35 * 0.35;
+            if (c.edge_object == c.face_object && near) {
+                local.emplace_back(c.edge, c.face_object);
+                ++dropped;
+            } else {
+                filtered.contacts.push_back(c);
+                kept_self += c.edge_object == c.face_object;
+            }
+        }
+        EXPECT_TRUE(same(got, filtered)) << "seed " << seed;
+        std::sort(local.begin(), local.end());
+        for (Index e = 0; e < want.edges.rows(); ++e) {
+            const Index object =
+                s.vertex_object.empty() ? 0 : s.vertex_object[static_cast<std::size_t>(want.edges(e, 0))];
+            const bool expect = std::binary_search(local.begin(), local.end(), std::make_pair(e, object));
+            EXPECT_EQ(det.crosses_locally(e, object, s.positions), expect) << "seed " << seed << ", edge " << e;
+            EXPECT_FALSE(det.crosses_locally(e, object + 1, s.positions));
+        }
+    }
+    EXPECT_GT(dropped, 0);   // the rule left something out
+    EXPECT_GT(kept_self, 0); // and kept far self crossings
+    EdgeFaceDetector det;
+    Scene s = test::random_scene(1, 2, 2, 0.1);
+    det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object);
+    const std::vector<double> bad = {-1.0, 1.0};
+    EXPECT_THROW(det.set_local_reach(s.positions, bad), Error);
+    EXPECT_THROW(det.set_local_reach(Positions(2, 3), std::vector<double>(2, 1.0)), Error);
 }
 
 TEST(CoreEdgeContacts, EqualsOracleOnDegenerateLattices)

@@ -1,8 +1,9 @@
 // ContactParams::edges: a boundary edge passing through a far boundary face, with no vertex inside anything, is
 // pushed out (src/sim/contact_response.cpp, add_edge_contacts). Two bars crossed at rest, each one's long edges
 // through the other's side faces and no vertex of either inside the other: with the option the crossing is undone
-// within a few steps, without it it stays. The same bit for bit at one and two threads; the scene key is read and
-// checked.
+// within a few steps, without it it stays. A thin bar pierced straight through a thin slab (no edge of the slab
+// through the bar, so no pair): pulled out the short way with the option, left without. The same bit for bit at one
+// and two threads; the scene key is read and checked.
 #include "sim_support.hpp"
 #include "support.hpp"
 
@@ -45,6 +46,23 @@ size_t crossings(const Simulation& sim)
     return find_edge_face_contacts(m.tets, m.positions, m.vertex_object, m.tet_object).contacts.size();
 }
 
+/// A thin bar (0.05 × 0.05 × 1, along z) pierced straight through a static thin slab (1 × 1 × 0.05), off its face
+/// diagonals: the bar's edges pass in through the slab's top face and out through its bottom face, no edge of the slab
+/// passes through the bar and no vertex of either is inside the other. The bar's lower end is 0.15 below the slab.
+Scene pierced_slab(bool edges)
+{
+    Scene s;
+    ObjectSpec slab = bar_object({1.0, 1.0, 0.05}, {0, 0, 0});
+    slab.is_static = true;
+    s.objects.push_back(slab);
+    s.objects.push_back(bar_object({0.05, 0.05, 1.0}, {0.3, -0.2, 0.35}));
+    s.gravity.setZero();
+    s.dt = 1.0 / 100;
+    s.output.every = 0;
+    s.contact.edges = edges;
+    return s;
+}
+
 } // namespace
 
 TEST(SimEdges, CrossedBarsAreUndoneOnlyWithEdgeContacts)
@@ -66,6 +84,32 @@ TEST(SimEdges, CrossedBarsAreUndoneOnlyWithEdgeContacts)
         } else {
             EXPECT_GT(crossings(sim), 0u) << "nothing pushes the crossing";
             EXPECT_EQ(sim.last_stats().edge_contacts, 0);
+        }
+    }
+}
+
+TEST(SimEdges, SlabPiercedStraightThroughIsUndoneOnlyWithEdgeContacts)
+{
+    for (const bool edges : {false, true}) {
+        Simulation sim(pierced_slab(edges));
+        ASSERT_GT(crossings(sim), 0u) << "the bar starts through the slab";
+        int steps = 0;
+        for (; steps < 100 && crossings(sim) > 0; ++steps) {
+            sim.step();
+            // Without the edge contacts nothing moves; with them the bar's lower end passes up through the slab.
+            if (!edges) {
+                EXPECT_EQ(sim.last_stats().contacts, 0) << "no vertex inside anything, step " << steps + 1;
+            }
+        }
+        const auto [b0, bn] = sim.object_vertices(1);
+        if (edges) {
+            EXPECT_EQ(crossings(sim), 0u) << "the bar is out of the slab";
+            EXPECT_LT(steps, 100);
+            EXPECT_GE(sim.positions().middleRows(b0, bn).col(2).minCoeff(), 0.025 - 1e-9)
+                << "out the short way: the bar's lower end above the slab";
+        } else {
+            EXPECT_GT(crossings(sim), 0u) << "nothing pushes the bar";
+            EXPECT_LT(sim.positions().middleRows(b0, bn).col(2).minCoeff(), -0.1);
         }
     }
 }

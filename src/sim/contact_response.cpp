@@ -47,6 +47,10 @@ void closest_points(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& 
     }
 }
 
+/// The edge-face contacts' skin (candidate reuse between substeps), in mean edges of the smallest moving object: on
+/// the hand at 1/240 a quarter edge cost less than half or one edge (docs/simulator.md, "Edges through faces").
+constexpr double edge_skin_edges = 0.25;
+
 /// The threads of the stages that take every core where the scene says 0 (chosen step by step: the detector follows
 /// the step's count, these run on every core).
 int stage_threads(int threads)
@@ -100,8 +104,24 @@ void ContactResponse::setup(const Scene& scene, const TetMesh& mesh, const Model
         if (scene.contact.margin > 0 || scene.contact.speculative)
             m_proximity.setup(mesh, m_rest, model, options, scene.contact.margin, scene.contact.speculative,
                               local_contact_edges);
-        if (scene.contact.edges)
+        if (scene.contact.edges) {
             m_edges.set_topology(mesh.tets, mesh.num_vertices(), mesh.vertex_object, mesh.tet_object, options);
+            // Candidate reuse between substeps (EdgeFaceDetector::set_skin): a skin of edge_skin_edges × the
+            // smallest moving object's mean edge.
+            double edge = 0;
+            for (size_t o = 0; o < model.object_mean_edge.size(); ++o)
+                if (model.object_mean_edge[o] > 0 && (o >= options.size() || !options[o].is_static))
+                    edge = edge > 0 ? std::min(edge, model.object_mean_edge[o]) : model.object_mean_edge[o];
+            m_edges.set_skin(edge_skin_edges * edge);
+            // The locality rule of the crossings (add_edge_contacts) applied in the find, so that neither the tests
+            // nor the kept pairs hold the object's own neighbourhood; a hair narrower than the rule, so that rounding
+            // never drops a pair the rule keeps. The crossings it leaves out are asked for one by one when a pair
+            // needs them (crosses_locally).
+            std::vector<double> reach(model.object_mean_edge.size());
+            for (size_t o = 0; o < reach.size(); ++o)
+                reach[o] = local_contact_edges * model.object_mean_edge[o] * (1 - 1e-9);
+            m_edges.set_local_reach(m_rest, reach);
+        }
         m_proximity.set_threads(stage_threads(scene.detect.threads));
         m_edge_threads = stage_threads(scene.detect.threads);
     }
@@ -138,6 +158,7 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
     m_c.clear();
     m_mred.clear();
     m_edge_pairs.clear();
+    m_released.clear();
     m_ignored_local = 0;
     if (!m_enabled) return;
     auto t0 = Clock::now();
@@ -213,7 +234,7 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
             Index node[5];
             double coef[5];
             stencil(q, node, coef);
-            for (int k = 0; k < 4; ++k) {
+            for (int k = 0; k < 5; ++k) {
                 const size_t j = static_cast<size_t>(node[k]);
                 if (!model.fixed[j]) inv += coef[k] * coef[k] / model.mass[j];
             }
@@ -229,9 +250,9 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
         m_c[q] = m_params.damping > 0 ? m_params.damping : std::sqrt(m_k[q] * m_mred[q]);
     }
     // Weight: a vertex inside k tets of one object (on shared faces) gets 1/k of the response from each.
-    for (size_t a = 0; a < nc;) {
+    for (size_t a = 0; a < edge_begin;) {
         size_t b = a;
-        while (b < nc && active[b].vertex == active[a].vertex)
+        while (b < edge_begin && active[b].vertex == active[a].vertex)
             ++b;
         for (size_t i = a; i < b; ++i) {
             int same = 0;
@@ -240,6 +261,29 @@ void ContactResponse::update(const Positions& x, const Positions& v, double h, S
             m_weight[i] = 1.0 / same;
         }
         a = b;
+    }
+    // The end of an edge pulled out of a part it pierces passes through that part: the part does not push it back.
+    for (size_t q = 0; q < edge_begin && !m_released.empty(); ++q)
+        if (std::binary_search(m_released.begin(), m_released.end(),
+                               std::make_pair(active[q].vertex, active[q].tet_object)))
+            m_weight[q] = 0;
+    // An edge contact: 1 / the most pairs either of its edges is in. Each corner of an intersection curve has two
+    // neighbours, so an edge is in two pairs on a closed curve; at full weight each it was pushed twice as hard as an
+    // edge with one partner, and a vertex's contacts above are weighted so that it is not either.
+    m_edge_count.clear();
+    for (const EdgePair& e : m_edge_pairs) {
+        if (e.through) continue; // in no pair: weight 1
+        m_edge_count.emplace_back(e.a[0], e.a[1]);
+        m_edge_count.emplace_back(e.b[0], e.b[1]);
+    }
+    std::sort(m_edge_count.begin(), m_edge_count.end());
+    const auto pairs_of = [&](const Index* ends) {
+        const auto range = std::equal_range(m_edge_count.begin(), m_edge_count.end(), std::make_pair(ends[0], ends[1]));
+        return static_cast<double>(range.second - range.first);
+    };
+    for (size_t q = edge_begin; q < nc; ++q) {
+        const EdgePair& e = m_edge_pairs[q - edge_begin];
+        m_weight[q] = e.through ? 1.0 : 1.0 / std::max(pairs_of(e.a), pairs_of(e.b));
     }
     stats.ms_response += ms_since(t0);
 }
@@ -267,7 +311,7 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
                                    [](const EdgeFaceContact& c, Index e) { return c.edge < e; });
         for (; it != crossings.end() && it->edge == g; ++it)
             if (it->face_object == object) return true;
-        return false;
+        return m_edges.crosses_locally(g, object, x); // a crossing the find left out as local
     };
     const Positions& rest = m_rest;
     // The pairs (edge, an edge of a face it passes through that passes through the first edge's object), each
@@ -310,6 +354,74 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
         m_edge_pairs.push_back(e);
         m_active.push_back(ct);
     }
+    // An edge in no pair that passes in through one face of a far part and out through another (a thin part pierced
+    // straight through, the intersection curve inside one face of it, so no edge of that part crosses back): pushed
+    // along itself the shorter way, until the crossings are beyond its nearer end; the face it leaves the part
+    // through last on that way pushed back. Crossings of one edge are consecutive (sorted by edge, face).
+    m_paired.clear();
+    m_released.clear();
+    for (const auto& [ea, eb] : m_edge_keys) {
+        m_paired.push_back(ea);
+        m_paired.push_back(eb);
+    }
+    std::sort(m_paired.begin(), m_paired.end());
+    for (size_t i = 0; i < crossings.size();) {
+        size_t j = i;
+        while (j < crossings.size() && crossings[j].edge == crossings[i].edge)
+            ++j;
+        if (j - i >= 2 && !std::binary_search(m_paired.begin(), m_paired.end(), crossings[i].edge)) {
+            for (size_t k = i; k < j; ++k) {
+                const Index object = crossings[k].face_object;
+                bool first = true; // the first crossing of this object: it makes the object's contact
+                for (size_t m = i; m < k; ++m)
+                    first = first && crossings[m].face_object != object;
+                if (!first) continue;
+                const EdgeFaceContact *lo = nullptr, *hi = nullptr; // its far crossings of least and greatest t
+                for (size_t m = k; m < j; ++m) {
+                    const EdgeFaceContact& c = crossings[m];
+                    if (c.face_object != object) continue;
+                    if (c.edge_object == c.face_object &&
+                        near_at_rest(rest, c.edge_vertices, 2, c.face_vertices, 3,
+                                     local_contact_edges * model.object_mean_edge[static_cast<size_t>(object)]))
+                        continue;
+                    if (!lo || c.edge_t < lo->edge_t) lo = &c;
+                    if (!hi || c.edge_t > hi->edge_t) hi = &c;
+                }
+                // In through the first, out through the last (from end 0 to end 1).
+                if (!lo || lo == hi || lo->inner_end != 1 || hi->inner_end != 0) continue;
+                const Vec3 a0 = x.row(lo->edge_vertices[0]).transpose(), a1 = x.row(lo->edge_vertices[1]).transpose();
+                const double length = (a1 - a0).norm();
+                if (!(length > 0)) continue;
+                const Vec3 along = (a1 - a0) / length;
+                // Forwards (towards end 1) the part leaves past end 0 after hi's t × length; backwards past end 1 after
+                // (1 − lo's t) × length.
+                const bool forwards = hi->edge_t <= 1 - lo->edge_t;
+                const EdgeFaceContact& c = forwards ? *hi : *lo;
+                EdgePair e{};
+                e.through = true;
+                e.a[0] = e.b[0] = c.edge_vertices[0];
+                e.a[1] = e.b[1] = c.edge_vertices[1];
+                e.s = c.edge_t;
+                for (int v = 0; v < 3; ++v) {
+                    e.f[v] = c.face_vertices[v];
+                    e.bary[v] = c.face_bary[v];
+                }
+                Contact ct;
+                ct.vertex = forwards ? c.edge_vertices[0] : c.edge_vertices[1];
+                ct.vertex_object = c.edge_object;
+                ct.tet = -1;
+                ct.tet_object = c.face_object;
+                ct.depth = forwards ? c.edge_t * length : (1 - c.edge_t) * length;
+                for (int r = 0; r < 3; ++r)
+                    ct.direction[r] = forwards ? along(r) : -along(r);
+                m_edge_pairs.push_back(e);
+                m_active.push_back(ct);
+                m_released.emplace_back(ct.vertex, ct.tet_object);
+            }
+        }
+        i = j;
+    }
+    std::sort(m_released.begin(), m_released.end());
 }
 
 void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
@@ -318,6 +430,17 @@ void ContactResponse::stencil(size_t q, Index node[5], double coef[5]) const
     const size_t edge_begin = m_active.size() - m_edge_pairs.size();
     if (q >= edge_begin) {
         const EdgePair& e = m_edge_pairs[q - edge_begin];
+        if (e.through) {
+            node[0] = e.a[0];
+            node[1] = e.a[1];
+            coef[0] = 1.0 - e.s;
+            coef[1] = e.s;
+            for (int v = 0; v < 3; ++v) {
+                node[2 + v] = e.f[v];
+                coef[2 + v] = -e.bary[v];
+            }
+            return;
+        }
         node[0] = e.a[0];
         node[1] = e.a[1];
         node[2] = e.b[0];

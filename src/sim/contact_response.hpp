@@ -98,10 +98,15 @@ class ContactResponse {
 
     /// An edge contact (ContactParams::edges): edge a of one object passes through a far boundary face that has
     /// edge b, and b passes through a boundary face of a's object; a is pushed towards b (and b towards a) along the
-    /// segment between their closest points a(s), b(u), by its length.
+    /// segment between their closest points a(s), b(u), by its length. Or (`through`) edge a, in no such pair, passes
+    /// in and out of a thin part of another surface: a is pushed along itself, the face f it crosses at a(s)
+    /// (barycentric `bary`) the other way, until the part is beyond a's nearer end.
     struct EdgePair {
         Index a[2], b[2];
         double s, u;
+        bool through = false;
+        Index f[3] = {0, 0, 0};
+        double bary[3] = {0, 0, 0};
     };
     /// The edge contacts of the edge-face contacts found at x, into m_edge_pairs and (as Contacts, vertex a's
     /// nearer end, tet −1) appended to m_active.
@@ -120,6 +125,11 @@ class ContactResponse {
     int m_edge_threads = 1;
     std::vector<EdgePair> m_edge_pairs; ///< the edge contacts, the last m_edge_pairs.size() of m_active
     std::vector<std::pair<Index, Index>> m_edge_keys;
+    std::vector<std::pair<Index, Index>> m_edge_count; ///< the edges of m_edge_pairs, sorted (their weights)
+    std::vector<Index> m_paired;                       ///< the edges of m_edge_keys, sorted
+    /// (vertex, object): the end of a `through` edge contact that passes through that object on its way out; its
+    /// own contacts with the object are released (weight 0) while it does.
+    std::vector<std::pair<Index, Index>> m_released;
     std::vector<Contact> m_contacts, m_near, m_active;
     std::vector<double> m_weight, m_k, m_c, m_mred;
     std::vector<double> m_object_rate; // automatic penalty per unit effective mass per object (0: static)

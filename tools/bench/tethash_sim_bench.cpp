@@ -56,16 +56,17 @@ struct Row {
     int threads_asked = 1;  ///< the run's --threads (the --bodies table pairs one thread with more)
     double substeps = 1;    ///< mean substeps per step (more than the scene's where steps were refined)
     std::int64_t inverted = 0, far_self = 0;
-    std::int64_t unconverged = 0;  ///< substeps whose sweeps reached their cap
-    std::int64_t retaken = 0;      ///< steps taken again with tighter tolerances for energy they gained
-    std::int64_t crossed = 0;      ///< steps taken again in more substeps for a far part entered unseen
-    std::int64_t far_self_max = 0; ///< most far self-penetrations at any frame (every 1/60 s), not only the end
-    std::int64_t inside = 0;       ///< vertices inside a tet of another object at the end
-    std::int64_t inside_max = 0;   ///< the most at any frame (every 1/60 s)
-    std::int64_t unresolved = 0;   ///< steps whose continuous check left an impact past its retakes
-    double mean_z = 0;             ///< mean height of the vertices at the end (how far the body sagged or sank)
-    double energy_ratio = 0;       ///< total energy at the end / at the start (a passive drop must stay ≤ 1)
-    double volume_ratio = 0;       ///< volume of the dynamic tets at the end / at the start
+    std::int64_t unconverged = 0;       ///< substeps whose sweeps reached their cap
+    std::int64_t retaken = 0;           ///< steps taken again with tighter tolerances for energy they gained
+    std::int64_t crossed = 0;           ///< steps taken again in more substeps for a far part entered unseen
+    std::int64_t far_self_max = 0;      ///< most far self-penetrations at any frame (every 1/60 s), not only the end
+    std::int64_t inside = 0;            ///< vertices inside a tet of another object at the end
+    std::int64_t inside_max = 0;        ///< the most at any frame (every 1/60 s)
+    std::int64_t unresolved = 0;        ///< steps whose continuous check left an impact past its retakes
+    std::int64_t edge_contacts_max = 0; ///< most edge contacts (contact.edges) at any step (CSV only)
+    double mean_z = 0;                  ///< mean height of the vertices at the end (how far the body sagged or sank)
+    double energy_ratio = 0;            ///< total energy at the end / at the start (a passive drop must stay ≤ 1)
+    double volume_ratio = 0;            ///< volume of the dynamic tets at the end / at the start
     bool stable = false;
     std::string failure;
 };
@@ -168,6 +169,7 @@ Row run(const std::string& name, const sim::Scene& scene, int steps, bool cpu_ti
             if (st.tightened > 0) ++r.retaken;
             if (st.crossings > 0) ++r.crossed;
             if (st.continuous_unresolved > 0) ++r.unresolved;
+            r.edge_contacts_max = std::max(r.edge_contacts_max, st.edge_contacts);
         }
     } catch (const RunFailure& e) {
         r.failure = e.what();
@@ -522,17 +524,18 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows)
         out << "scene,integrator,dt,vertices,tets,ms_step,ms_step_mean,ms_detect,ms_depth,ms_proximity,"
                "ms_response,ms_integrate,ms_other,threads,iterations,substeps,contacts,inverted,far_self,"
                "far_self_max,mean_z,energy_ratio,volume_ratio,unconverged,stable,bytes_per_tet,cpu_ms_step,"
-               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure,retaken,crossed,inside,inside_max,unresolved\n";
+               "cpu_ms_step_mean,iterations_mean,setup_cpu_ms,failure,retaken,crossed,inside,inside_max,unresolved,"
+               "edge_contacts_max\n";
         for (const Row& r : rows)
             out << fmt::format("{},{},{:.6g},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.3g},"
                                "{:.3g},{:.3g},{:.4g},{},{},{},{:.5g},{:.4g},{:.4g},{},{},{:.4g},{:.4g},{:.4g},{:.3g},{:"
-                               ".4g},\"{}\",{},{},{},{},{}\n",
+                               ".4g},\"{}\",{},{},{},{},{},{}\n",
                                r.scene, r.integrator, r.dt, r.vertices, r.tets, r.ms, r.ms_mean, r.detect, r.depth,
                                r.proximity, r.response, r.integrate, r.other, r.threads, r.sweeps, r.substeps,
                                r.contacts, r.inverted, r.far_self, r.far_self_max, r.mean_z, r.energy_ratio,
                                r.volume_ratio, r.unconverged, r.stable ? 1 : 0, r.bytes_per_tet, r.cpu_ms,
                                r.cpu_ms_mean, r.sweeps_mean, r.setup_ms, r.failure, r.retaken, r.crossed, r.inside,
-                               r.inside_max, r.unresolved);
+                               r.inside_max, r.unresolved, r.edge_contacts_max);
     }
     std::filesystem::rename(tmp, csv);
 }
