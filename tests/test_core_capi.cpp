@@ -123,6 +123,23 @@ TEST(CoreCapi, SameContactsAsDetectorAndOracle)
     }
 }
 
+namespace {
+
+/// The end of a step of `s`: each object moved along x by 0.3 (odd objects one way, even the other) and each vertex
+/// by a jitter of up to 0.15 per axis.
+Positions step_end(const test::Scene& s)
+{
+    Positions x1 = s.positions;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.15, 0.15);
+    for (Eigen::Index v = 0; v < x1.rows(); ++v)
+        x1.row(v) += Eigen::RowVector3d(0.3 * (s.vertex_object[static_cast<size_t>(v)] % 2 ? 1 : -1), 0, 0) +
+                     Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    return x1;
+}
+
+} // namespace
+
 TEST(CoreCapi, ContinuousContactsAsTheBruteForceOverAStep)
 {
     // A step of a random scene (each object moved by its own translation and a jitter) through the C API at 1 and 2
@@ -130,12 +147,7 @@ TEST(CoreCapi, ContinuousContactsAsTheBruteForceOverAStep)
     // edges' ends), kinds and times of impact; too small a capacity, a missing `end` and a wrong vertex count are
     // refused with a status and the function's name; set_topology forgets the contacts.
     const test::Scene s = test::random_scene(13, 4, 3, 0.3);
-    Positions x1 = s.positions;
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> u(-0.15, 0.15);
-    for (Eigen::Index v = 0; v < x1.rows(); ++v)
-        x1.row(v) += Eigen::RowVector3d(0.3 * (s.vertex_object[static_cast<size_t>(v)] % 2 ? 1 : -1), 0, 0) +
-                     Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    const Positions x1 = step_end(s);
     const ccd::ContinuousResult want = ccd::detect_continuous_brute_force(s.tets, s.positions, x1);
     ASSERT_GT(want.contacts.size(), 0u);
     for (int threads : {1, 2}) {
@@ -189,12 +201,7 @@ TEST(CoreCapi, ContinuousLocalityAsCpp)
     // than without it, and the rule outlives object options (set_object_options re-applies the topology) but not
     // set_topology; num_groups 0 removes it.
     const test::Scene s = test::random_scene(13, 4, 3, 0.3);
-    Positions x1 = s.positions;
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<double> u(-0.15, 0.15);
-    for (Eigen::Index v = 0; v < x1.rows(); ++v)
-        x1.row(v) += Eigen::RowVector3d(0.3 * (s.vertex_object[static_cast<size_t>(v)] % 2 ? 1 : -1), 0, 0) +
-                     Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    const Positions x1 = step_end(s);
     const std::vector<double> reach_sq{0.09, 0.0, 0.09, 0.09};
     ccd::ContinuousDetector cpp;
     cpp.set_topology(s.tets, static_cast<Index>(s.positions.rows()));
