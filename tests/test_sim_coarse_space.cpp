@@ -8,6 +8,7 @@
 #include "tethash/sim/model.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -205,13 +206,14 @@ TEST(SimCoarseSpace, RefreshAndCorrectionAreBitIdenticalAtOneAndTwoThreads)
     const size_t un = static_cast<size_t>(model.num_vertices());
     ASSERT_GT(un, 4096u);
     const double h = 12.0 / std::sqrt(model.object_frequency_sq[0]); // ω h 12: about 200 nodes
-    // A turned and bent state, ground-like blocks on the lowest vertices, a residual of every sign.
+    // A turned and bent state (bent enough for the cells near the ends to be turned apart from the object, in
+    // parallel), ground-like blocks on the lowest vertices, a residual of every sign.
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
     std::vector<double> x4(4 * un, 0.0), extra(6 * un, 0.0), r(3 * un);
     std::vector<std::int32_t> with_extra;
     for (size_t i = 0; i < un; ++i) {
         const Eigen::Vector3d p = mesh.positions.row(static_cast<Index>(i)).transpose();
-        const Eigen::Vector3d q = turn * p + Eigen::Vector3d(0, 0, 0.05 * p.x() * p.x());
+        const Eigen::Vector3d q = turn * p + Eigen::Vector3d(0, 0, 0.8 * p.x() * p.x());
         for (size_t c = 0; c < 3; ++c) {
             x4[4 * i + c] = q[static_cast<Index>(c)];
             r[3 * i + c] = std::sin(0.37 * static_cast<double>(3 * i + c));
@@ -231,6 +233,7 @@ TEST(SimCoarseSpace, RefreshAndCorrectionAreBitIdenticalAtOneAndTwoThreads)
         ASSERT_GT(coarse.nodes(), 100);
         ASSERT_GT(coarse.matrix().nonZeros(), 9 * 2048);
         ASSERT_TRUE(coarse.prepare(h, x4.data(), extra, with_extra));
+        EXPECT_GT(coarse.cells_turned_apart(), 16u);
         coarse.correct(r, dx[threads - 1]);
         values[threads - 1].assign(coarse.matrix().valuePtr(), coarse.matrix().valuePtr() + coarse.matrix().nonZeros());
     }
@@ -241,4 +244,69 @@ TEST(SimCoarseSpace, RefreshAndCorrectionAreBitIdenticalAtOneAndTwoThreads)
     for (const double d : dx[0])
         norm += d * d;
     EXPECT_GT(norm, 0.0);
+}
+
+TEST(SimCoarseSpace, PartTurnedAgainstTheBodyKeepsItsStiffnessAlongItsSprings)
+{
+    // A bar whose far half turned by 1.2 rad about z against its near half (a leg turned against the body): the
+    // lattice's matrix at that state is to be close to the Galerkin product of the fine matrix there, Pᵀ A(x) P. With
+    // the object's one rotation (the polar factor of the whole, about half the turn) both halves' stiffness points
+    // 0.6 rad off their springs; each lattice cell turned by its own vertices' rotation puts it back along them
+    // (except in the cells at the joint, which the turn shears).
+    meshing::GenerateParams g;
+    g.shape = "box";
+    g.resolution = 10;
+    g.size = Eigen::Vector3d(2.0, 0.4, 0.4);
+    const TetMesh mesh = meshing::generate(g);
+    Material m;
+    m.young = 1e5;
+    m.density = 1000;
+    const Model model = Model::build(mesh, {m}, {0});
+    const double h = 40.0 / std::sqrt(model.object_frequency_sq[0]); // ω h 40: cells of about two mean edges
+    detail::CoarseSpace coarse;
+    coarse.build(model, mesh.positions, {0.0}, h);
+    ASSERT_GT(coarse.nodes(), 60);
+    const size_t un = static_cast<size_t>(model.num_vertices());
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    Positions x = mesh.positions;
+    std::vector<double> x4(4 * un, 0.0);
+    for (size_t i = 0; i < un; ++i) {
+        const Eigen::Vector3d p = mesh.positions.row(static_cast<Index>(i)).transpose();
+        const Eigen::Vector3d q = p.x() > 0 ? Eigen::Vector3d(turn * p) : p;
+        x.row(static_cast<Index>(i)) = q.transpose();
+        for (size_t c = 0; c < 3; ++c)
+            x4[4 * i + c] = q[static_cast<Index>(c)];
+    }
+    ASSERT_TRUE(coarse.prepare(h, x4.data(), {}, {}));
+    const Eigen::SparseMatrix<double> p = coarse.prolongation();
+    const std::vector<char> in_lattice(un, 1);
+    const Eigen::MatrixXd exact =
+        Eigen::MatrixXd(Eigen::SparseMatrix<double>(p.transpose() * (fine_matrix(model, x, {0.0}, in_lattice, h) * p)));
+    // The start matrix turned by the object's one rotation (what the lattice had before its cells' own rotations).
+    Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d c = Eigen::Vector3d::Zero(), c0 = Eigen::Vector3d::Zero();
+    double mass = 0;
+    for (size_t i = 0; i < un; ++i) {
+        mass += model.mass[i];
+        c += model.mass[i] * x.row(static_cast<Index>(i)).transpose();
+        c0 += model.mass[i] * mesh.positions.row(static_cast<Index>(i)).transpose();
+    }
+    c /= mass;
+    c0 /= mass;
+    for (size_t i = 0; i < un; ++i)
+        s += model.mass[i] * (x.row(static_cast<Index>(i)).transpose() - c) *
+             (mesh.positions.row(static_cast<Index>(i)).transpose() - c0).transpose();
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(s, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::Matrix3d whole = svd.matrixU() * svd.matrixV().transpose();
+    ASSERT_GT(Eigen::AngleAxisd(whole).angle(), 0.4);
+    const Eigen::MatrixXd start = coarse.start_matrix(h);
+    Eigen::MatrixXd one_rotation = start;
+    for (Index a = 0; a < coarse.nodes(); ++a)
+        for (Index b = 0; b < coarse.nodes(); ++b)
+            one_rotation.block<3, 3>(3 * a, 3 * b) = whole * start.block<3, 3>(3 * a, 3 * b) * whole.transpose();
+    const Eigen::MatrixXd got = Eigen::MatrixXd(coarse.matrix());
+    const double off_by_cells = (got - exact).norm(), off_by_object = (one_rotation - exact).norm();
+    EXPECT_GT(coarse.cells_turned_apart(), 0u);
+    EXPECT_LT(off_by_cells, 0.5 * off_by_object) << "cells " << off_by_cells << ", object " << off_by_object;
+    EXPECT_LT((got - got.transpose()).cwiseAbs().maxCoeff(), 1e-9 * got.cwiseAbs().maxCoeff());
 }

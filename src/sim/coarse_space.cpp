@@ -13,7 +13,6 @@
 #include <unordered_map>
 
 namespace tethash::sim::detail {
-
 namespace {
 
 /// The most lattice nodes one object gets (each carries three unknowns of the factorised system): nodes_per_omega_h
@@ -29,6 +28,17 @@ namespace {
 constexpr size_t max_nodes_per_object = 400;
 constexpr size_t min_nodes_cap = 200;
 constexpr double nodes_per_omega_h = 8.0;
+
+/// A cell's rotation (prepare) is the polar factor of its vertices' moment Σ m (x − c)(x0 − c0)ᵀ plus this fraction of
+/// their Σ m |x0 − c0|² times the object's rotation: the object's rotation fills the directions a cell's vertices leave
+/// open (along a line, in a plane, few of them), as lattice nodes turned by their own vertices' rotation did not: those
+/// whose vertices lay nearly along a line got rotations 0.1-0.9 rad off a stiff body that does not bend, which then
+/// swept ten times as much. The raptor at 15 cm and 1/60 swept 1,012 times in its 30 steps with 0, 763 with 0.1, 965
+/// with 0.3 (1,356 with the object's rotation alone; docs/simulator.md, "Where a 15 cm step's extra work goes").
+constexpr double cell_rotation_hold = 0.1;
+/// A cell turned by less than this (rad) against its object takes the object's rotation: only the parts that turned
+/// against the body (a leg, a tail) are turned apart, which costs a pass over their entries at a factorisation.
+constexpr double cell_own_rotation = 0.2;
 
 /// The weight-to-bending number ρ g L³ / (E t²) above which a thin sheet's weight folds it (no lattice, below).
 constexpr double sheet_folds = 10.0;
@@ -58,6 +68,9 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
     const size_t un = static_cast<size_t>(n);
     m_node.assign(8 * un, -1);
     m_weight.assign(8 * un, 0.0);
+    m_vertex_cell.assign(un, -1);
+    m_cell_object.clear();
+    m_cells = 0;
     m_object.clear();
     m_objects.clear();
     m_nodes = 0;
@@ -125,7 +138,12 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
             cell *= 1.25;
         }
         id.assign(id.size(), -1);
+        std::vector<std::int32_t> cell_ids(id.size(), -1);
         Object obj;
+        // Cells turned apart only where a substep couples further than a cell: below (P1's struts collapsing at 1 m
+        // and 1/60, ω h 2.5 against cells of 3.2 mean edges) the sweeps carry a cell's waves, and the cells' own
+        // rotations made the collapse enter its own struts within a step (refined steps).
+        obj.cells_turn = omega_h > cell / model.object_mean_edge[o];
         for (const std::int32_t i : vs) {
             int c[3];
             double t[3];
@@ -133,6 +151,14 @@ void CoarseSpace::build(const Model& model, const Positions& x, const std::vecto
                 const double q = (x(i, r) - lo[r]) / cell;
                 c[r] = std::clamp(static_cast<int>(std::floor(q)), 0, dims[r] - 2);
                 t[r] = std::clamp(q - c[r], 0.0, 1.0);
+            }
+            {
+                const size_t key = static_cast<size_t>((c[2] * dims[1] + c[1]) * dims[0] + c[0]);
+                if (cell_ids[key] < 0) {
+                    cell_ids[key] = m_cells++;
+                    m_cell_object.push_back(static_cast<std::int32_t>(m_objects.size()));
+                }
+                m_vertex_cell[static_cast<size_t>(i)] = cell_ids[key];
             }
             for (int k = 0; k < 8; ++k) {
                 const int a = k & 1, b = (k >> 1) & 1, d = (k >> 2) & 1;
@@ -238,6 +264,40 @@ void CoarseSpace::build_pattern()
         const Index v = static_cast<Index>(i);
         couple(&v, 1);
     }
+    // Per cell the elements whose first vertex in a lattice lies in it (their stiffness is turned by its rotation),
+    // and its free vertices (which give the rotation).
+    auto element_cell = [&](const Index* vs, int count) {
+        for (int a = 0; a < count; ++a)
+            if (m_vertex_cell[static_cast<size_t>(vs[a])] >= 0) return m_vertex_cell[static_cast<size_t>(vs[a])];
+        return std::int32_t{-1};
+    };
+    auto bucket = [&](std::vector<std::int32_t>& start, std::vector<std::int32_t>& items, Index count, auto cell_of) {
+        start.assign(static_cast<size_t>(m_cells) + 1, 0);
+        for (Index e = 0; e < count; ++e) {
+            const std::int32_t c = cell_of(e);
+            if (c >= 0) ++start[static_cast<size_t>(c) + 1];
+        }
+        for (size_t c = 0; c < static_cast<size_t>(m_cells); ++c)
+            start[c + 1] += start[c];
+        items.resize(static_cast<size_t>(start.back()));
+        std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+        for (Index e = 0; e < count; ++e) {
+            const std::int32_t c = cell_of(e);
+            if (c >= 0) items[static_cast<size_t>(fill[static_cast<size_t>(c)]++)] = static_cast<std::int32_t>(e);
+        }
+    };
+    bucket(m_cell_spring_start, m_cell_spring, model.springs.edges.rows(), [&](Index e) {
+        const Index vs[2] = {model.springs.edges(e, 0), model.springs.edges(e, 1)};
+        return element_cell(vs, 2);
+    });
+    bucket(m_cell_tet_start, m_cell_tet, model.volumes.tets.rows(), [&](Index t) {
+        const Index vs[4] = {model.volumes.tets(t, 0), model.volumes.tets(t, 1), model.volumes.tets(t, 2),
+                             model.volumes.tets(t, 3)};
+        return element_cell(vs, 4);
+    });
+    bucket(m_cell_vertex_start, m_cell_vertex, static_cast<Index>(un), [&](Index i) {
+        return model.fixed[static_cast<size_t>(i)] ? std::int32_t{-1} : m_vertex_cell[static_cast<size_t>(i)];
+    });
     m_vertex_blocks.assign(64 * un, -1);
     for (size_t i = 0; i < un; ++i)
         if (m_node[8 * i] >= 0)
@@ -308,13 +368,26 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
     // gᵀ, B = s I), so its coarse part is (P D)ᵀ B (P D) with P D gathered on the element's few distinct nodes
     // (its vertices share most of their cell corners). Pinned vertices drop out of D (their rows and columns of the
     // fine matrix are empty) and get a stiff hold on their mass; the ground is added per substep.
-    Cached out{h, std::vector<double>(9 * m_blocks.size(), 0.0)};
+    Cached out{h, std::vector<double>(9 * m_blocks.size(), 0.0), {}, {}, {}};
     double* values = out.values.data();
+    // The elements' part also cell by cell (the cell of each element's first vertex), each cell's blocks apart, to
+    // be turned by the cell's own rotation (prepare).
+    std::vector<std::int32_t> cell_slot(m_blocks.size(), -1);
     auto add_block = [&](std::int32_t bi, std::int32_t bj, const Eigen::Matrix3d& b) {
-        double* v = values + 9 * static_cast<size_t>(block_at(bi, bj));
+        const std::int32_t block = block_at(bi, bj);
+        double* v = values + 9 * static_cast<size_t>(block);
+        std::int32_t& at = cell_slot[static_cast<size_t>(block)];
+        if (at < 0) {
+            at = static_cast<std::int32_t>(out.cell_block.size());
+            out.cell_block.push_back(block);
+            out.cell_values.resize(out.cell_values.size() + 9, 0.0);
+        }
+        double* w = out.cell_values.data() + 9 * static_cast<size_t>(at);
         for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c)
+            for (int c = 0; c < 3; ++c) {
                 v[3 * r + c] += b(r, c);
+                w[3 * r + c] += b(r, c);
+            }
     };
     // An element's distinct nodes and per node its row of P D (a weight per vertex times the vertex's D).
     std::vector<std::int32_t> nodes;
@@ -331,11 +404,11 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
     auto in_play = [&](Index v) {
         return m_node[8 * static_cast<size_t>(v)] >= 0 && !model.fixed[static_cast<size_t>(v)];
     };
-    for (Index e = 0; e < model.springs.edges.rows(); ++e) {
+    auto spring_part = [&](Index e) {
         const Index i = model.springs.edges(e, 0), j = model.springs.edges(e, 1);
         const Eigen::Vector3d d = (m_start.row(i) - m_start.row(j)).transpose();
         const double len = d.norm();
-        if (!(len > 0)) continue;
+        if (!(len > 0)) return;
         const Eigen::Vector3d u = d / len;
         const Eigen::Matrix3d uu = u * u.transpose();
         const size_t ue = static_cast<size_t>(e);
@@ -355,11 +428,11 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
         for (size_t p = 0; p < nodes.size(); ++p)
             for (size_t q = 0; q < nodes.size(); ++q)
                 add_block(nodes[p], nodes[q], (weights[p] * weights[q]) * b);
-    }
+    };
     // The volume terms: k / 6V0 (g gᵀ) with the relative damping the sweeps give them (k (1 + damping / h); the
     // model's matrix damps the springs only).
     const Tets& tets = model.volumes.tets;
-    for (Index t = 0; t < tets.rows(); ++t) {
+    auto tet_part = [&](Index t) {
         const size_t o = static_cast<size_t>(model.vertex_object[static_cast<size_t>(tets(t, 0))]);
         const double dh = (o < m_damping.size() ? m_damping[o] : 0.0) / h;
         const Eigen::Vector3d a = m_start.row(tets(t, 0)).transpose(), b = m_start.row(tets(t, 1)).transpose(),
@@ -388,6 +461,16 @@ const CoarseSpace::Cached& CoarseSpace::cached(double h)
             for (size_t q = 0; q < nodes.size(); ++q)
                 add_block(nodes[p], nodes[q], sp * rows[q].transpose());
         }
+    };
+    out.cell_start.assign(1, 0);
+    for (size_t c = 0; c < static_cast<size_t>(m_cells); ++c) {
+        for (std::int32_t at = m_cell_spring_start[c]; at < m_cell_spring_start[c + 1]; ++at)
+            spring_part(m_cell_spring[static_cast<size_t>(at)]);
+        for (std::int32_t at = m_cell_tet_start[c]; at < m_cell_tet_start[c + 1]; ++at)
+            tet_part(m_cell_tet[static_cast<size_t>(at)]);
+        for (size_t at = static_cast<size_t>(out.cell_start.back()); at < out.cell_block.size(); ++at)
+            cell_slot[static_cast<size_t>(out.cell_block[at])] = -1;
+        out.cell_start.push_back(static_cast<std::int32_t>(out.cell_block.size()));
     }
     // The masses / h² (pinned vertices of the dynamic objects held by 10⁴ times theirs).
     double mass_sum = 0;
@@ -475,9 +558,50 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
     m_factored_h = h;
     m_factored_extra = with_extra;
     m_factored_rotation = m_rotation;
+    // Each cell's rotation since the start: the polar factor of its free vertices' Σ m (x − c)(x0 − c0)ᵀ plus
+    // cell_rotation_hold times their Σ m |x0 − c0|² times the object's rotation (a cell whose vertices lie along a
+    // line or in a plane, or hold little mass, takes the object's rotation about what they leave open), the object's
+    // where that is no rotation (an inverted cell) or within cell_own_rotation of it.
+    m_cell_rotation.resize(static_cast<size_t>(m_cells));
+    m_turned_cells.clear();
+    for (size_t cell = 0; cell < static_cast<size_t>(m_cells); ++cell) {
+        const Eigen::Matrix3d& ro = m_rotation[static_cast<size_t>(m_cell_object[cell])];
+        if (!m_objects[static_cast<size_t>(m_cell_object[cell])].cells_turn) {
+            m_cell_rotation[cell] = ro;
+            continue;
+        }
+        double mass = 0;
+        Eigen::Vector3d c = Eigen::Vector3d::Zero(), c0 = Eigen::Vector3d::Zero();
+        for (std::int32_t at = m_cell_vertex_start[cell]; at < m_cell_vertex_start[cell + 1]; ++at) {
+            const size_t v = static_cast<size_t>(m_cell_vertex[static_cast<size_t>(at)]);
+            mass += model.mass[v];
+            c += model.mass[v] * Eigen::Vector3d(x4[4 * v], x4[4 * v + 1], x4[4 * v + 2]);
+            c0 += model.mass[v] * m_start.row(static_cast<Index>(v)).transpose();
+        }
+        if (!(mass > 0)) {
+            m_cell_rotation[cell] = ro;
+            continue;
+        }
+        c /= mass;
+        c0 /= mass;
+        Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+        double spread = 0;
+        for (std::int32_t at = m_cell_vertex_start[cell]; at < m_cell_vertex_start[cell + 1]; ++at) {
+            const size_t v = static_cast<size_t>(m_cell_vertex[static_cast<size_t>(at)]);
+            const Eigen::Vector3d q0 = m_start.row(static_cast<Index>(v)).transpose() - c0;
+            s += model.mass[v] * (Eigen::Vector3d(x4[4 * v], x4[4 * v + 1], x4[4 * v + 2]) - c) * q0.transpose();
+            spread += model.mass[v] * q0.squaredNorm();
+        }
+        s += cell_rotation_hold * spread * ro;
+        m_cell_rotation[cell] = s.determinant() > 0 ? closest_rotation(s) : ro;
+        if (std::abs(Eigen::AngleAxisd(m_cell_rotation[cell] * ro.transpose()).angle()) < cell_own_rotation)
+            m_cell_rotation[cell] = ro;
+        else
+            m_turned_cells.push_back(static_cast<std::int32_t>(cell));
+    }
+    double* values = m_matrix.valuePtr();
     // Each thread owns the blocks of a range of the matrix's block rows: it turns them, then adds the ground's and
     // contacts' terms that fall in them, vertex by vertex (every entry sums in vertex order at any thread count).
-    double* values = m_matrix.valuePtr();
     const bool parallel = m_threads > 1 && m_blocks.size() > 2048;
 #ifdef TETHASH_HAVE_OPENMP
 #pragma omp parallel num_threads(m_threads) if (parallel)
@@ -516,6 +640,34 @@ bool CoarseSpace::prepare(double h, const double* x4, const std::vector<double>&
                 }
             }
         }
+    }
+    if (!m_turned_cells.empty()) {
+        // The cells turned apart from their object: their part turned by their own rotation instead of the object's
+        // (the differences in parallel, each entry apart; summed in entry order, the same at any thread count).
+        m_turned.resize(base.cell_values.size());
+        const std::int32_t count = static_cast<std::int32_t>(m_turned_cells.size());
+#ifdef TETHASH_HAVE_OPENMP
+#pragma omp parallel for num_threads(m_threads) schedule(static) if (m_threads > 1 && count > 16)
+#endif
+        for (std::int32_t k = 0; k < count; ++k) {
+            const size_t cell = static_cast<size_t>(m_turned_cells[static_cast<size_t>(k)]);
+            const Eigen::Matrix3d& rc = m_cell_rotation[cell];
+            const Eigen::Matrix3d& ro = m_rotation[static_cast<size_t>(m_cell_object[cell])];
+            for (std::int32_t at = base.cell_start[cell]; at < base.cell_start[cell + 1]; ++at) {
+                const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> b0(base.cell_values.data() +
+                                                                                        9 * static_cast<size_t>(at));
+                Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m_turned.data() +
+                                                                         9 * static_cast<size_t>(at)) =
+                    rc * b0 * rc.transpose() - ro * b0 * ro.transpose();
+            }
+        }
+        for (const std::int32_t cell : m_turned_cells)
+            for (std::int32_t at = base.cell_start[static_cast<size_t>(cell)];
+                 at < base.cell_start[static_cast<size_t>(cell) + 1]; ++at) {
+                const size_t b = static_cast<size_t>(base.cell_block[static_cast<size_t>(at)]);
+                for (size_t q = 0; q < 9; ++q)
+                    values[m_block_value[9 * b + q]] += m_turned[9 * static_cast<size_t>(at) + q];
+            }
     }
     if (!m_analysed) {
         m_factor.analyse(m_nodes, m_blocks);

@@ -16,10 +16,13 @@
 // each correction (block_descent.cpp) makes a slightly stale matrix cost a little convergence, not correctness.
 //
 // The matrix: the springs' and volume terms' stiffness and damping and the masses at the start positions, Pᵀ (K +
-// C / h + M / h²) P, kept per substep length h; per substep each object's block is turned by the object's rotation
-// since the start (polar decomposition of its positions against the start), and the ground's and contacts' own
-// terms at the current iterate are added, vertex by vertex (their diagonal blocks). Pinned vertices hold their
-// lattice nodes by a stiff term. The lattice's cells are a sixth of the object's longest extent while ω h ≤ 4, finer
+// C / h + M / h²) P, kept per substep length h, the elements' part apart per lattice cell (the cell of each element's
+// first vertex); at a factorisation each object's block is turned by the object's rotation since the start (polar
+// decomposition of its positions against the start), the part of each cell that turned by more than 0.2 rad against
+// its object (a leg, a tail) by the cell's own rotation instead, where ω h exceeds the cell in mean edges (with the
+// object's rotation such a part had its stiffness across its springs), and the ground's and contacts' own terms at
+// the current iterate are added, vertex by vertex (their diagonal blocks). Pinned vertices hold their lattice nodes by
+// a stiff term. The lattice's cells are a sixth of the object's longest extent while ω h ≤ 4, finer
 // as ω h grows (the waves a substep couples reach further), and at least two
 // mean edges; an object gets at most a quarter as many nodes as it has vertices (125 for any) and at most 8 ω h
 // between 200 and 400: the factorisation costs a few sweeps, and is worth more where ω h makes a substep need many.
@@ -69,6 +72,9 @@ class CoarseSpace {
     Eigen::MatrixXd start_matrix(double h);
     /// P (3n × 3 nodes): the trilinear weights of each vertex in a lattice on its 8 nodes (for tests).
     Eigen::SparseMatrix<double> prolongation() const;
+    /// The lattice cells the last prepare() that factorised turned by their own rotation, apart from their object's
+    /// (for tests).
+    size_t cells_turned_apart() const { return m_turned_cells.size(); }
     /// The matrix of the last prepare() that factorised (for tests).
     const Eigen::SparseMatrix<double>& matrix() const { return m_matrix; }
 
@@ -80,6 +86,8 @@ class CoarseSpace {
     struct Cached {
         double h;
         std::vector<double> values; ///< block values (9 per block, row-major 3 × 3) of Pᵀ (K + C/h + M/h²) P
+        std::vector<std::int32_t> cell_start, cell_block; ///< per cell its entries (CSR): the block of each
+        std::vector<double> cell_values;                  ///< 9 per entry: the cell's elements' part of its block
     };
     const Model* m_model = nullptr;
     Positions m_start;
@@ -93,6 +101,9 @@ class CoarseSpace {
         std::vector<std::int32_t> vertices;                ///< its vertices in a lattice
         Eigen::Vector3d centre0 = Eigen::Vector3d::Zero(); ///< mass centre at the start
         double mass = 0;
+        /// Its cells turned by their own rotations where they turned against it: where a substep couples further
+        /// than a cell (ω h above the cell in mean edges).
+        bool cells_turn = false;
     };
     std::vector<Object> m_objects;
     // Block pattern (once per lattice): blocks (I, J) of the coarse matrix, the scalar positions of each in the CSR
@@ -114,7 +125,15 @@ class CoarseSpace {
     std::vector<Cached> m_cache;
     std::vector<Eigen::Matrix3d> m_rotation;          ///< per object, this substep
     std::vector<Eigen::Matrix3d> m_factored_rotation; ///< per object, at the last factorisation
-    std::vector<std::int32_t> m_factored_extra;       ///< the vertices with ground or contact terms then
+    // Lattice cells (those holding a vertex): per vertex its cell, per cell its object, elements and free vertices.
+    std::int32_t m_cells = 0;
+    std::vector<std::int32_t> m_vertex_cell, m_cell_object;
+    std::vector<std::int32_t> m_cell_spring_start, m_cell_spring, m_cell_tet_start, m_cell_tet;
+    std::vector<std::int32_t> m_cell_vertex_start, m_cell_vertex;
+    std::vector<Eigen::Matrix3d> m_cell_rotation; ///< per cell, this substep
+    std::vector<double> m_turned; ///< 9 per cell entry: its block turned by its cell's rotation less by its object's
+    std::vector<std::int32_t> m_turned_cells;   ///< the cells turned apart from their object, this substep
+    std::vector<std::int32_t> m_factored_extra; ///< the vertices with ground or contact terms then
     double m_factored_h = 0;
     int m_factored_age = 0; ///< substeps since the last factorisation
     Eigen::VectorXd m_rc, m_dc;
