@@ -1,12 +1,18 @@
 // Stages 2 and 3 of the hash detector for one tet and one thread's candidates: the tet's box → bucket ranges →
 // candidate vertices (SIMD scan), then the closed inside test by lazily built face planes with a filtered exact
 // fallback; and each thread's radix sort of its contacts.
+#include "../simd.hpp"
 #include "detector_impl.hpp"
 #include "scan.hpp"
 #include "tethash/predicates.hpp"
 
 #include <algorithm>
 #include <cstring>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define TETHASH_X86 1
+#endif
 
 namespace tethash {
 
@@ -146,6 +152,11 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         ts.counters.box_rejections += sc.box_rejections;
         ts.counters.own += sc.own;
     }
+    finish_run(ts, t, run_begin);
+}
+
+__attribute__((always_inline)) inline void DetectorImpl::finish_run(ThreadState& ts, Index t, std::int32_t run_begin)
+{
     std::int32_t run_end = static_cast<std::int32_t>(ts.used);
     // Self-collision off for this tet's object: drop the candidates of the same object here, so that the kept
     // candidates of a skin are already filtered.
@@ -163,6 +174,113 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
     ts.runs[ts.num_runs] = {t, run_begin, run_end};
     ts.num_runs += run_end > run_begin;
 }
+
+namespace {
+#ifdef TETHASH_X86
+const bool avx2_box = detail::avx2_kernels();
+#else
+const bool avx2_box = false;
+#endif
+} // namespace
+
+bool DetectorImpl::lean_stage_tets(bool with_stats) const
+{
+    if (!avx2_box || with_stats || params.hash != HashFunction::column) return false;
+    for (const VertexTable& table : tables)
+        if (table.size() > 0 && !table.modulus().pow2) return false;
+    return true;
+}
+
+#ifdef TETHASH_X86
+// Stage 2 for one tet in the common case (column hash, power-of-two tables, no statistics; run only where
+// lean_stage_tets() says so): the box, its cells and its float copy in the lanes (x, y, z, -) of AVX2 registers, one
+// contiguous range per column, the scan kernel called directly, the candidate buffer sized once per table (a tet
+// takes each table entry at most once: an entry's key matches one column of the tet's cell box). The same values as
+// stage_tets: the same operations per lane (min, max, the clamp, p · (1/l), floor, p − origin rounded to float; a
+// ±0 difference in a min or max changes no cell and no float comparison), so the same candidate runs. Tets outside
+// the common case (cell boxes too big for the keys or the range array, a z-run as long as a table) go to stage_tets.
+__attribute__((target("avx2"))) void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P)
+{
+    const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
+    const __m256i xyz = _mm256_setr_epi64x(-1, -1, -1, 0); // 3 doubles: never reads past the vertex
+    const __m256d a = _mm256_maskload_pd(P + 3 * static_cast<std::size_t>(tv[0]), xyz);
+    const __m256d b = _mm256_maskload_pd(P + 3 * static_cast<std::size_t>(tv[1]), xyz);
+    const __m256d c = _mm256_maskload_pd(P + 3 * static_cast<std::size_t>(tv[2]), xyz);
+    const __m256d d = _mm256_maskload_pd(P + 3 * static_cast<std::size_t>(tv[3]), xyz);
+    const __m256d limit = _mm256_set1_pd(max_cell_coordinate * cell_size), sk = _mm256_set1_pd(skin);
+    const __m256d lo = _mm256_max_pd(_mm256_sub_pd(_mm256_min_pd(_mm256_min_pd(a, b), _mm256_min_pd(c, d)), sk),
+                                     _mm256_sub_pd(_mm256_setzero_pd(), limit));
+    const __m256d hi = _mm256_min_pd(_mm256_add_pd(_mm256_max_pd(_mm256_max_pd(a, b), _mm256_max_pd(c, d)), sk), limit);
+    const __m256d inv = _mm256_set1_pd(inv_cell);
+    const __m128i c0 = _mm256_cvttpd_epi32(_mm256_floor_pd(_mm256_mul_pd(lo, inv)));
+    const __m128i c1 = _mm256_cvttpd_epi32(_mm256_floor_pd(_mm256_mul_pd(hi, inv)));
+    const __m256d org = _mm256_setr_pd(origin[0], origin[1], origin[2], 0.0);
+    detail::ScanQuery q;
+    _mm_storeu_ps(q.lo, _mm256_cvtpd_ps(_mm256_sub_pd(lo, org)));
+    _mm_storeu_ps(q.hi, _mm256_cvtpd_ps(_mm256_sub_pd(hi, org)));
+    std::memcpy(q.own, tv, sizeof q.own);
+    alignas(16) std::int32_t c0s[4], ns[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(c0s), c0);
+    _mm_store_si128(reinterpret_cast<__m128i*>(ns), _mm_add_epi32(_mm_sub_epi32(c1, c0), _mm_set1_epi32(1)));
+    const std::int32_t nx = ns[0], ny = ns[1], nz = ns[2];
+    constexpr int max_ranges = 64;
+    // Outside the common case: the general path (which also reports a cell box too big for the grid).
+    if (nx > key_exact_xy || ny > key_exact_xy || nz > key_exact_z || 2 * nx * ny > max_ranges) {
+        stage_tets(ts, t, P, false);
+        return;
+    }
+    const std::int32_t run_begin = static_cast<std::int32_t>(ts.used);
+    const int num_tables =
+        any_static && !flags.is_static[static_cast<std::size_t>(tet_object[static_cast<std::size_t>(t)])] ? 2 : 1;
+    const std::int32_t x0 = c0s[0], y0 = c0s[1], y1 = y0 + ny - 1;
+    q.z0 = c0s[2];
+    q.z1 = c0s[2] + nz - 1;
+    const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(c0s[2]));
+    const detail::ScanKernel scan = detail::column_scan_kernel();
+    detail::ScanCounters unused;
+    for (int ti = 0; ti < num_tables; ++ti) {
+        const VertexTable& table = tables[ti];
+        if (table.size() == 0) continue;
+        const TableModulus& mod = table.modulus();
+        if (static_cast<std::uint64_t>(nz) >= mod.n) { // a z-run that covers the table: the general path
+            ts.used = static_cast<std::size_t>(run_begin);
+            stage_tets(ts, t, P, false);
+            return;
+        }
+        const std::int32_t* start = table.start.data();
+        const std::uint64_t mask = mod.mask, n = mod.n;
+        detail::ScanRange ranges[max_ranges];
+        int nr = 0;
+        std::int32_t x = x0, y = y0;
+        for (std::int32_t j = nx * ny; j > 0; --j) {
+            const std::uint64_t b0 = (column_mix(x, y) + zoff) & mask;
+            const std::uint64_t e = b0 + static_cast<std::uint64_t>(nz);
+            if (e <= n) [[likely]] {
+                ranges[nr] = {start[b0], start[e], x, y};
+                nr += ranges[nr].begin < ranges[nr].end;
+            } else {
+                ranges[nr] = {start[b0], start[n], x, y};
+                nr += ranges[nr].begin < ranges[nr].end;
+                ranges[nr] = {start[0], start[e - n], x, y};
+                nr += ranges[nr].begin < ranges[nr].end;
+            }
+            const bool wrap = y == y1;
+            x += wrap;
+            y = wrap ? y0 : y + 1;
+        }
+        if (nr == 0) continue;
+        const std::size_t need = ts.used + static_cast<std::size_t>(table.size()) + 8; // 8: the kernel's slack
+        if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
+        ts.used += static_cast<std::size_t>(scan(table, ranges, nr, q, ts.candidates.data() + ts.used, unused));
+    }
+    finish_run(ts, t, run_begin);
+}
+#else
+void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P)
+{
+    stage_tets(ts, t, P, false);
+}
+#endif
 
 // Stage 3 over a thread's candidate runs: face planes per tet (only tets with candidates), filtered
 // plane tests for all candidates of the tet at once (AVX2 where available), exact orientation only where
