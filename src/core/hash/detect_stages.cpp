@@ -199,7 +199,8 @@ bool DetectorImpl::lean_stage_tets(bool with_stats) const
 // stage_tets: the same operations per lane (min, max, the clamp, p · (1/l), floor, p − origin rounded to float; a
 // ±0 difference in a min or max changes no cell and no float comparison), so the same candidate runs. Tets outside
 // the common case (cell boxes too big for the keys or the range array, a z-run as long as a table) go to stage_tets.
-__attribute__((target("avx2"))) void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P)
+__attribute__((target("avx2"))) void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P,
+                                                                   detail::ScanKernel scan)
 {
     const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
     const __m256i xyz = _mm256_setr_epi64x(-1, -1, -1, 0); // 3 doubles: never reads past the vertex
@@ -236,7 +237,6 @@ __attribute__((target("avx2"))) void DetectorImpl::stage_tets_lean(ThreadState& 
     q.z0 = c0s[2];
     q.z1 = c0s[2] + nz - 1;
     const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(c0s[2]));
-    const detail::ScanKernel scan = detail::column_scan_kernel();
     detail::ScanCounters unused;
     for (int ti = 0; ti < num_tables; ++ti) {
         const VertexTable& table = tables[ti];
@@ -276,7 +276,7 @@ __attribute__((target("avx2"))) void DetectorImpl::stage_tets_lean(ThreadState& 
     finish_run(ts, t, run_begin);
 }
 #else
-void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P)
+void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P, detail::ScanKernel)
 {
     stage_tets(ts, t, P, false);
 }
