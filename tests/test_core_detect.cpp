@@ -440,9 +440,11 @@ TEST(CoreDetect, LeanColumnPathFallsBackPerTetAndTable)
     Scene s = test::random_scene(28, 3, 3, 0.9);
     test::append_object(s, test::lattice_object(1, 1, 1, 0.3, Eigen::Vector3d(-0.1, -0.2, 0.0))); // static
     Scene needles;
-    needles.positions = test::matrix_of<Positions>(std::vector<Eigen::Vector3d>{
-        {0.0, 0.0, -1.0}, {0.3, 0.0, -1.0}, {0.0, 0.3, -1.0}, {0.1, 0.1, 20.0},    // ~100 cells in z
-        {-0.3, 0.1, -1.5}, {0.0, 0.1, -1.5}, {-0.3, 0.4, -1.5}, {-0.2, 0.2, 200.0}}); // ~1000 cells
+    // Two needles: about 100 cells long in z (longer than the static table) and about 1000 (beyond the keys' window).
+    const std::vector<Eigen::Vector3d> needle_points = {{0.0, 0.0, -1.0},  {0.3, 0.0, -1.0},  {0.0, 0.3, -1.0},
+                                                        {0.1, 0.1, 20.0},  {-0.3, 0.1, -1.5}, {0.0, 0.1, -1.5},
+                                                        {-0.3, 0.4, -1.5}, {-0.2, 0.2, 200.0}};
+    needles.positions = test::matrix_of<Positions>(needle_points);
     needles.tets = test::matrix_of<Tets>(std::vector<std::array<Index, 4>>{{0, 1, 2, 3}, {4, 5, 6, 7}});
     needles.vertex_object.assign(8, 0);
     needles.tet_object.assign(2, 0);
