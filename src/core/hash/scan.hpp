@@ -10,7 +10,7 @@ namespace tethash::detail {
 /// (lo, hi, relative to the table origin), and not one of the tet's own vertices. In scan_ranges the column comes
 /// from each range and the z-range [z0, z1] from the query (the same for all ranges of one call).
 struct ScanQuery {
-    float lo[4], hi[4]; ///< [3] unused (room for 4-lane stores)
+    float lo[3], hi[3];
     std::int32_t cx = 0, cy = 0, z0 = 0, z1 = 0;
     Index own[4];
 };
