@@ -357,6 +357,7 @@ const ScanFn chosen_lean = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean<tr
 const ScanFn chosen_column = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean<false> : chosen;
 #else
 const ScanFn chosen_lean = chosen;
+const ScanFn chosen_column = chosen;
 #endif
 const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 #ifdef TETHASH_X86
