@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
@@ -427,6 +428,53 @@ TEST(CoreDetect, LongTetsAndAliasedCellKeys)
                         << "cell " << cell << " table " << table << " hash " << to_string(hash) << " threads "
                         << threads;
                 }
+}
+
+TEST(CoreDetect, LeanColumnPathFallsBackPerTetAndTable)
+{
+    // Without statistics the column hash runs stage 2's lean path, which hands a tet to the general one when its
+    // cell box is too big for the keys (a needle over 1000 cells in z) or for the range array, or, table by table,
+    // when its z-run is as long as the table: here the small static object's table (16 buckets) against a needle of
+    // about 100 cells whose moving-table candidates are already appended. Contacts as the oracle's, with and without
+    // a skin, at 1 and 2 threads, and as with statistics (run_detector: the general path alone).
+    Scene s = test::random_scene(28, 3, 3, 0.9);
+    test::append_object(s, test::lattice_object(1, 1, 1, 0.3, Eigen::Vector3d(-0.1, -0.2, 0.0))); // static
+    Scene needles;
+    // Two needles: about 100 cells long in z (longer than the static table) and about 1000 (beyond the keys' window).
+    const std::vector<Eigen::Vector3d> needle_points = {{0.0, 0.0, -1.0},  {0.3, 0.0, -1.0},  {0.0, 0.3, -1.0},
+                                                        {0.1, 0.1, 20.0},  {-0.3, 0.1, -1.5}, {0.0, 0.1, -1.5},
+                                                        {-0.3, 0.4, -1.5}, {-0.2, 0.2, 200.0}};
+    needles.positions = test::matrix_of<Positions>(needle_points);
+    needles.tets = test::matrix_of<Tets>(std::vector<std::array<Index, 4>>{{0, 1, 2, 3}, {4, 5, 6, 7}});
+    needles.vertex_object.assign(8, 0);
+    needles.tet_object.assign(2, 0);
+    test::append_object(s, needles);
+    s.objects.resize(5);
+    s.objects[3].is_static = true;
+    s.objects[1].self_collision = false;
+    const std::vector<Contact> want = run_oracle(s);
+    ASSERT_GT(want.size(), 50u);
+    // The needles and the static object meet the scene.
+    EXPECT_TRUE(std::any_of(want.begin(), want.end(), [&](const Contact& c) { return c.tet_object == 3; }));
+    EXPECT_TRUE(std::any_of(want.begin(), want.end(), [&](const Contact& c) { return c.tet_object == 4; }));
+    for (std::int64_t table : {0, 2, 1024})
+        for (double skin : {0.0, 0.05})
+            for (int threads : {1, 2}) {
+                DetectParams p;
+                p.cell_size_mode = DetectParams::CellSizeMode::absolute;
+                p.cell_size = 0.2;
+                p.table_size = table;
+                p.skin = skin;
+                p.threads = threads;
+                Detector det(p);
+                det.set_topology(s.tets, static_cast<Index>(s.positions.rows()), s.vertex_object, s.tet_object,
+                                 s.objects);
+                // Twice: with a skin the second call reuses the kept candidates of the first.
+                for (int call = 0; call < 2; ++call)
+                    EXPECT_TRUE(same_contacts(det.detect(s.positions), want))
+                        << "table " << table << " skin " << skin << " threads " << threads << " call " << call;
+                EXPECT_TRUE(same_contacts(run_detector(s, p), want)) << "table " << table;
+            }
 }
 
 TEST(CoreDetect, ScanKernelFollowsTethashSimd)

@@ -147,12 +147,17 @@ void DetectorImpl::detect_full(const PositionsRef& positions, int T, Index m, In
         if (ok) {
             const auto t0 = Clock::now();
             const bool keep = skin > 0;
+            const bool lean = lean_stage_tets(with_stats);
+            const detail::ScanKernel column_scan = detail::column_scan_kernel();
 #pragma omp for schedule(monotonic : dynamic, chunk_tets) nowait
             for (Index t = 0; t < m; ++t) {
                 if (keep && t % chunk_tets == 0) // a chunk starts: remember where its runs go
                     chunks[static_cast<std::size_t>(t / chunk_tets)] = {rank, static_cast<std::int32_t>(ts.num_runs),
                                                                         0};
-                stage_tets(ts, t, P, with_stats);
+                if (lean)
+                    stage_tets_lean(ts, t, P, column_scan);
+                else
+                    stage_tets(ts, t, P, with_stats);
             }
             ts.ms_tets = ms_since(t0);
             const auto t1 = Clock::now();

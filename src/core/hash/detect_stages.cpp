@@ -1,6 +1,7 @@
 // Stages 2 and 3 of the hash detector for one tet and one thread's candidates: the tet's box → bucket ranges →
 // candidate vertices (SIMD scan), then the closed inside test by lazily built face planes with a filtered exact
 // fallback; and each thread's radix sort of its contacts.
+#include "../simd.hpp"
 #include "detector_impl.hpp"
 #include "scan.hpp"
 #include "tethash/predicates.hpp"
@@ -146,6 +147,11 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
         ts.counters.box_rejections += sc.box_rejections;
         ts.counters.own += sc.own;
     }
+    finish_run(ts, t, run_begin);
+}
+
+__attribute__((always_inline)) inline void DetectorImpl::finish_run(ThreadState& ts, Index t, std::int32_t run_begin)
+{
     std::int32_t run_end = static_cast<std::int32_t>(ts.used);
     // Self-collision off for this tet's object: drop the candidates of the same object here, so that the kept
     // candidates of a skin are already filtered.
@@ -162,6 +168,103 @@ void DetectorImpl::stage_tets(ThreadState& ts, Index t, const double* P, bool wi
     if (ts.num_runs == ts.runs.size()) ts.runs.resize(std::max<std::size_t>(64, 2 * ts.runs.size()));
     ts.runs[ts.num_runs] = {t, run_begin, run_end};
     ts.num_runs += run_end > run_begin;
+}
+
+namespace {
+// The lean path pays with the column kernel of the AVX2 scan (no z test); the scalar kernels keep the general path.
+const bool avx2_scan = detail::avx2_kernels();
+} // namespace
+
+bool DetectorImpl::lean_stage_tets(bool with_stats) const
+{
+    if (!avx2_scan || with_stats || params.hash != HashFunction::column) return false;
+    for (const VertexTable& table : tables)
+        if (table.size() > 0 && !table.modulus().pow2) return false;
+    return true;
+}
+
+// Stage 2 for one tet in the common case (column hash, power-of-two tables, no statistics, AVX2; run only where
+// lean_stage_tets() says so): the box and its cells as in stage_tets, one contiguous range per column (two where the
+// z-run wraps around the table), the scan kernel (column_scan_kernel: no z test) called directly, no per-tet branch
+// on statistics, hash or table kind. Tets outside the common case (cell boxes too big for the keys or the range
+// array, a z-run as long as a table) go to stage_tets. (The box, cells and float box in the lanes (x, y, z, -) of
+// AVX2 registers: 10 % fewer instructions, but the function compiled for AVX2 measured 3 % slower on the hand; the
+// candidate buffer sized by the table instead of the ranges' lengths: 4 % fewer, 1.5 % slower on the hand.)
+void DetectorImpl::stage_tets_lean(ThreadState& ts, Index t, const double* P, detail::ScanKernel scan)
+{
+    const Index* tv = tets.data() + 4 * static_cast<std::size_t>(t);
+    const double* pa = P + 3 * static_cast<std::size_t>(tv[0]);
+    const double* pb = P + 3 * static_cast<std::size_t>(tv[1]);
+    const double* pc = P + 3 * static_cast<std::size_t>(tv[2]);
+    const double* pd = P + 3 * static_cast<std::size_t>(tv[3]);
+    detail::ScanQuery q;
+    std::int32_t c0s[3];
+    std::int64_t ns[3]; // up to 2^31 + 1 cells at the guarded range's ends
+    const double limit = max_cell_coordinate * cell_size;
+    for (int k = 0; k < 3; ++k) {
+        const double lo = std::max(std::min(std::min(pa[k], pb[k]), std::min(pc[k], pd[k])) - skin, -limit);
+        const double hi = std::min(std::max(std::max(pa[k], pb[k]), std::max(pc[k], pd[k])) + skin, limit);
+        c0s[k] = floor_to_int(lo * inv_cell);
+        ns[k] = std::int64_t{floor_to_int(hi * inv_cell)} - c0s[k] + 1;
+        q.lo[k] = static_cast<float>(lo - origin[k]);
+        q.hi[k] = static_cast<float>(hi - origin[k]);
+    }
+    std::memcpy(q.own, tv, sizeof q.own);
+    const std::int64_t nx = ns[0], ny = ns[1], nz = ns[2];
+    constexpr int max_ranges = 64;
+    // Outside the common case: the general path (which also reports a cell box too big for the grid).
+    if (nx > key_exact_xy || ny > key_exact_xy || nz > key_exact_z || 2 * nx * ny > max_ranges) {
+        stage_tets(ts, t, P, false);
+        return;
+    }
+    const std::int32_t run_begin = static_cast<std::int32_t>(ts.used);
+    const int num_tables =
+        any_static && !flags.is_static[static_cast<std::size_t>(tet_object[static_cast<std::size_t>(t)])] ? 2 : 1;
+    const std::int32_t x0 = c0s[0], y0 = c0s[1], y1 = static_cast<std::int32_t>(y0 + ny - 1);
+    q.z0 = c0s[2];
+    q.z1 = static_cast<std::int32_t>(c0s[2] + nz - 1);
+    const std::uint64_t zoff = static_cast<std::uint64_t>(static_cast<std::int64_t>(c0s[2]));
+    detail::ScanCounters unused;
+    for (int ti = 0; ti < num_tables; ++ti) {
+        const VertexTable& table = tables[ti];
+        if (table.size() == 0) continue;
+        const TableModulus& mod = table.modulus();
+        if (static_cast<std::uint64_t>(nz) >= mod.n) { // a z-run that covers the table: the general path
+            ts.used = static_cast<std::size_t>(run_begin);
+            stage_tets(ts, t, P, false);
+            return;
+        }
+        const std::int32_t* start = table.start.data();
+        const std::uint64_t mask = mod.mask, n = mod.n;
+        detail::ScanRange ranges[max_ranges];
+        int nr = 0;
+        std::size_t total = 0;
+        std::int32_t x = x0, y = y0;
+        for (std::int64_t j = nx * ny; j > 0; --j) {
+            const std::uint64_t b0 = (column_mix(x, y) + zoff) & mask;
+            const std::uint64_t e = b0 + static_cast<std::uint64_t>(nz);
+            if (e <= n) [[likely]] {
+                ranges[nr] = {start[b0], start[e], x, y};
+                total += static_cast<std::size_t>(std::max(start[e] - start[b0], 0));
+                nr += ranges[nr].begin < ranges[nr].end;
+            } else {
+                total += static_cast<std::size_t>(std::max(start[n] - start[b0], 0)) +
+                         static_cast<std::size_t>(std::max(start[e - n] - start[0], 0));
+                ranges[nr] = {start[b0], start[n], x, y};
+                nr += ranges[nr].begin < ranges[nr].end;
+                ranges[nr] = {start[0], start[e - n], x, y};
+                nr += ranges[nr].begin < ranges[nr].end;
+            }
+            const bool wrap = y == y1;
+            x += wrap;
+            y = wrap ? y0 : y + 1;
+        }
+        if (nr == 0) continue;
+        const std::size_t need = ts.used + total + 8; // 8: the kernel's slack
+        if (ts.candidates.size() < need) ts.candidates.resize(need + need / 4 + 64);
+        ts.used += static_cast<std::size_t>(scan(table, ranges, nr, q, ts.candidates.data() + ts.used, unused));
+    }
+    finish_run(ts, t, run_begin);
 }
 
 // Stage 3 over a thread's candidate runs: face planes per tet (only tets with candidates), filtered

@@ -7,6 +7,7 @@
 #include "../timing.hpp"
 #include "detect_checks.hpp"
 #include "hash_grid.hpp"
+#include "scan.hpp"
 #include "tethash/detect.hpp"
 
 #include <algorithm>
@@ -155,6 +156,13 @@ class DetectorImpl {
                                                  Clock::time_point t_call, double ms_setup);
     void fill_stats(DetectStats& s, int T, Index m, bool reuse, double ms_vertices, double ms_sort) const;
     void stage_tets(ThreadState& ts, Index t, const double* P, bool with_stats);
+    /// Whether stage_tets_lean can run this call (AVX2, no statistics, column hash, power-of-two tables).
+    bool lean_stage_tets(bool with_stats) const;
+    /// stage_tets without statistics for the common case (see detect_stages.cpp), with the column hash's scan kernel
+    /// `scan` (detail::column_scan_kernel()); the same contacts.
+    void stage_tets_lean(ThreadState& ts, Index t, const double* P, detail::ScanKernel scan);
+    /// The end of stage 2 for one tet: the self-collision rule on its candidates [run_begin, ts.used), its run.
+    void finish_run(ThreadState& ts, Index t, std::int32_t run_begin);
     void stage_inside(ThreadState& ts, const CandidateRun* runs, std::size_t num_runs, const Index* candidates,
                       const double* P);
     bool moved_less_than(const double* P, int T, double limit) const;

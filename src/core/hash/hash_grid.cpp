@@ -157,16 +157,17 @@ bool VertexTable::build_team(const double* positions, const Index* ids, Index co
         if (rank == 0) {
             bad = cells(0, count);
             if (!bad) {
-                std::memset(s, 0, (static_cast<std::size_t>(table_size) + 1) * sizeof(std::int32_t));
+                // Counts, inclusive prefix sums (start[b] = the end of bucket b), then the vertices scattered from
+                // the last down, each to one before its bucket's current end: stable, and start[b] ends as the
+                // bucket's beginning, with no shift of the offsets afterwards.
+                std::memset(s, 0, static_cast<std::size_t>(table_size) * sizeof(std::int32_t));
                 for (Index i = 0; i < count; ++i)
-                    ++s[bucket[i] + 1];
-                for (std::int64_t b = 0; b < table_size; ++b)
-                    s[b + 1] += s[b];
-                for (Index i = 0; i < count; ++i)
-                    put(i, static_cast<std::size_t>(s[bucket[i]]++));
-                // start[b] now holds the end of bucket b: shift right by one.
-                std::memmove(s + 1, s, static_cast<std::size_t>(table_size) * sizeof(std::int32_t));
-                s[0] = 0;
+                    ++s[bucket[i]];
+                for (std::int64_t b = 1; b < table_size; ++b)
+                    s[b] += s[b - 1];
+                s[table_size] = count;
+                for (Index i = count - 1; i >= 0; --i)
+                    put(i, static_cast<std::size_t>(--s[bucket[i]]));
             }
         }
         return !bad_after_barrier(bad);

@@ -125,7 +125,8 @@ constexpr PackTable pack_table;
 
 // The lean kernel, branch-free per 8 entries: box, cell (column of the range, z-run of the query) and own-vertex
 // tests as lane masks, one movemask, survivors left-packed by a permutation from pack_table and stored 8 at a time
-// (`out` has 8 ids of slack). No statistics.
+// (`out` has 8 ids of slack). No statistics. Without `ZTest` the cell test is the column alone (column_scan_kernel).
+template <bool ZTest>
 __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const VertexTable& t, const ScanRange* ranges,
                                                                           std::int32_t count, const ScanQuery& q,
                                                                           Index* out, ScanCounters&)
@@ -156,9 +157,11 @@ __attribute__((target("avx2,popcnt"))) std::int32_t scan_ranges_avx2_lean(const 
             const __m256 iny = _mm256_and_ps(_mm256_cmp_ps(y, ly, _CMP_GE_OQ), _mm256_cmp_ps(y, hy, _CMP_LE_OQ));
             const __m256 inz = _mm256_and_ps(_mm256_cmp_ps(z, lz, _CMP_GE_OQ), _mm256_cmp_ps(z, hz, _CMP_LE_OQ));
             const __m256i k = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(KEY + i));
-            const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
-            const __m256i cell =
-                _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk), _mm256_cmpgt_epi32(zs, dz));
+            __m256i cell = _mm256_cmpeq_epi32(_mm256_and_si256(k, colmask), qk);
+            if constexpr (ZTest) {
+                const __m256i dz = _mm256_and_si256(_mm256_sub_epi32(_mm256_srli_epi32(k, 22), z0), zmask);
+                cell = _mm256_and_si256(cell, _mm256_cmpgt_epi32(zs, dz));
+            }
             const __m256i ids = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(ID + i));
             const __m256i isown =
                 _mm256_or_si256(_mm256_or_si256(_mm256_cmpeq_epi32(ids, o0), _mm256_cmpeq_epi32(ids, o1)),
@@ -350,9 +353,11 @@ ScanFn choose()
 
 const ScanFn chosen = choose();
 #ifdef TETHASH_X86
-const ScanFn chosen_lean = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean : chosen;
+const ScanFn chosen_lean = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean<true> : chosen;
+const ScanFn chosen_column = chosen == scan_ranges_avx2 ? scan_ranges_avx2_lean<false> : chosen;
 #else
 const ScanFn chosen_lean = chosen;
+const ScanFn chosen_column = chosen;
 #endif
 const FilterFn chosen_filter = chosen == scan_ranges_scalar ? filter_scalar
 #ifdef TETHASH_X86
@@ -369,6 +374,11 @@ std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std:
 {
     if (exact_positions) return scan_ranges_exact(table, ranges, count, q, out, counters, exact_positions, inv_cell);
     return (full_counts ? chosen : chosen_lean)(table, ranges, count, q, out, counters);
+}
+
+ScanKernel column_scan_kernel()
+{
+    return chosen_column;
 }
 
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,

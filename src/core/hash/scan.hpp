@@ -35,6 +35,17 @@ std::int32_t scan_ranges(const VertexTable& table, const ScanRange* ranges, std:
                          Index* out, ScanCounters& counters, bool full_counts = true,
                          const double* exact_positions = nullptr, double inv_cell = 0);
 
+/// A scan kernel of the column hash without the dispatch of scan_ranges: no full counts, no exact positions, and
+/// (with AVX2) no z test, only the column's: in the buckets of a column's z-run [z0, z1] (one contiguous range or two
+/// pieces wrapping around the table, nz = z1 − z0 + 1 < the table size n), an entry of that column has z ≡ z0 .. z1
+/// (mod n), so one outside the z-run is at least n − nz + 1 ≥ 1 cells away from it and the float box rejects it (the
+/// float rounding of the box can admit a vertex just outside the double box: then one more candidate for the exact
+/// stage 3, never a duplicate, since each entry lies in one range of its column). Not for Teschner's hash, whose bucket
+/// of one cell holds other cells of the same column that another z-layer's batch scans too.
+using ScanKernel = std::int32_t (*)(const VertexTable&, const ScanRange*, std::int32_t, const ScanQuery&, Index*,
+                                    ScanCounters&);
+ScanKernel column_scan_kernel();
+
 /// Appends to `out` the ids of the entries [begin, end) of `table` that match `q`; returns how many.
 /// `out` must have room for end − begin ids.
 std::int32_t scan_bucket_range(const VertexTable& table, std::int32_t begin, std::int32_t end, const ScanQuery& q,
