@@ -1,6 +1,5 @@
 #include "block_ldlt.hpp"
 
-#include <Eigen/LU>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
 
@@ -8,6 +7,45 @@
 #include <cmath>
 
 namespace tethash::sim::detail {
+
+namespace {
+
+/// D_k's own LDLᵀ, in place (no pivoting, x, y, z in order, as a scalar factorisation eliminates a node's three
+/// unknowns): the multipliers below the diagonal, the pivots' reciprocals on it. False where a pivot is zero or not
+/// finite. Reads the lower triangle of d only.
+bool factorise_pivot(Eigen::Matrix3d& d)
+{
+    const double d0 = d(0, 0);
+    if (!std::isfinite(d0) || d0 == 0) return false;
+    const double l10 = d(1, 0) / d0, l20 = d(2, 0) / d0;
+    const double d1 = d(1, 1) - l10 * d(1, 0);
+    if (!std::isfinite(d1) || d1 == 0) return false;
+    const double l21 = (d(2, 1) - l20 * d(1, 0)) / d1;
+    const double d2 = d(2, 2) - l20 * d(2, 0) - l21 * (d(2, 1) - l20 * d(1, 0));
+    if (!std::isfinite(d2) || d2 == 0) return false;
+    d.setZero();
+    d(1, 0) = l10;
+    d(2, 0) = l20;
+    d(2, 1) = l21;
+    d(0, 0) = 1 / d0;
+    d(1, 1) = 1 / d1;
+    d(2, 2) = 1 / d2;
+    return true;
+}
+
+/// v = D⁻¹ v for each column of v, D given by factorise_pivot()'s f: forward, scaled, backward.
+template <typename M> void apply_pivot_inverse(const Eigen::Matrix3d& f, M& v)
+{
+    v.row(1) -= f(1, 0) * v.row(0);
+    v.row(2) -= f(2, 0) * v.row(0) + f(2, 1) * v.row(1);
+    v.row(0) *= f(0, 0);
+    v.row(1) *= f(1, 1);
+    v.row(2) *= f(2, 2);
+    v.row(1) -= f(2, 1) * v.row(2);
+    v.row(0) -= f(1, 0) * v.row(1) + f(2, 0) * v.row(2);
+}
+
+} // namespace
 
 void BlockLdlt::analyse(std::int32_t nodes, const std::vector<std::pair<std::int32_t, std::int32_t>>& blocks)
 {
@@ -75,7 +113,7 @@ void BlockLdlt::analyse(std::int32_t nodes, const std::vector<std::pair<std::int
         m_li_start[k + 1] = m_li_start[k] + count[k];
     m_li.assign(static_cast<size_t>(m_li_start[m]), 0);
     m_lx.assign(m_li.size(), Eigen::Matrix3d::Zero());
-    m_dinv.assign(m, Eigen::Matrix3d::Zero());
+    m_pivot.assign(m, Eigen::Matrix3d::Zero());
     m_y.assign(m, Eigen::Matrix3d::Zero());
     m_pattern.assign(m, 0);
     m_fill.assign(m, 0);
@@ -120,15 +158,16 @@ bool BlockLdlt::factorise(const double* values, const std::int32_t* at)
             m_y[i].setZero();
             for (std::int32_t q = m_li_start[i]; q < m_fill[i]; ++q)
                 m_y[static_cast<size_t>(m_li[static_cast<size_t>(q)])].noalias() -= m_lx[static_cast<size_t>(q)] * w;
-            const Eigen::Matrix3d l = w.transpose() * m_dinv[i];
+            Eigen::Matrix3d t = w;
+            apply_pivot_inverse(m_pivot[i], t);
+            const Eigen::Matrix3d l = t.transpose();
             d.noalias() -= l * w;
             const size_t q = static_cast<size_t>(m_fill[i]++);
             m_li[q] = kk;
             m_lx[q] = l;
         }
-        const double det = d.determinant();
-        if (!std::isfinite(det) || det == 0) return false;
-        m_dinv[k] = d.inverse();
+        if (!factorise_pivot(d)) return false;
+        m_pivot[k] = d;
     }
     m_ok = true;
     return true;
@@ -145,7 +184,7 @@ void BlockLdlt::solve(const double* b, double* x) const
         for (std::int32_t q = m_li_start[i]; q < m_li_start[i + 1]; ++q)
             z[static_cast<size_t>(m_li[static_cast<size_t>(q)])].noalias() -= m_lx[static_cast<size_t>(q)] * z[i];
     for (size_t i = 0; i < m; ++i)
-        z[i] = m_dinv[i] * z[i];
+        apply_pivot_inverse(m_pivot[i], z[i]);
     for (size_t i = m; i-- > 0;)
         for (std::int32_t q = m_li_start[i]; q < m_li_start[i + 1]; ++q)
             z[i].noalias() -=
