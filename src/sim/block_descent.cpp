@@ -829,15 +829,24 @@ double BlockDescent::coarse_correction(double* xp, double h, bool first)
         }
     }
     if (!(slope0 > 0)) return 0; // not a descent direction here: no correction this time
-    for (const std::int32_t i : m_order)
-        for (size_t q = 0; q < 3; ++q)
-            xp[4 * static_cast<size_t>(i) + q] += m_dx[3 * static_cast<size_t>(i) + q];
-    refresh_contacts(xp);
-    residual(xp, h, m_residual_end, false);
-    double slope1 = 0;
-    for (const std::int32_t i : m_order)
-        for (size_t q = 0; q < 3; ++q)
-            slope1 += m_residual_end[3 * static_cast<size_t>(i) + q] * m_dx[3 * static_cast<size_t>(i) + q];
+    // xp moved by `by` times the correction; the correction's slope where xp is (the residual along it: the energy
+    // still falls where it is positive).
+    const auto move = [&](double by) {
+        for (const std::int32_t i : m_order)
+            for (size_t q = 0; q < 3; ++q)
+                xp[4 * static_cast<size_t>(i) + q] += by * m_dx[3 * static_cast<size_t>(i) + q];
+    };
+    const auto slope_here = [&] {
+        refresh_contacts(xp);
+        residual(xp, h, m_residual_end, false);
+        double slope = 0;
+        for (const std::int32_t i : m_order)
+            for (size_t q = 0; q < 3; ++q)
+                slope += m_residual_end[3 * static_cast<size_t>(i) + q] * m_dx[3 * static_cast<size_t>(i) + q];
+        return slope;
+    };
+    move(1.0);
+    const double slope1 = slope_here();
     double alpha = slope0 > slope1 ? std::min(1.0, slope0 / (slope0 - slope1)) : 1.0;
     // Still going down at the clamp's end (slope1 > 0): the secant's minimum further along, within the lattice's
     // whole correction (over times the clamped one), and where the slope there says it went past, the secant between
@@ -846,27 +855,14 @@ double BlockDescent::coarse_correction(double* xp, double h, bool first)
     if (slope1 > 0 && alpha >= 1.0 && over > 1.0) {
         const double reach = slope0 > slope1 ? std::min(over, slope0 / (slope0 - slope1)) : over;
         if (reach > 1.0) {
-            for (const std::int32_t i : m_order)
-                for (size_t q = 0; q < 3; ++q)
-                    xp[4 * static_cast<size_t>(i) + q] += (reach - 1.0) * m_dx[3 * static_cast<size_t>(i) + q];
-            refresh_contacts(xp);
-            residual(xp, h, m_residual_end, false);
-            double slope2 = 0;
-            for (const std::int32_t i : m_order)
-                for (size_t q = 0; q < 3; ++q)
-                    slope2 += m_residual_end[3 * static_cast<size_t>(i) + q] * m_dx[3 * static_cast<size_t>(i) + q];
+            move(reach - 1.0);
+            const double slope2 = slope_here();
             alpha = slope2 < 0 ? 1.0 + (reach - 1.0) * slope1 / (slope1 - slope2) : reach;
-            if (alpha < reach)
-                for (const std::int32_t i : m_order)
-                    for (size_t q = 0; q < 3; ++q)
-                        xp[4 * static_cast<size_t>(i) + q] -= (reach - alpha) * m_dx[3 * static_cast<size_t>(i) + q];
+            if (alpha < reach) move(-(reach - alpha));
             return 0.5 * alpha * slope0;
         }
     }
-    if (alpha < 1.0)
-        for (const std::int32_t i : m_order)
-            for (size_t q = 0; q < 3; ++q)
-                xp[4 * static_cast<size_t>(i) + q] -= (1.0 - alpha) * m_dx[3 * static_cast<size_t>(i) + q];
+    if (alpha < 1.0) move(-(1.0 - alpha));
     return 0.5 * alpha * slope0;
 }
 
