@@ -57,4 +57,20 @@ inline sim::ObjectSpec bar_object(const Eigen::Vector3d& size, const Eigen::Vect
     return o;
 }
 
+/// A bar along y (0.05 thick) with its centre `height` above a static bar along x as thin (both one cube, 1 long), no
+/// gravity, dt 1/100, no output: at height 0.03 the two cross edge through face with no vertex of either inside the
+/// other (their vertices are at their far ends).
+inline sim::Scene crossed_bars_scene(double height)
+{
+    sim::Scene s;
+    sim::ObjectSpec lower = bar_object({1.0, 0.05, 0.05}, {0, 0, 0});
+    lower.is_static = true;
+    s.objects.push_back(lower);
+    s.objects.push_back(bar_object({0.05, 1.0, 0.05}, {0, 0, height}));
+    s.gravity.setZero();
+    s.dt = 1.0 / 100;
+    s.output.every = 0;
+    return s;
+}
+
 } // namespace tethash::test

@@ -19,20 +19,35 @@ using namespace tethash::sim;
 
 namespace {
 
+/// A body's mesh and model.
+struct Body {
+    TetMesh mesh;
+    Model model;
+};
+
+/// A generated box of `resolution` cells along its longest side, young 1e5, density 1000 and `damping`, as one object.
+Body box_body(int resolution, const Eigen::Vector3d& size, double damping = Material{}.damping)
+{
+    meshing::GenerateParams g;
+    g.shape = "box";
+    g.resolution = resolution;
+    g.size = size;
+    Body out;
+    out.mesh = meshing::generate(g);
+    Material m;
+    m.young = 1e5;
+    m.density = 1000;
+    m.damping = damping;
+    out.model = Model::build(out.mesh, {m}, {0});
+    return out;
+}
+
 /// Nodes of the lattice over a box of young `young` (1 m, 2,000 vertices and more, so that a quarter of its
 /// vertices does not bind) built for a substep h = omega_h / ω.
 std::int32_t lattice_nodes(double omega_h)
 {
-    meshing::GenerateParams g;
-    g.shape = "box";
-    g.resolution = 12;
-    g.size = Eigen::Vector3d::Constant(1.0);
-    const TetMesh mesh = meshing::generate(g);
+    const auto [mesh, model] = box_body(12, Eigen::Vector3d::Constant(1.0));
     EXPECT_GE(mesh.num_vertices(), 1600);
-    Material m;
-    m.young = 1e5;
-    m.density = 1000;
-    const Model model = Model::build(mesh, {m}, {0});
     const double omega = std::sqrt(model.object_frequency_sq[0]);
     detail::CoarseSpace coarse;
     coarse.build(model, mesh.positions, {0.0}, omega_h / omega);
@@ -56,12 +71,7 @@ TEST(SimCoarseSpace, LatticeStaysSmallWhereASubstepNeedsFewSweeps)
 namespace {
 
 /// Two boxes (1 m and a turned 0.4 m one) as two objects, a few vertices of the first pinned.
-struct TwoBodies {
-    TetMesh mesh;
-    Model model;
-};
-
-TwoBodies two_bodies()
+Body two_bodies()
 {
     meshing::GenerateParams g;
     g.shape = "box";
@@ -74,7 +84,7 @@ TwoBodies two_bodies()
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
     for (Index i = 0; i < b.num_vertices(); ++i)
         b.positions.row(i) = (turn * b.positions.row(i).transpose() + Eigen::Vector3d(0.2, 0.1, 0.9)).transpose();
-    TwoBodies out;
+    Body out;
     TetMesh& m = out.mesh;
     m.positions.resize(a.num_vertices() + b.num_vertices(), 3);
     m.positions << a.positions, b.positions;
@@ -134,7 +144,7 @@ TEST(SimCoarseSpace, AssembledMatrixIsTheGalerkinProductOfTheFineMatrix)
     // The lattice's matrix is assembled element by element on the nodes: it must be Pᵀ A P of the fine matrix (plus
     // the small floor on the diagonal), across two objects, pinned vertices and the springs' and volumes' damping; and
     // after prepare() with ground or contact blocks on some vertices, Pᵀ (A + E) P.
-    const TwoBodies bodies = two_bodies();
+    const Body bodies = two_bodies();
     const Model& model = bodies.model;
     const std::vector<double> damping = {0.01, 0.01};
     const double h = 1.0 / 240;
@@ -193,16 +203,7 @@ TEST(SimCoarseSpace, RefreshAndCorrectionAreBitIdenticalAtOneAndTwoThreads)
 {
     // The matrix's refresh splits its block rows over the threads, the restriction its nodes and the prolongation its
     // vertices: every sum is taken in the same order at any count (a box large enough for the parallel paths).
-    meshing::GenerateParams g;
-    g.shape = "box";
-    g.resolution = 18;
-    g.size = Eigen::Vector3d(1.0, 0.7, 0.5);
-    const TetMesh mesh = meshing::generate(g);
-    Material m;
-    m.young = 1e5;
-    m.density = 1000;
-    m.damping = 0.01;
-    const Model model = Model::build(mesh, {m}, {0});
+    const auto [mesh, model] = box_body(18, Eigen::Vector3d(1.0, 0.7, 0.5), 0.01);
     const size_t un = static_cast<size_t>(model.num_vertices());
     ASSERT_GT(un, 4096u);
     const double h = 12.0 / std::sqrt(model.object_frequency_sq[0]); // ω h 12: about 200 nodes
@@ -253,15 +254,7 @@ TEST(SimCoarseSpace, PartTurnedAgainstTheBodyKeepsItsStiffnessAlongItsSprings)
     // the object's one rotation (the polar factor of the whole, about half the turn) both halves' stiffness points
     // 0.6 rad off their springs; each lattice cell turned by its own vertices' rotation puts it back along them
     // (except in the cells at the joint, which the turn shears).
-    meshing::GenerateParams g;
-    g.shape = "box";
-    g.resolution = 10;
-    g.size = Eigen::Vector3d(2.0, 0.4, 0.4);
-    const TetMesh mesh = meshing::generate(g);
-    Material m;
-    m.young = 1e5;
-    m.density = 1000;
-    const Model model = Model::build(mesh, {m}, {0});
+    const auto [mesh, model] = box_body(10, Eigen::Vector3d(2.0, 0.4, 0.4));
     const double h = 40.0 / std::sqrt(model.object_frequency_sq[0]); // ω h 40: cells of about two mean edges
     detail::CoarseSpace coarse;
     coarse.build(model, mesh.positions, {0.0}, h);

@@ -59,15 +59,8 @@ double lowest(const Scene& s, int steps)
 /// either is inside the other (their vertices are at their far ends). No gravity, the crossing check on.
 Scene crossed_bars(bool continuous)
 {
-    Scene s;
-    ObjectSpec lower = bar_object({1.0, 0.05, 0.05}, {0, 0, 0});
-    lower.is_static = true;
-    s.objects.push_back(lower);
-    s.objects.push_back(bar_object({0.05, 1.0, 0.05}, {0, 0, 0.12}));
+    Scene s = crossed_bars_scene(0.12);
     s.objects[1].velocity = Eigen::Vector3d(0, 0, -10);
-    s.gravity.setZero();
-    s.dt = 1.0 / 100;
-    s.output.every = 0;
     s.crossing_check = true;
     s.continuous_check = continuous;
     return s;

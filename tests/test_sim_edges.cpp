@@ -25,14 +25,7 @@ namespace {
 /// is inside the other (their vertices are at their far ends). No gravity, dt 1/100.
 Scene crossed_bars(bool edges)
 {
-    Scene s;
-    ObjectSpec lower = bar_object({1.0, 0.05, 0.05}, {0, 0, 0});
-    lower.is_static = true;
-    s.objects.push_back(lower);
-    s.objects.push_back(bar_object({0.05, 1.0, 0.05}, {0, 0, 0.03}));
-    s.gravity.setZero();
-    s.dt = 1.0 / 100;
-    s.output.every = 0;
+    Scene s = crossed_bars_scene(0.03);
     s.contact.edges = edges;
     return s;
 }

@@ -314,14 +314,18 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
         return m_edges.crosses_locally(g, object, x); // a crossing the find left out as local
     };
     const Positions& rest = m_rest;
+    // A self crossing the rest state calls local (a vertex of the edge and one of the face within the contacts'
+    // reach): the material's to resolve, not a contact.
+    const auto local_self = [&](const EdgeFaceContact& c) {
+        return c.edge_object == c.face_object &&
+               near_at_rest(rest, c.edge_vertices, 2, c.face_vertices, 3,
+                            local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.face_object)]);
+    };
     // The pairs (edge, an edge of a face it passes through that passes through the first edge's object), each
     // once, the lower edge index first: the crossings of the intersection of two surfaces, taken two by two.
     m_edge_keys.clear();
     for (const EdgeFaceContact& c : crossings) {
-        if (c.edge_object == c.face_object) { // a self pair the rest state calls local is the material's
-            const double reach = local_contact_edges * model.object_mean_edge[static_cast<size_t>(c.face_object)];
-            if (near_at_rest(rest, c.edge_vertices, 2, c.face_vertices, 3, reach)) continue;
-        }
+        if (local_self(c)) continue;
         for (int k = 0; k < 3; ++k) {
             const Index g = edge_index(c.face_vertices[k], c.face_vertices[(k + 1) % 3]);
             if (g < 0 || !crosses_object(g, c.edge_object)) continue;
@@ -379,11 +383,7 @@ void ContactResponse::add_edge_contacts(const EdgeFaceResult& found, const Posit
                 const EdgeFaceContact *lo = nullptr, *hi = nullptr; // its far crossings of least and greatest t
                 for (size_t m = k; m < j; ++m) {
                     const EdgeFaceContact& c = crossings[m];
-                    if (c.face_object != object) continue;
-                    if (c.edge_object == c.face_object &&
-                        near_at_rest(rest, c.edge_vertices, 2, c.face_vertices, 3,
-                                     local_contact_edges * model.object_mean_edge[static_cast<size_t>(object)]))
-                        continue;
+                    if (c.face_object != object || local_self(c)) continue;
                     if (!lo || c.edge_t < lo->edge_t) lo = &c;
                     if (!hi || c.edge_t > hi->edge_t) hi = &c;
                 }
